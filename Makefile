@@ -1,0 +1,30 @@
+# Thin wrapper around CMake.  `make run`: set up, build, prepare the bunny,
+# run the default scene.  `make test`: set up, build, run every test.
+BUILD     ?= build
+BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
+MESHES    := $(BUILD)/meshes
+JOBS      ?= 2
+
+.PHONY: all deps build meshes run test clean
+
+all: build
+
+deps:
+	@sh tools/install-deps.sh
+
+build: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@cmake --build $(BUILD) -j $(JOBS)
+
+meshes: build
+	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny --target-tets 200000
+	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_small --target-tets 15000
+
+run: meshes
+	$(BUILD)/cohfrac run scenes/bunny_drop.lua --mesh-dir $(MESHES)
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure
+
+clean:
+	rm -rf $(BUILD) out

@@ -1,0 +1,634 @@
+// cohfrac — Bullet rigid-body world behind the C header cf_bullet.h.
+// Built with BT_USE_DOUBLE_PRECISION and -fno-exceptions: nothing here throws,
+// and no C++ type leaves this file.
+#include "cf_bullet.h"
+
+#include <btBulletDynamicsCommon.h>
+#include <LinearMath/btConvexHullComputer.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstddef>
+#include <cstdio>
+#include <limits>
+#include <new>
+#include <vector>
+
+namespace {
+
+// Per thread, so OpenMP callers do not overwrite each other's message.
+thread_local char g_error[256] = "";
+
+void set_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(g_error, sizeof g_error, fmt, ap);
+    va_end(ap);
+}
+
+bool finite3(const double *v)
+{
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+bool nonzero3(const double *v) { return v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0; }
+
+enum BodyKind { BODY_DYNAMIC, BODY_STATIC, BODY_KINEMATIC };
+
+struct Body {
+    btRigidBody *rb;
+    btCollisionShape *shape;
+    btDefaultMotionState *motion;
+    BodyKind kind;
+    btVector3 kin_v, kin_w;  // prescribed velocity of a kinematic obstacle
+    double impulse;          // normal contact impulse during the last cfb_step
+    std::vector<int> ignored;
+    // The quaternion last given by the caller and the basis it produced:
+    // while the basis is untouched, get_state returns that exact quaternion
+    // (matrix -> quaternion conversion would differ by round-off or sign).
+    bool has_quat;
+    double quat[4];
+    btMatrix3x3 quat_basis;
+};
+
+// Exposes the fixed-step accumulator so each cfb_step runs a whole number of
+// sub-steps with nothing carried over between calls.
+class StepWorld : public btDiscreteDynamicsWorld {
+public:
+    StepWorld(btDispatcher *d, btBroadphaseInterface *b, btConstraintSolver *s,
+              btCollisionConfiguration *c)
+        : btDiscreteDynamicsWorld(d, b, s, c)
+    {
+    }
+    void reset_local_time() { m_localTime = 0; }
+};
+
+// Bodies of one collision family (user index 2, -1 = none) never collide
+// with each other.  Checked for every overlapping pair before narrow phase.
+class FamilyDispatcher : public btCollisionDispatcher {
+public:
+    explicit FamilyDispatcher(btCollisionConfiguration *c) : btCollisionDispatcher(c) {}
+    bool needsCollision(const btCollisionObject *a, const btCollisionObject *b) override
+    {
+        const int fa = a->getUserIndex2();
+        if (fa >= 0 && fa == b->getUserIndex2()) return false;
+        return btCollisionDispatcher::needsCollision(a, b);
+    }
+};
+
+}  // namespace
+
+struct cfb_world {
+    btDefaultCollisionConfiguration *config;
+    FamilyDispatcher *dispatcher;
+    btDbvtBroadphase *broadphase;
+    btSequentialImpulseConstraintSolver *solver;
+    StepWorld *dyn;
+    std::vector<Body *> bodies;  // index = id; removed slots are NULL
+    std::vector<Body *> kinematic;
+    int n_dynamic;
+    int ticks;  // sub-steps run by the current cfb_step
+};
+
+namespace {
+
+Body *lookup(const cfb_world *w, int id)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return NULL;
+    }
+    if (id < 0 || static_cast<size_t>(id) >= w->bodies.size() || !w->bodies[id]) {
+        set_error("invalid body id %d", id);
+        return NULL;
+    }
+    return w->bodies[id];
+}
+
+bool state_valid(const cfb_state *s)
+{
+    if (!s) {
+        set_error("state is NULL");
+        return false;
+    }
+    const double q2 = s->quat[0] * s->quat[0] + s->quat[1] * s->quat[1] +
+                      s->quat[2] * s->quat[2] + s->quat[3] * s->quat[3];
+    if (!finite3(s->pos) || !finite3(s->v) || !finite3(s->w) || !std::isfinite(q2)) {
+        set_error("state has a non-finite value");
+        return false;
+    }
+    if (!(q2 > 1e-30)) {
+        set_error("state quaternion is zero");
+        return false;
+    }
+    return true;
+}
+
+// Caller's quaternion, normalised only when it is not already unit to
+// round-off (so a unit input is kept bit for bit).
+void unit_quat(const double in[4], double out[4])
+{
+    const double q2 = in[0] * in[0] + in[1] * in[1] + in[2] * in[2] + in[3] * in[3];
+    const double f = std::fabs(q2 - 1.0) > 1e-14 ? 1.0 / std::sqrt(q2) : 1.0;
+    for (int i = 0; i < 4; ++i) out[i] = in[i] * f;
+}
+
+btTransform state_transform(const double q[4], const double p[3])
+{
+    // cfb order is (w,x,y,z); btQuaternion takes (x,y,z,w).
+    return btTransform(btQuaternion(q[1], q[2], q[3], q[0]), btVector3(p[0], p[1], p[2]));
+}
+
+void remember_quat(Body *b, const double q[4])
+{
+    b->has_quat = true;
+    for (int i = 0; i < 4; ++i) b->quat[i] = q[i];
+    b->quat_basis = b->rb->getCenterOfMassTransform().getBasis();
+}
+
+bool friction_valid(double friction, double restitution)
+{
+    if (!std::isfinite(friction) || friction < 0.0 || !std::isfinite(restitution) ||
+        restitution < 0.0) {
+        set_error("friction and restitution must be finite and >= 0");
+        return false;
+    }
+    return true;
+}
+
+// Takes ownership of shape; registers the body and returns its id.
+int add_body(cfb_world *w, btCollisionShape *shape, double mass, const btVector3 &inertia,
+             const btTransform &xf, BodyKind kind, const btVector3 &kin_v, double friction,
+             double restitution)
+{
+    Body *b = new (std::nothrow) Body();
+    if (!b) {
+        delete shape;
+        set_error("out of memory");
+        return -1;
+    }
+    b->shape = shape;
+    b->motion = new btDefaultMotionState(xf);
+    btRigidBody::btRigidBodyConstructionInfo ci(mass, b->motion, shape, inertia);
+    // No damping of any kind: free flight must follow the integrator exactly.
+    ci.m_linearDamping = 0;
+    ci.m_angularDamping = 0;
+    ci.m_additionalDamping = false;
+    // Bullet combines pair coefficients as products (friction clamped to 10).
+    ci.m_friction = friction;
+    ci.m_restitution = restitution;
+    b->rb = new btRigidBody(ci);
+    b->kind = kind;
+    b->kin_v = kin_v;
+    b->kin_w = btVector3(0, 0, 0);
+    b->impulse = 0.0;
+    b->has_quat = false;
+
+    const int id = static_cast<int>(w->bodies.size());
+    b->rb->setUserIndex(id);
+    b->rb->setUserIndex2(-1);  // no collision family
+    if (kind == BODY_KINEMATIC) {
+        b->rb->setCollisionFlags(b->rb->getCollisionFlags() |
+                                 btCollisionObject::CF_KINEMATIC_OBJECT);
+        b->rb->setLinearVelocity(kin_v);
+    }
+    // Sleeping is off so that runs are reproducible and contact impulses are
+    // reported every step.  To enable it later, leave dynamic bodies at
+    // ACTIVE_TAG and set sleeping thresholds (kinematic ones must stay awake).
+    if (kind != BODY_STATIC) b->rb->setActivationState(DISABLE_DEACTIVATION);
+
+    w->bodies.push_back(b);
+    if (kind == BODY_KINEMATIC) w->kinematic.push_back(b);
+    w->dyn->addRigidBody(b->rb);
+    if (kind == BODY_DYNAMIC) w->n_dynamic++;
+    return id;
+}
+
+int add_obstacle(cfb_world *w, btCollisionShape *shape, const double center[3],
+                 const double velocity[3], double friction, double restitution)
+{
+    const bool moving = velocity && nonzero3(velocity);
+    const btVector3 v = moving ? btVector3(velocity[0], velocity[1], velocity[2])
+                               : btVector3(0, 0, 0);
+    btTransform xf;
+    xf.setIdentity();
+    xf.setOrigin(btVector3(center[0], center[1], center[2]));
+    return add_body(w, shape, 0.0, btVector3(0, 0, 0), xf,
+                    moving ? BODY_KINEMATIC : BODY_STATIC, v, friction, restitution);
+}
+
+bool obstacle_args_valid(const cfb_world *w, const double center[3], const double velocity[3],
+                         double friction, double restitution)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return false;
+    }
+    if (!center || !finite3(center) || (velocity && !finite3(velocity))) {
+        set_error("obstacle centre/velocity missing or non-finite");
+        return false;
+    }
+    return friction_valid(friction, restitution);
+}
+
+// Before each sub-step: Bullet derives a kinematic body's velocity from its
+// motion-state displacement once per stepSimulation (zero on the first
+// call), so restore the prescribed velocity for the contact solver.
+void pre_tick(btDynamicsWorld *dw, btScalar)
+{
+    cfb_world *w = static_cast<cfb_world *>(dw->getWorldUserInfo());
+    for (size_t i = 0; i < w->kinematic.size(); ++i) {
+        Body *b = w->kinematic[i];
+        b->rb->setLinearVelocity(b->kin_v);
+        b->rb->setAngularVelocity(b->kin_w);
+    }
+}
+
+// After each sub-step: collect the solved normal impulses (velocity pass
+// only; the split-impulse position pass Bullet uses for penetrations deeper
+// than 4 cm applies none), then move the
+// kinematic bodies by their velocity over the sub-step (the dynamic bodies
+// have just been moved by integrateTransforms).
+void post_tick(btDynamicsWorld *dw, btScalar h)
+{
+    cfb_world *w = static_cast<cfb_world *>(dw->getWorldUserInfo());
+    w->ticks++;
+    btDispatcher *disp = dw->getDispatcher();
+    const int nm = disp->getNumManifolds();
+    for (int m = 0; m < nm; ++m) {
+        const btPersistentManifold *man = disp->getManifoldByIndexInternal(m);
+        double sum = 0.0;
+        for (int c = 0; c < man->getNumContacts(); ++c)
+            sum += man->getContactPoint(c).getAppliedImpulse();
+        if (sum == 0.0) continue;
+        const int ids[2] = {man->getBody0()->getUserIndex(), man->getBody1()->getUserIndex()};
+        for (int k = 0; k < 2; ++k) {
+            if (ids[k] >= 0 && static_cast<size_t>(ids[k]) < w->bodies.size() &&
+                w->bodies[ids[k]])
+                w->bodies[ids[k]]->impulse += sum;
+        }
+    }
+    for (size_t i = 0; i < w->kinematic.size(); ++i) {
+        Body *b = w->kinematic[i];
+        btTransform next = b->rb->getWorldTransform();
+        // Pure translation leaves the basis bit-exact (a quaternion round
+        // trip through integrateTransform would not).
+        if (b->kin_w.isZero())
+            next.setOrigin(next.getOrigin() + b->kin_v * h);
+        else
+            btTransformUtil::integrateTransform(b->rb->getWorldTransform(), b->kin_v, b->kin_w,
+                                                h, next);
+        b->motion->setWorldTransform(next);
+        b->rb->setWorldTransform(next);
+    }
+}
+
+// A pair that stops colliding keeps its manifold, whose stale points would
+// still reach the solver; release it.
+void drop_contacts(cfb_world *w, Body *a, Body *b)
+{
+    btOverlappingPairCache *cache = w->dyn->getBroadphase()->getOverlappingPairCache();
+    btBroadphasePair *pair =
+        cache->findPair(a->rb->getBroadphaseHandle(), b->rb->getBroadphaseHandle());
+    if (pair) cache->cleanOverlappingPair(*pair, w->dispatcher);
+}
+
+void destroy_body(cfb_world *w, Body *b)
+{
+    w->dyn->removeRigidBody(b->rb);
+    delete b->rb;
+    delete b->motion;
+    delete b->shape;
+    delete b;
+}
+
+}  // namespace
+
+extern "C" {
+
+cfb_world *cfb_world_create(const double gravity[3])
+{
+    if (!gravity || !finite3(gravity)) {
+        set_error("gravity missing or non-finite");
+        return NULL;
+    }
+    cfb_world *w = new (std::nothrow) cfb_world();
+    if (!w) {
+        set_error("out of memory");
+        return NULL;
+    }
+    w->config = new btDefaultCollisionConfiguration();
+    w->dispatcher = new FamilyDispatcher(w->config);
+    w->broadphase = new btDbvtBroadphase();
+    w->solver = new btSequentialImpulseConstraintSolver();
+    w->dyn = new StepWorld(w->dispatcher, w->broadphase, w->solver, w->config);
+    w->dyn->setGravity(btVector3(gravity[0], gravity[1], gravity[2]));
+    // Motion states show the state at the end of the last sub-step, not one
+    // sub-step behind.
+    w->dyn->setLatencyMotionStateInterpolation(false);
+    w->dyn->setInternalTickCallback(pre_tick, w, true);
+    w->dyn->setInternalTickCallback(post_tick, w, false);
+    w->n_dynamic = 0;
+    w->ticks = 0;
+    return w;
+}
+
+void cfb_world_destroy(cfb_world *w)
+{
+    if (!w) return;
+    for (size_t i = 0; i < w->bodies.size(); ++i)
+        if (w->bodies[i]) destroy_body(w, w->bodies[i]);
+    delete w->dyn;
+    delete w->solver;
+    delete w->broadphase;
+    delete w->dispatcher;
+    delete w->config;
+    delete w;
+}
+
+int cfb_add_plane(cfb_world *w, const double point[3], const double normal[3], double friction,
+                  double restitution)
+{
+    if (!obstacle_args_valid(w, point, NULL, friction, restitution)) return -1;
+    if (!normal || !finite3(normal) || !nonzero3(normal)) {
+        set_error("plane normal missing, zero or non-finite");
+        return -1;
+    }
+    btVector3 n(normal[0], normal[1], normal[2]);
+    n.normalize();
+    const btScalar c = n.dot(btVector3(point[0], point[1], point[2]));
+    btTransform xf;
+    xf.setIdentity();
+    return add_body(w, new btStaticPlaneShape(n, c), 0.0, btVector3(0, 0, 0), xf, BODY_STATIC,
+                    btVector3(0, 0, 0), friction, restitution);
+}
+
+int cfb_add_sphere(cfb_world *w, const double center[3], double radius,
+                   const double velocity[3], double friction, double restitution)
+{
+    if (!obstacle_args_valid(w, center, velocity, friction, restitution)) return -1;
+    if (!std::isfinite(radius) || !(radius > 0.0)) {
+        set_error("sphere radius must be finite and > 0");
+        return -1;
+    }
+    return add_obstacle(w, new btSphereShape(radius), center, velocity, friction, restitution);
+}
+
+int cfb_add_box(cfb_world *w, const double center[3], const double half_extents[3],
+                const double velocity[3], double friction, double restitution)
+{
+    if (!obstacle_args_valid(w, center, velocity, friction, restitution)) return -1;
+    if (!half_extents || !finite3(half_extents) || !(half_extents[0] > 0.0) ||
+        !(half_extents[1] > 0.0) || !(half_extents[2] > 0.0)) {
+        set_error("box half extents must be finite and > 0");
+        return -1;
+    }
+    btBoxShape *box = new btBoxShape(btVector3(half_extents[0], half_extents[1], half_extents[2]));
+    // btBoxShape keeps its outer size and rounds corners by the margin; keep
+    // the rounding small relative to thin boxes.
+    const double hmin = std::fmin(half_extents[0], std::fmin(half_extents[1], half_extents[2]));
+    if (box->getMargin() > 0.1 * hmin) box->setMargin(0.1 * hmin);
+    return add_obstacle(w, box, center, velocity, friction, restitution);
+}
+
+int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
+                      int n, double margin, const cfb_state *s, double friction,
+                      double restitution)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return -1;
+    }
+    if (!std::isfinite(mass) || !(mass > 0.0)) {
+        set_error("mass must be finite and > 0 (got %g)", mass);
+        return -1;
+    }
+    if (!inertia || !finite3(inertia) || !(inertia[0] > 0.0) || !(inertia[1] > 0.0) ||
+        !(inertia[2] > 0.0)) {
+        set_error("principal moments must be finite and > 0");
+        return -1;
+    }
+    if (!pts || n < 4) {
+        set_error("a hull needs at least 4 points (got %d)", pts ? n : 0);
+        return -1;
+    }
+    for (int i = 0; i < n; ++i) {
+        if (!finite3(pts + 3 * i)) {
+            set_error("hull point %d is non-finite", i);
+            return -1;
+        }
+    }
+    if (!std::isfinite(margin) || margin < 0.0) {
+        set_error("margin must be finite and >= 0");
+        return -1;
+    }
+    if (!state_valid(s) || !friction_valid(friction, restitution)) return -1;
+
+    // Keep only the hull vertices: support queries are linear in the vertex
+    // count, and fragments may come with thousands of surface nodes.
+    btConvexHullComputer hull;
+    hull.compute(pts, 3 * static_cast<int>(sizeof(double)), n, 0, 0);
+    const int nv = hull.vertices.size();
+    if (nv < 4) {
+        set_error("hull points are degenerate (%d hull vertices)", nv);
+        return -1;
+    }
+    btConvexHullShape *shape = new btConvexHullShape(&hull.vertices[0][0], nv, sizeof(btVector3));
+    shape->setMargin(margin);
+    shape->recalcLocalAabb();  // the cached box was built with the default margin
+
+    double q[4];
+    unit_quat(s->quat, q);
+    const btTransform xf = state_transform(q, s->pos);
+    // The body frame is the principal frame, so the given moments are the
+    // local inertia (not Bullet's estimate from the hull's bounding box).
+    const int id = add_body(w, shape, mass, btVector3(inertia[0], inertia[1], inertia[2]), xf,
+                            BODY_DYNAMIC, btVector3(0, 0, 0), friction, restitution);
+    if (id < 0) return -1;
+    Body *b = w->bodies[id];
+    b->rb->setLinearVelocity(btVector3(s->v[0], s->v[1], s->v[2]));
+    b->rb->setAngularVelocity(btVector3(s->w[0], s->w[1], s->w[2]));
+    b->rb->setInterpolationLinearVelocity(b->rb->getLinearVelocity());
+    b->rb->setInterpolationAngularVelocity(b->rb->getAngularVelocity());
+    remember_quat(b, q);
+    return id;
+}
+
+void cfb_remove_body(cfb_world *w, int id)
+{
+    Body *b = lookup(w, id);
+    if (!b) return;
+    // Others keep a pointer to this body in their ignore lists; drop it so a
+    // later body allocated at the same address is not ignored by mistake.
+    for (size_t k = 0; k < b->ignored.size(); ++k) {
+        Body *o = w->bodies[b->ignored[k]];
+        if (!o) continue;
+        o->rb->setIgnoreCollisionCheck(b->rb, false);
+        for (size_t j = 0; j < o->ignored.size(); ++j) {
+            if (o->ignored[j] == id) {
+                o->ignored.erase(o->ignored.begin() + static_cast<std::ptrdiff_t>(j));
+                break;
+            }
+        }
+    }
+    if (b->kind == BODY_DYNAMIC) w->n_dynamic--;
+    for (size_t k = 0; k < w->kinematic.size(); ++k) {
+        if (w->kinematic[k] == b) {
+            w->kinematic.erase(w->kinematic.begin() + static_cast<std::ptrdiff_t>(k));
+            break;
+        }
+    }
+    destroy_body(w, b);
+    w->bodies[id] = NULL;
+}
+
+void cfb_get_state(const cfb_world *w, int id, cfb_state *s)
+{
+    const Body *b = lookup(w, id);
+    if (!b) return;
+    if (!s) {
+        set_error("state is NULL");
+        return;
+    }
+    const btTransform &xf = b->rb->getCenterOfMassTransform();
+    const btVector3 &p = xf.getOrigin();
+    const btVector3 &v = b->rb->getLinearVelocity();
+    const btVector3 &om = b->rb->getAngularVelocity();
+    for (int i = 0; i < 3; ++i) {
+        s->pos[i] = p[i];
+        s->v[i] = v[i];
+        s->w[i] = om[i];
+    }
+    if (b->has_quat && xf.getBasis() == b->quat_basis) {
+        for (int i = 0; i < 4; ++i) s->quat[i] = b->quat[i];
+        return;
+    }
+    btQuaternion q;
+    xf.getBasis().getRotation(q);
+    const double sgn = q.w() < 0 ? -1.0 : 1.0;  // one representative: w >= 0
+    s->quat[0] = sgn * q.w();
+    s->quat[1] = sgn * q.x();
+    s->quat[2] = sgn * q.y();
+    s->quat[3] = sgn * q.z();
+}
+
+void cfb_set_state(cfb_world *w, int id, const cfb_state *s)
+{
+    Body *b = lookup(w, id);
+    if (!b) return;
+    if (!state_valid(s)) return;
+    if (b->kind == BODY_STATIC) {
+        set_error("body %d is static", id);
+        return;
+    }
+    double q[4];
+    unit_quat(s->quat, q);
+    const btTransform xf = state_transform(q, s->pos);
+    const btVector3 v(s->v[0], s->v[1], s->v[2]);
+    const btVector3 om(s->w[0], s->w[1], s->w[2]);
+    btRigidBody *rb = b->rb;
+    if (b->kind == BODY_KINEMATIC) {
+        b->kin_v = v;
+        b->kin_w = om;
+        rb->setWorldTransform(xf);
+    } else {
+        rb->setCenterOfMassTransform(xf);  // also refreshes the world inertia
+    }
+    rb->setInterpolationWorldTransform(xf);
+    rb->setLinearVelocity(v);
+    rb->setAngularVelocity(om);
+    rb->setInterpolationLinearVelocity(v);
+    rb->setInterpolationAngularVelocity(om);
+    rb->clearForces();
+    b->motion->setWorldTransform(xf);
+    rb->activate(true);
+    w->dyn->updateSingleAabb(rb);
+    remember_quat(b, q);
+}
+
+void cfb_ignore_pair(cfb_world *w, int a, int b)
+{
+    Body *ba = lookup(w, a);
+    if (!ba) return;
+    Body *bb = lookup(w, b);
+    if (!bb) return;
+    if (a == b) {
+        set_error("cannot ignore a body against itself (%d)", a);
+        return;
+    }
+    for (size_t k = 0; k < ba->ignored.size(); ++k)
+        if (ba->ignored[k] == b) return;  // Bullet does not check duplicates
+    ba->ignored.push_back(b);
+    bb->ignored.push_back(a);
+    ba->rb->setIgnoreCollisionCheck(bb->rb, true);
+    bb->rb->setIgnoreCollisionCheck(ba->rb, true);
+    drop_contacts(w, ba, bb);
+}
+
+int cfb_set_family(cfb_world *w, int id, int family)
+{
+    Body *b = lookup(w, id);
+    if (!b) return -1;
+    if (family < -1) {
+        set_error("family must be >= 0, or -1 for none (got %d)", family);
+        return -1;
+    }
+    b->rb->setUserIndex2(family);
+    if (family < 0) return 0;
+    for (size_t i = 0; i < w->bodies.size(); ++i) {
+        Body *o = w->bodies[i];
+        if (o && o != b && o->rb->getUserIndex2() == family) drop_contacts(w, b, o);
+    }
+    return 0;
+}
+
+int cfb_step(cfb_world *w, double dt, int substeps)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return -1;
+    }
+    if (!std::isfinite(dt) || !(dt > 0.0) || substeps < 1) {
+        set_error("cfb_step needs dt > 0 and substeps >= 1 (got %g, %d)", dt, substeps);
+        return -1;
+    }
+    const double h = dt / substeps;
+    // stepSimulation runs int(accumulated/h) sub-steps; with dt/h only
+    // approximately equal to substeps that may round down to substeps-1.
+    // Nudge the interval up by ulps so the quotient is exactly substeps, and
+    // clear the accumulator around the call so nothing carries over.
+    double t = dt;
+    while (static_cast<int>(t / h) < substeps)
+        t = std::nextafter(t, std::numeric_limits<double>::infinity());
+    for (size_t i = 0; i < w->bodies.size(); ++i)
+        if (w->bodies[i]) w->bodies[i]->impulse = 0.0;
+    w->ticks = 0;
+    w->dyn->reset_local_time();
+    w->dyn->stepSimulation(t, substeps, h);
+    w->dyn->reset_local_time();
+    if (w->ticks != substeps) {
+        set_error("ran %d sub-steps instead of %d", w->ticks, substeps);
+        return -1;
+    }
+    return 0;
+}
+
+double cfb_contact_impulse(const cfb_world *w, int id)
+{
+    const Body *b = lookup(w, id);
+    return b ? b->impulse : -1.0;
+}
+
+int cfb_body_count(const cfb_world *w)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return -1;
+    }
+    return w->n_dynamic;
+}
+
+const char *cfb_last_error(void) { return g_error; }
+
+}  // extern "C"

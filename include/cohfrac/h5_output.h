@@ -1,0 +1,121 @@
+/* cohfrac — HDF5 output (H5MD-style layout, DESIGN §7), readable by h5py and
+ * ParaView (through the XDMF sidecar written next to the file).
+ *
+ * Layout (all SI; every dataset chunked and extendable, flushed each frame so
+ * a killed run leaves a readable file):
+ *   /                      attrs creator, version, units="SI", up_axis="+z",
+ *                          quaternion_order="wxyz", scene_name
+ *   /parameters/scene      the resolved scene (Lua text), string
+ *   /particles/fragments/<field>/{step[T] int64, time[T] float64 s, value[T][N](...)}
+ *       field   value shape   meaning                         fill
+ *       id          [T][N]     fragment id, -1 when not alive   -1
+ *       position    [T][N][3]  centre of mass, m                NaN
+ *       orientation [T][N][4]  rest->current rotation (w,x,y,z) NaN
+ *       velocity    [T][N][3]  COM velocity, m/s                NaN
+ *       angular_velocity [T][N][3] rad/s                        NaN
+ *       mode        [T][N]     0 rigid, 1 fracture, -1 not alive -1
+ *     Column j is fragment id j for the whole file; N grows as fragments are born.
+ *   /fragments/{parent[N] int32 (-1 for an initial body), birth_time[N] s,
+ *               mass[N] kg, n_tets[N], inertia_principal[N][3] kg m^2}
+ *   /observables/<name>/{step[T] int64, time[T] s, value[T] float64}
+ *   /handoffs/{time, fragment, direction (0 rigid->fracture, 1 fracture->rigid),
+ *              momentum_error (relative), handoff_loss (J)}  one row per hand-off
+ *   /h5md                  H5MD 1.1 metadata: attr version [1,1], author/ and
+ *                          creator/ (attrs name, version), modules/units
+ *   /particles/fragments/box  attrs dimension=3, boundary=["none"]*3 (H5MD)
+ *   /xdmf/polyvertex[M] int32  written by cf_h5_close for the sidecar: the
+ *                          alive columns of every frame, concatenated in order
+ *
+ * How the writer behaves (what a reader may rely on):
+ *   - step and time of all six particle fields are hard links to the same two
+ *     datasets.  Their length T is the number of complete frames; in a file
+ *     left by a killed run a value dataset may hold one more, partial row, so
+ *     read T = len(step).
+ *   - N = max(1 + largest id ever written in a frame, number of fragment
+ *     records); in every frame the columns of fragments not alive hold the
+ *     fill value (NaN, -1 for id and mode), as do all frames before a birth.
+ *   - Frames, fragment batches and hand-offs are flushed to disk at once;
+ *     observable samples with the next of those or on close, so write a
+ *     frame's observables before the frame.
+ *   - No HDF5 file lock is held: another process (h5py) can open the file
+ *     read-only while the run goes on and sees the state of the last flush.
+ *   - Strings (attributes, the scene) are variable-length UTF-8.  No object
+ *     timestamps are stored, so the same calls by the same user give the same
+ *     bytes (/h5md/author's name is $USER).
+ *   - The sidecar `<path minus .h5 or .hdf5>.xdmf` (".xdmf" appended to any
+ *     other name) is XDMF 3: a temporal collection of Polyvertex grids, one
+ *     per frame with at least one alive fragment, whose cells are the alive
+ *     fragments' centres and whose node attributes are id, mode, velocity and
+ *     angular_velocity, read as hyperslabs of the .h5 named by its base name
+ *     (keep the two files side by side).  ParaView 5.11 opens it with its
+ *     XDMF 3 readers (the default for .xdmf).
+ *   - Invalid arguments (negative or repeated ids in a frame, fragment ids
+ *     that are not the next ones, a parent that is not an earlier fragment,
+ *     an observable name that is empty or holds '/') give CF_ERR_OUTPUT and
+ *     write nothing.  HDF5's own error printing is off during every call
+ *     (and restored after it); every HDF5 failure gives CF_ERR_OUTPUT with a
+ *     message naming the file, what failed and HDF5's innermost reason.
+ */
+#ifndef COHFRAC_H5_OUTPUT_H
+#define COHFRAC_H5_OUTPUT_H
+
+#include "cohfrac/error.h"
+
+typedef struct cf_h5 cf_h5;
+
+/* One fragment's state in a frame. */
+typedef struct cf_frag_frame {
+    int id;                  /* fragment id = column */
+    int mode;                /* 0 rigid, 1 fracture */
+    double com[3];           /* m */
+    double quat[4];          /* w,x,y,z */
+    double v[3];             /* m/s */
+    double w[3];             /* rad/s */
+} cf_frag_frame;
+
+/* A newly born fragment (initial body or product of a split). */
+typedef struct cf_frag_info {
+    int id;
+    int parent;              /* -1 for an initial body */
+    double birth_time;       /* s */
+    double mass;             /* kg */
+    int n_tets;
+    double inertia_principal[3]; /* kg m^2 */
+} cf_frag_info;
+
+/* One hand-off between modes. */
+typedef struct cf_handoff_record {
+    double time;             /* s */
+    int fragment;            /* the fragment that changed mode (the parent for a split) */
+    int direction;           /* 0 rigid -> fracture, 1 fracture -> rigid */
+    double momentum_error;   /* |P_after - P_before| / |P_before| */
+    double handoff_loss;     /* J: kinetic energy not carried by rigid motion */
+} cf_handoff_record;
+
+/* Create (truncate) `path` and write the root attributes and the scene text.
+ * The parent directory is created if missing.  Also writes `<path minus .h5>.xdmf`
+ * on close.  Error CF_ERR_OUTPUT names the path and the HDF5 reason; on any
+ * error *out is NULL. */
+cf_status cf_h5_open(const char *path, const char *scene_name, const char *scene_text,
+                     cf_h5 **out, cf_error *err);
+
+/* Append one frame holding `n` alive fragments (any order). Flushes. */
+cf_status cf_h5_write_frame(cf_h5 *h, long step, double time, const cf_frag_frame *frags,
+                            int n, cf_error *err);
+
+/* Append fragment records (ids must be new and consecutive from 0). */
+cf_status cf_h5_add_fragments(cf_h5 *h, const cf_frag_info *info, int n, cf_error *err);
+
+/* Append a scalar observable sample, creating /observables/<name> on first use.
+ * Cheap (open datasets are kept); reaches the disk with the next flush. */
+cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double time,
+                                 double value, cf_error *err);
+
+/* Append one hand-off record. */
+cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err);
+
+/* Flush, write /xdmf/polyvertex and the XDMF sidecar, close.  The handle is
+ * freed even when an error is returned.  Safe on NULL. */
+cf_status cf_h5_close(cf_h5 *h, cf_error *err);
+
+#endif

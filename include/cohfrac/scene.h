@@ -1,0 +1,139 @@
+/* cohfrac — scenes: a Lua 5.4 script that returns a table.
+ *
+ * The script runs sandboxed (base functions without dofile/loadfile/load of
+ * bytecode, plus string, table and math; no io, os, package, debug).  The
+ * returned table is checked against the schema below: unknown keys and wrong
+ * types are errors that name the key path ("solver.pbd.k_stiffnes").  Every
+ * key has a default; `--set key.path=value` overrides anything (the value is
+ * a Lua expression: 1e-6, "pbd", {0,0,1}; list items as bodies[1].scale).
+ *
+ * Schema (SI units; defaults in brackets):
+ *   name            string   ["scene"]
+ *   duration        s        [1.0]        simulated time
+ *   gravity         {x,y,z}  [{0,0,-9.81}] m/s^2
+ *   material = {                          bulk and cohesive properties
+ *     E [1e6] Pa, nu [0.3], rho [2400] kg/m^3,
+ *     G_I [22] N/m, sigma_max [1e4] Pa, alpha [2],
+ *     G_II [=G_I] N/m, tau_max [=sigma_max] Pa, beta [=alpha],
+ *     friction [0.5], restitution [0.0] }
+ *   bodies = { {                          one entry per solid
+ *     mesh        string: a prepared mesh name ("bunny", "bunny_small")
+ *                 looked up in the mesh directory, or a path to a TetGen
+ *                 .node/.ele pair (with or without extension)   [required]
+ *     scale [1], position [{0,0,0}] m (of the mesh's bounding-box centre),
+ *     orientation [{1,0,0,0}] quaternion (w,x,y,z) applied before scale,
+ *     velocity [{0,0,0}] m/s, angular_velocity [{0,0,0}] rad/s (about the COM)
+ *   }, ... }
+ *   obstacles = { {type="plane", point={0,0,0}, normal={0,0,1}},
+ *                 {type="sphere", center=..., radius=..., velocity={0,0,0}},
+ *                 {type="box", center=..., half_extents=..., velocity={0,0,0}} }
+ *                 [{}]; `type` is required, as are a sphere's center and radius
+ *                 and a box's center and half_extents (no sensible default)
+ *   solver = {
+ *     rigid_backend ["bullet"] | "pbd"
+ *     dt_rigid [1e-3] s, rigid_substeps [5] (Bullet sub-steps per dt_rigid)
+ *     dt_fracture [5e-6] s, check_interval [1] steps, quiet_steps [400]
+ *     max_fracture_time [0.05] s (a fragment returns to rigid mode after this
+ *       long in fracture mode even if still cracking)
+ *     impact_threshold [0.2] m/s: normal contact impulse per unit mass in one
+ *       rigid step that sends a rigid fragment to fracture mode
+ *     elasticity ["corotational"] | "linear"
+ *     criterion ["traction"] | "source": cohesive insertion rule, DESIGN §3.3
+ *       (facet traction sigma_n >= sigma_max or tau >= tau_max; or the
+ *       source's nodal-averaged max principal stress >= 0.9 sigma_max at all
+ *       three facet nodes)
+ *     pbd = { k_stiffness [0.9], iterations [3], k_damping [1.0] }
+ *     threads [0] (0: all cores)
+ *   }
+ *   output = { file ["out/<name>.h5"], frame_interval [0.01] s }
+ */
+#ifndef COHFRAC_SCENE_H
+#define COHFRAC_SCENE_H
+
+#include "cohfrac/error.h"
+
+typedef struct cf_material {
+    double E, nu, rho;             /* Pa, -, kg/m^3 */
+    double G_I, G_II;              /* fracture energies phi_n, phi_t, N/m */
+    double sigma_max, tau_max;     /* cohesive strengths, Pa */
+    double alpha, beta;            /* PPR shape parameters */
+    double friction, restitution;  /* contact with obstacles */
+} cf_material;
+
+typedef struct cf_body_def {
+    char mesh[1024];           /* resolved TetGen base path (no extension) */
+    double scale;
+    double position[3];        /* m, where the bounding-box centre goes */
+    double orientation[4];     /* w,x,y,z, normalised */
+    double velocity[3];        /* m/s */
+    double angular_velocity[3];/* rad/s */
+} cf_body_def;
+
+typedef enum { CF_OBSTACLE_PLANE, CF_OBSTACLE_SPHERE, CF_OBSTACLE_BOX } cf_obstacle_type;
+
+typedef struct cf_obstacle {
+    cf_obstacle_type type;
+    double point[3], normal[3];  /* plane (normal normalised) */
+    double center[3];            /* sphere, box: at t = 0 */
+    double radius;               /* sphere, m */
+    double half_extents[3];      /* box (axis-aligned), m */
+    double velocity[3];          /* sphere, box: constant, m/s */
+} cf_obstacle;
+
+typedef enum { CF_RIGID_BULLET, CF_RIGID_PBD } cf_rigid_backend;
+typedef enum { CF_ELASTICITY_COROTATIONAL, CF_ELASTICITY_LINEAR } cf_elasticity;
+typedef enum { CF_CRITERION_TRACTION, CF_CRITERION_SOURCE } cf_criterion;
+
+typedef struct cf_solver_settings {
+    cf_rigid_backend rigid_backend;
+    double dt_rigid;
+    int rigid_substeps;
+    double dt_fracture;
+    int check_interval;
+    int quiet_steps;
+    double max_fracture_time;
+    double impact_threshold;
+    cf_elasticity elasticity;
+    cf_criterion criterion;
+    double k_stiffness;
+    int iterations;
+    double k_damping;
+    int threads;
+} cf_solver_settings;
+
+typedef struct cf_output_settings {
+    char file[1024];
+    double frame_interval;
+} cf_output_settings;
+
+typedef struct cf_scene {
+    char name[128];
+    double duration;
+    double gravity[3];
+    cf_material material;
+    int n_bodies;
+    cf_body_def *bodies;
+    int n_obstacles;
+    cf_obstacle *obstacles;
+    cf_solver_settings solver;
+    cf_output_settings output;
+    char *resolved; /* the resolved scene as Lua text (every key, defaults filled,
+                       mesh paths absolute); loading it again gives this scene */
+} cf_scene;
+
+/* Load and validate a scene script.  `overrides` are "key.path=value"
+ * strings applied before validation.  Prepared mesh names are looked up in
+ * `mesh_dir` as <mesh_dir>/<name>.node.
+ * Errors: CF_ERR_FILE_OPEN, CF_ERR_SCENE_SYNTAX (file:line from Lua),
+ * CF_ERR_SCENE_KEY (unknown key path, or missing required key),
+ * CF_ERR_SCENE_TYPE (key path, expected and found type),
+ * CF_ERR_SCENE_VALUE (key path, value, allowed range), CF_ERR_SCENE_OVERRIDE.
+ * On error `out` is left empty. */
+cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
+                        const char *mesh_dir, cf_scene *out, cf_error *err);
+
+/* Free what cf_scene_load allocated and zero *s.  NULL and an already
+ * freed (zeroed) scene are fine. */
+void cf_scene_free(cf_scene *s);
+
+#endif

@@ -1,0 +1,95 @@
+/* cohfrac — closed triangle surfaces and mesh preparation.
+ *
+ * Reads OBJ / OFF / STL (ASCII and binary) surfaces, finds and repairs
+ * self-intersections, and turns a closed surface into a Tet4 mesh by running
+ * the `tetgen` program (run as a program, never linked: AGPL).
+ */
+#ifndef COHFRAC_SURFACE_H
+#define COHFRAC_SURFACE_H
+
+#include "cohfrac/error.h"
+#include "cohfrac/mesh.h"
+
+typedef struct cf_surface {
+    int n_verts;
+    int n_tris;
+    double *v; /* [n_verts][3] vertex positions (file units) */
+    int *tri;  /* [n_tris][3] 0-based, counter-clockwise seen from outside */
+} cf_surface;
+
+/* Load a surface; the format is taken from the extension (.obj, .off, .stl).
+ * OBJ polygons are fan-triangulated; normals/texcoords are ignored; STL
+ * vertices are welded exactly.
+ * Errors: CF_ERR_FILE_OPEN, CF_ERR_MESH_PARSE (file:line), CF_ERR_MESH_INDEX. */
+cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err);
+
+/* Write as OFF (used to hand the surface to tetgen). Error CF_ERR_OUTPUT. */
+cf_status cf_surface_write_off(const cf_surface *s, const char *path, cf_error *err);
+
+/* Find pairs of triangles that intersect other than at a shared vertex or
+ * edge.  Writes up to `max_pairs` pairs into pairs[2*k], pairs[2*k+1]
+ * (triangle indices, 0-based; pairs sorted, lower index first) and returns
+ * the total number found, -1 when out of memory.  Shared vertices and edges
+ * of neighbouring triangles do not count; touching elsewhere does.  Uses
+ * double-precision orientation tests (exact for exactly coplanar input such
+ * as axis-aligned faces) and a uniform grid, O(n) for even meshes. */
+int cf_surface_self_intersections(const cf_surface *s, int *pairs, int max_pairs);
+
+/* Repair the defect class of DESIGN §9: a valence-3 vertex whose three
+ * triangles overlap their neighbours.  Such a vertex is removed and its three
+ * triangles replaced by the one triangle of its three neighbours.  Only
+ * vertices touching an intersecting pair are considered.  Returns the number
+ * of vertices removed (>= 0).  The surface is compacted (unused vertices
+ * dropped). */
+int cf_surface_repair_valence3(cf_surface *s);
+
+/* Enclosed volume (divergence theorem), file units cubed; positive when the
+ * triangles are counter-clockwise seen from outside. */
+double cf_surface_volume(const cf_surface *s);
+
+/* Reverse the orientation of every triangle (inside-out surfaces). */
+void cf_surface_flip(cf_surface *s);
+
+/* Drop vertices no triangle uses, renumbering the rest in order.  Returns
+ * the number dropped, -1 when out of memory. */
+int cf_surface_remove_unused(cf_surface *s);
+
+/* Is the surface a closed, consistently oriented 2-manifold (every edge in
+ * exactly two triangles with opposite directions, one fan per vertex)?
+ * Returns 1 yes, 0 no (with the first problem, naming vertex/triangle
+ * indices, in `why` if non-NULL), -1 out of memory. */
+int cf_surface_check_closed(const cf_surface *s, char *why, size_t why_len);
+
+/* Reduce to about `target_tris` triangles by quadric-error edge collapse
+ * (Garland & Heckbert 1997), cheapest collapse first with a fixed
+ * tie-break, so the result is reproducible.  A collapse is refused when it
+ * breaks the link condition (would pinch the surface), leaves a vertex of
+ * valence < 3, flips or turns a triangle by more than 60 degrees or makes a
+ * needle; boundary edges are never collapsed.  Stops early when no valid
+ * collapse is left.  The vertex positions move (optimal quadric points);
+ * unused vertices are dropped.  Returns the new triangle count, -1 when out
+ * of memory.  It does not test for self-intersections: check afterwards. */
+int cf_surface_decimate(cf_surface *s, int target_tris);
+
+void cf_surface_free(cf_surface *s);
+
+/* Options for `cohfrac mesh`. */
+typedef struct cf_mesh_prep_opts {
+    const char *input;    /* surface file (.obj/.off/.stl) */
+    const char *output;   /* output base: writes <output>.node/.ele */
+    int target_tets;      /* approximate number of tets wanted (0: tetgen -pq default) */
+    int verbose;          /* print what is done to stderr */
+} cf_mesh_prep_opts;
+
+/* Load, report self-intersections (face indices) and repair them, coarsen
+ * the surface if `target_tets` needs it, run tetgen, check orientation and
+ * volume of the result against the surface's enclosed volume, and write
+ * <output>.node/.ele.  Skips all work when the outputs exist and are newer
+ * than the input and were made with the same options (a stamp file
+ * <output>.stamp records them).
+ * Errors: as cf_surface_load, CF_ERR_SURFACE_INTERSECT (intersections left
+ * after repair: lists face pairs), CF_ERR_EXTERNAL (tetgen missing or
+ * failed: its output is quoted), CF_ERR_MESH_INVERTED. */
+cf_status cf_mesh_prepare(const cf_mesh_prep_opts *opts, cf_error *err);
+
+#endif

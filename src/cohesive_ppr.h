@@ -1,0 +1,40 @@
+/* Extrinsic PPR cohesive law (DESIGN §3.5): Park, Paulino, Celes, Espinha
+ * 2012, IJNME 92:1-35 — the extrinsic (lambda -> 0) limit of the
+ * Park-Paulino-Roesler potential, JMPS 57:891-908 (2009).
+ *
+ * Openings in m, tractions in Pa, fracture energies in N/m.  The traction is
+ * sigma_max at zero opening; pure mode-I work is sigma_max delta_n / alpha =
+ * phi_n.  Unloading and reloading follow the secant to the origin; complete
+ * failure when an opening passes its final width; compression is a penalty. */
+#ifndef COHFRAC_COHESIVE_PPR_H
+#define COHFRAC_COHESIVE_PPR_H
+
+#include "solid.h"
+
+typedef struct cf_ppr {
+    double phi_n, phi_t, sigma_max, tau_max, alpha, beta;
+    double delta_n, delta_t;     /* final openings, m */
+    double Gamma_n, Gamma_t;     /* energy constants */
+    double dbar_n, dbar_t;       /* conjugate final openings, m */
+} cf_ppr;
+
+void cf_ppr_init(cf_ppr *p, const cf_material *m);
+
+/* Envelope (monotonic loading) tractions at normal opening dn >= 0 and
+ * tangential opening dt >= 0. */
+void cf_ppr_envelope(const cf_ppr *p, double dn, double dt, double *Tn, double *Tt);
+
+/* Traction with history for one node pair.  dn may be negative (contact:
+ * Tn = -k_contact... given as kp_dn = penalty traction for dn < 0).
+ * Updates *dn_max, *dt_max, *failed. */
+void cf_ppr_traction(const cf_ppr *p, double dn, double dt, double *dn_max, double *dt_max,
+                     unsigned char *failed, double *Tn, double *Tt);
+
+/* Add the forces of every cohesive element in [first, last) to s->f.
+ * Nodal (Newton-Cotes) integration: each node pair carries traction * A/3.
+ * Compression is resisted by a penalty whose per-pair stiffness is
+ * 0.1 m_min / dt^2 (a twentieth of the explicit bound 2 m_min / dt^2 of one
+ * pair, so a node copy in several pairs stays stable), dt the step size.  Returns the number of node pairs in complete failure. */
+int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, int first, int last, double dt);
+
+#endif

@@ -1,0 +1,1250 @@
+/* cohfrac — HDF5 output in an H5MD-style layout (DESIGN §7), plus an XDMF 3
+ * sidecar so ParaView can play the fragment centres back over time.
+ *
+ * The layout is documented in include/cohfrac/h5_output.h.  Choices made
+ * here, and why:
+ *   - Every dataset is chunked and extendable; the per-fragment series are
+ *     [T][N](,k) with both T and N unlimited and an HDF5 fill value (NaN, or
+ *     -1 for id and mode), so widening N fills past frames by itself.
+ *   - The particle fields share one step and one time dataset through hard
+ *     links (H5MD allows this), so one append per frame updates all of them.
+ *   - Within a frame the values are written first and step/time last, and the
+ *     file is flushed at the end: len(step) is always the number of complete
+ *     frames, even in a file left behind by a killed run.
+ *   - The writer takes no HDF5 file lock, so another process (h5py, a
+ *     monitoring script) can open the file read-only while the run goes on.
+ *   - HDF5's automatic error printing is switched off for the duration of
+ *     each call (and restored after); failures become CF_ERR_OUTPUT with a
+ *     message naming the file, the step that failed and HDF5's own reason.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "cohfrac/h5_output.h"
+
+#include <hdf5.h>
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#ifndef COHFRAC_VERSION
+#define COHFRAC_VERSION "0.1.0"
+#endif
+
+/* Chunk shapes.  Frames are flushed one at a time, and a flush rewrites every
+ * chunk the frame touched, so the time extent of a chunk is kept small. */
+#define FRAME_CHUNK_T 8
+#define FRAME_CHUNK_N 32
+#define ROW_CHUNK 256
+
+/* One dataset family: a per-fragment field, a fragment record column or a
+ * hand-off column. */
+typedef struct column_def {
+    const char *name;
+    int ncomp;        /* 1: one value per row; k > 1: [..][k] */
+    int integer;      /* int32 (fill -1) instead of float64 (fill NaN) */
+    const char *unit; /* H5MD unit string, NULL when dimensionless */
+} column_def;
+
+enum { FLD_ID, FLD_POSITION, FLD_ORIENTATION, FLD_VELOCITY, FLD_ANGVEL, FLD_MODE, FLD_COUNT };
+static const column_def FIELDS[FLD_COUNT] = {
+    {"id", 1, 1, NULL},
+    {"position", 3, 0, "m"},
+    {"orientation", 4, 0, NULL},
+    {"velocity", 3, 0, "m s-1"},
+    {"angular_velocity", 3, 0, "rad s-1"},
+    {"mode", 1, 1, NULL},
+};
+
+enum { FR_PARENT, FR_BIRTH, FR_MASS, FR_NTETS, FR_INERTIA, FR_COUNT };
+static const column_def FRAGMENT_COLUMNS[FR_COUNT] = {
+    {"parent", 1, 1, NULL},
+    {"birth_time", 1, 0, "s"},
+    {"mass", 1, 0, "kg"},
+    {"n_tets", 1, 1, NULL},
+    {"inertia_principal", 3, 0, "kg m2"},
+};
+
+/* "time" is last: it is appended last, so its length counts complete rows. */
+enum { HO_FRAGMENT, HO_DIRECTION, HO_MOMERR, HO_LOSS, HO_TIME, HO_COUNT };
+static const column_def HANDOFF_COLUMNS[HO_COUNT] = {
+    {"fragment", 1, 1, NULL},
+    {"direction", 1, 1, NULL},
+    {"momentum_error", 1, 0, NULL},
+    {"handoff_loss", 1, 0, "J"},
+    {"time", 1, 0, "s"},
+};
+
+/* An observable series kept open so that appending a sample costs three
+ * small writes and no lookup in the file. */
+typedef struct observable {
+    char *name;
+    hid_t step, time, value;
+    hsize_t n;
+} observable;
+
+/* What the XDMF sidecar needs to know about one written frame. */
+typedef struct frame_record {
+    double time;
+    hsize_t ncols;  /* width N of the value datasets when it was written */
+    hsize_t first;  /* offset of its alive columns in the connectivity list */
+    hsize_t count;  /* number of alive fragments */
+} frame_record;
+
+struct cf_h5 {
+    char *path;
+    hid_t file;
+    hid_t step, time; /* shared by every /particles/fragments field */
+    hid_t value[FLD_COUNT];
+    hid_t fragment[FR_COUNT];
+    hid_t handoff[HO_COUNT];
+    hid_t obs_group;
+
+    hsize_t nframes, ncols, nfragments, nhandoffs;
+
+    frame_record *frames;
+    size_t frames_cap;
+    int *alive; /* alive columns of every frame, concatenated (XDMF topology) */
+    size_t nalive, alive_cap;
+
+    observable *obs;
+    size_t nobs, obs_cap, obs_last;
+
+    /* scratch reused by every frame */
+    double *dbuf;
+    size_t dbuf_cap;
+    int *ibuf;
+    size_t ibuf_cap;
+};
+
+/* ---- errors ------------------------------------------------------------ */
+
+#define REASON_LEN 400
+
+/* Walking upward, entry 0 is the innermost and most specific error (for a
+ * failed create it carries errno's text). */
+static herr_t innermost_error(unsigned n, const H5E_error2_t *e, void *data)
+{
+    if (n == 0 && e && e->desc)
+        snprintf((char *)data, REASON_LEN, "%s", e->desc);
+    return 0;
+}
+
+/* Turn the current HDF5 error stack into a CF_ERR_OUTPUT message. */
+static cf_status h5_fail(cf_error *err, const char *path, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static cf_status h5_fail(cf_error *err, const char *path, const char *fmt, ...)
+{
+    char what[256];
+    char reason[REASON_LEN] = "";
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost_error, reason);
+    H5Eclear2(H5E_DEFAULT);
+    if (reason[0])
+        return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': %s failed (HDF5: %s)", path,
+                            what, reason);
+    return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': %s failed", path, what);
+}
+
+static cf_status no_memory(cf_error *err, const char *path)
+{
+    return cf_error_set(err, CF_ERR_NOMEM, "output file '%s': out of memory", path);
+}
+
+/* HDF5 prints its error stack to stderr by default; the engine reports its
+ * own message instead.  The caller's setting is put back after each call. */
+typedef struct quiet_state {
+    H5E_auto2_t fn;
+    void *data;
+} quiet_state;
+
+static void quiet_begin(quiet_state *q)
+{
+    q->fn = NULL;
+    q->data = NULL;
+    if (H5Eget_auto2(H5E_DEFAULT, &q->fn, &q->data) < 0) {
+        q->fn = NULL;
+        q->data = NULL;
+    }
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+static void quiet_end(const quiet_state *q)
+{
+    H5Eset_auto2(H5E_DEFAULT, q->fn, q->data);
+}
+
+/* ---- small HDF5 helpers ------------------------------------------------ */
+
+static hid_t file_type(const column_def *c)
+{
+    return c->integer ? H5T_STD_I32LE : H5T_IEEE_F64LE;
+}
+
+static hid_t mem_type(const column_def *c)
+{
+    return c->integer ? H5T_NATIVE_INT : H5T_NATIVE_DOUBLE;
+}
+
+/* Object modification times would make two identical runs differ byte for
+ * byte, so they are not recorded. */
+static hid_t untimed_plist(hid_t cls)
+{
+    hid_t p = H5Pcreate(cls);
+    if (p >= 0 && H5Pset_obj_track_times(p, 0) < 0) {
+        H5Pclose(p);
+        return H5I_INVALID_HID;
+    }
+    return p;
+}
+
+static hid_t make_group(hid_t loc, const char *name)
+{
+    hid_t gcpl = untimed_plist(H5P_GROUP_CREATE);
+    hid_t g = H5I_INVALID_HID;
+    if (gcpl >= 0) {
+        g = H5Gcreate2(loc, name, H5P_DEFAULT, gcpl, H5P_DEFAULT);
+        H5Pclose(gcpl);
+    }
+    return g;
+}
+
+/* Variable-length UTF-8 strings read back as str in h5py. */
+static hid_t string_type(void)
+{
+    hid_t t = H5Tcopy(H5T_C_S1);
+    if (t >= 0 && (H5Tset_size(t, H5T_VARIABLE) < 0 || H5Tset_cset(t, H5T_CSET_UTF8) < 0)) {
+        H5Tclose(t);
+        return H5I_INVALID_HID;
+    }
+    return t;
+}
+
+/* Attribute of `n` strings (scalar when n == 0). */
+static int write_strings_attr(hid_t loc, const char *name, const char *const *values, hsize_t n)
+{
+    hid_t t = string_type();
+    hid_t s = n ? H5Screate_simple(1, &n, NULL) : H5Screate(H5S_SCALAR);
+    hid_t a = H5I_INVALID_HID;
+    int ok = t >= 0 && s >= 0;
+    if (ok)
+        ok = (a = H5Acreate2(loc, name, t, s, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
+             H5Awrite(a, t, values) >= 0;
+    if (a >= 0)
+        H5Aclose(a);
+    if (s >= 0)
+        H5Sclose(s);
+    if (t >= 0)
+        H5Tclose(t);
+    return ok ? 0 : -1;
+}
+
+static int write_string_attr(hid_t loc, const char *name, const char *value)
+{
+    const char *v[1] = {value ? value : ""};
+    return write_strings_attr(loc, name, v, 0);
+}
+
+static int write_ints_attr(hid_t loc, const char *name, const int *values, hsize_t n)
+{
+    hid_t s = H5Screate_simple(1, &n, NULL);
+    hid_t a = H5I_INVALID_HID;
+    int ok = s >= 0 &&
+             (a = H5Acreate2(loc, name, H5T_STD_I32LE, s, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
+             H5Awrite(a, H5T_NATIVE_INT, values) >= 0;
+    if (a >= 0)
+        H5Aclose(a);
+    if (s >= 0)
+        H5Sclose(s);
+    return ok ? 0 : -1;
+}
+
+static int write_string_dataset(hid_t loc, const char *name, const char *value)
+{
+    const char *v = value ? value : "";
+    hid_t t = string_type();
+    hid_t s = H5Screate(H5S_SCALAR);
+    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
+    hid_t d = H5I_INVALID_HID;
+    int ok = t >= 0 && s >= 0 && dcpl >= 0 &&
+             (d = H5Dcreate2(loc, name, t, s, H5P_DEFAULT, dcpl, H5P_DEFAULT)) >= 0 &&
+             H5Dwrite(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &v) >= 0;
+    if (d >= 0)
+        H5Dclose(d);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (s >= 0)
+        H5Sclose(s);
+    if (t >= 0)
+        H5Tclose(t);
+    return ok ? 0 : -1;
+}
+
+/* Chunked dataset that starts empty; `fill` (of `fill_type`) is what reads
+ * back from any element never written, including after an extension. */
+static hid_t create_extendable(hid_t loc, const char *name, hid_t ftype, int rank,
+                               const hsize_t *dims, const hsize_t *maxdims, const hsize_t *chunk,
+                               hid_t fill_type, const void *fill)
+{
+    hid_t space = H5Screate_simple(rank, dims, maxdims);
+    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
+    hid_t d = H5I_INVALID_HID;
+    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, rank, chunk) >= 0 &&
+        (!fill || H5Pset_fill_value(dcpl, fill_type, fill) >= 0))
+        d = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (space >= 0)
+        H5Sclose(space);
+    return d;
+}
+
+/* A row-appendable column: [n] or [n][k]. */
+static hid_t create_rows(hid_t loc, const char *name, hid_t ftype, int ncomp)
+{
+    hsize_t dims[2] = {0, (hsize_t)ncomp};
+    hsize_t maxdims[2] = {H5S_UNLIMITED, (hsize_t)ncomp};
+    hsize_t chunk[2] = {ROW_CHUNK, (hsize_t)ncomp};
+    return create_extendable(loc, name, ftype, ncomp > 1 ? 2 : 1, dims, maxdims, chunk,
+                             H5T_NATIVE_INT, NULL);
+}
+
+static int write_unit(hid_t obj, const char *unit)
+{
+    return unit ? write_string_attr(obj, "unit", unit) : 0;
+}
+
+/* Append `nrows` rows at `row0` to a rank-1 or rank-2 dataset. */
+static int append_rows(hid_t d, hsize_t row0, hsize_t nrows, hid_t mtype, const void *buf)
+{
+    hsize_t dims[2] = {0, 1};
+    hid_t fs = H5Dget_space(d);
+    int rank = fs >= 0 ? H5Sget_simple_extent_ndims(fs) : -1;
+    int ok = rank >= 1 && rank <= 2 && H5Sget_simple_extent_dims(fs, dims, NULL) >= 0;
+    if (fs >= 0)
+        H5Sclose(fs);
+    if (!ok)
+        return -1;
+    dims[0] = row0 + nrows;
+    if (H5Dset_extent(d, dims) < 0)
+        return -1;
+    hsize_t start[2] = {row0, 0};
+    hsize_t count[2] = {nrows, rank > 1 ? dims[1] : 1};
+    fs = H5Dget_space(d);
+    hid_t ms = H5Screate_simple(rank, count, NULL);
+    ok = fs >= 0 && ms >= 0 &&
+         H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
+         H5Dwrite(d, mtype, ms, fs, H5P_DEFAULT, buf) >= 0;
+    if (ms >= 0)
+        H5Sclose(ms);
+    if (fs >= 0)
+        H5Sclose(fs);
+    return ok ? 0 : -1;
+}
+
+/* Write columns [col0, col0+width) of frame `row` of a [T][N](,k) dataset. */
+static int write_frame_block(hid_t d, hsize_t row, hsize_t col0, hsize_t width, int ncomp,
+                             hid_t mtype, const void *buf)
+{
+    hsize_t start[3] = {row, col0, 0};
+    hsize_t count[3] = {1, width, (hsize_t)ncomp};
+    hsize_t nmem = width * (hsize_t)ncomp;
+    hid_t fs = H5Dget_space(d);
+    hid_t ms = H5Screate_simple(1, &nmem, NULL);
+    int ok = fs >= 0 && ms >= 0 &&
+             H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
+             H5Dwrite(d, mtype, ms, fs, H5P_DEFAULT, buf) >= 0;
+    if (ms >= 0)
+        H5Sclose(ms);
+    if (fs >= 0)
+        H5Sclose(fs);
+    return ok ? 0 : -1;
+}
+
+static void close_dataset(hid_t *d, int *failed)
+{
+    if (*d >= 0 && H5Dclose(*d) < 0)
+        *failed = 1;
+    *d = H5I_INVALID_HID;
+}
+
+/* ---- memory ------------------------------------------------------------ */
+
+/* Grow `*p` (elements of `size` bytes) to hold at least `need`. */
+static int grow(void **p, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return 0;
+    size_t n = *cap ? *cap : 16;
+    while (n < need)
+        n *= 2;
+    void *q = realloc(*p, n * size);
+    if (!q)
+        return -1;
+    *p = q;
+    *cap = n;
+    return 0;
+}
+
+static int grow_scratch(cf_h5 *h, size_t nint, size_t ndbl)
+{
+    void *ip = h->ibuf, *dp = h->dbuf;
+    int rc = grow(&ip, &h->ibuf_cap, nint, sizeof(int));
+    h->ibuf = ip;
+    if (rc == 0)
+        rc = grow(&dp, &h->dbuf_cap, ndbl, sizeof(double));
+    h->dbuf = dp;
+    return rc;
+}
+
+/* ---- open -------------------------------------------------------------- */
+
+/* mkdir -p of everything before the last '/'. */
+static cf_status make_parent_dirs(const char *path, cf_error *err)
+{
+    char *buf = strdup(path);
+    if (!buf)
+        return no_memory(err, path);
+    cf_status st = CF_OK;
+    for (char *p = buf + 1; *p && st == CF_OK; ++p) {
+        if (*p != '/' || p[-1] == '/')
+            continue;
+        *p = '\0';
+        if (mkdir(buf, 0777) != 0) {
+            int e = errno;
+            struct stat sb;
+            /* EEXIST is the usual case; any error is fine if a directory is there. */
+            if (stat(buf, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
+                if (e == EEXIST)
+                    st = cf_error_set(err, CF_ERR_OUTPUT,
+                                      "output file '%s': cannot create directory '%s': a file "
+                                      "that is not a directory is in the way",
+                                      path, buf);
+                else
+                    st = cf_error_set(err, CF_ERR_OUTPUT,
+                                      "output file '%s': cannot create directory '%s': %s", path,
+                                      buf, strerror(e));
+            }
+        }
+        *p = '/';
+    }
+    free(buf);
+    return st;
+}
+
+static void init_handles(cf_h5 *h)
+{
+    h->file = h->step = h->time = h->obs_group = H5I_INVALID_HID;
+    for (int i = 0; i < FLD_COUNT; ++i)
+        h->value[i] = H5I_INVALID_HID;
+    for (int i = 0; i < FR_COUNT; ++i)
+        h->fragment[i] = H5I_INVALID_HID;
+    for (int i = 0; i < HO_COUNT; ++i)
+        h->handoff[i] = H5I_INVALID_HID;
+}
+
+/* Close every HDF5 object and the file; returns -1 if any close failed. */
+static int close_handles(cf_h5 *h)
+{
+    int failed = 0;
+    for (size_t i = 0; i < h->nobs; ++i) {
+        close_dataset(&h->obs[i].step, &failed);
+        close_dataset(&h->obs[i].time, &failed);
+        close_dataset(&h->obs[i].value, &failed);
+    }
+    for (int i = 0; i < FLD_COUNT; ++i)
+        close_dataset(&h->value[i], &failed);
+    for (int i = 0; i < FR_COUNT; ++i)
+        close_dataset(&h->fragment[i], &failed);
+    for (int i = 0; i < HO_COUNT; ++i)
+        close_dataset(&h->handoff[i], &failed);
+    close_dataset(&h->step, &failed);
+    close_dataset(&h->time, &failed);
+    if (h->obs_group >= 0 && H5Gclose(h->obs_group) < 0)
+        failed = 1;
+    h->obs_group = H5I_INVALID_HID;
+    if (h->file >= 0 && H5Fclose(h->file) < 0)
+        failed = 1;
+    h->file = H5I_INVALID_HID;
+    return failed ? -1 : 0;
+}
+
+static void free_handle(cf_h5 *h)
+{
+    for (size_t i = 0; i < h->nobs; ++i)
+        free(h->obs[i].name);
+    free(h->obs);
+    free(h->frames);
+    free(h->alive);
+    free(h->dbuf);
+    free(h->ibuf);
+    free(h->path);
+    free(h);
+}
+
+/* /h5md: the H5MD version, author and creator, and the units module that
+ * the "unit" attributes belong to. */
+static int write_h5md_group(hid_t file)
+{
+    static const int version[2] = {1, 1};
+    static const int units_version[2] = {1, 0};
+    const char *user = getenv("USER");
+    hid_t g = make_group(file, "h5md");
+    int ok = g >= 0 && write_ints_attr(g, "version", version, 2) == 0;
+    hid_t sub = H5I_INVALID_HID;
+    if (ok) {
+        sub = make_group(g, "author");
+        ok = sub >= 0 && write_string_attr(sub, "name", user && *user ? user : "unknown") == 0;
+        if (sub >= 0)
+            H5Gclose(sub);
+    }
+    if (ok) {
+        sub = make_group(g, "creator");
+        ok = sub >= 0 && write_string_attr(sub, "name", "cohfrac") == 0 &&
+             write_string_attr(sub, "version", COHFRAC_VERSION) == 0;
+        if (sub >= 0)
+            H5Gclose(sub);
+    }
+    if (ok) {
+        hid_t modules = make_group(g, "modules");
+        sub = modules >= 0 ? make_group(modules, "units") : H5I_INVALID_HID;
+        ok = sub >= 0 && write_ints_attr(sub, "version", units_version, 2) == 0 &&
+             write_string_attr(sub, "system", "SI") == 0;
+        if (sub >= 0)
+            H5Gclose(sub);
+        if (modules >= 0)
+            H5Gclose(modules);
+    }
+    if (g >= 0)
+        H5Gclose(g);
+    return ok ? 0 : -1;
+}
+
+/* H5MD requires a box in every particles group; fragments fly free. */
+static int write_box(hid_t frags)
+{
+    static const int dimension = 3;
+    static const char *const boundary[3] = {"none", "none", "none"};
+    hid_t box = make_group(frags, "box");
+    int ok = box >= 0 && write_ints_attr(box, "dimension", &dimension, 1) == 0 &&
+             write_strings_attr(box, "boundary", boundary, 3) == 0;
+    if (box >= 0)
+        H5Gclose(box);
+    return ok ? 0 : -1;
+}
+
+/* One field group: step and time (created for the first field, hard links
+ * to those for the others) and the [T][N](,k) value dataset. */
+static int write_field_group(cf_h5 *h, hid_t frags, int f)
+{
+    static const double nan_fill = NAN;
+    static const int minus_one = -1;
+    const column_def *c = &FIELDS[f];
+    hid_t g = make_group(frags, c->name);
+    int ok = g >= 0;
+    if (ok && f == 0) {
+        hsize_t dims = 0, maxdims = H5S_UNLIMITED, chunk = ROW_CHUNK;
+        h->step = create_extendable(g, "step", H5T_STD_I64LE, 1, &dims, &maxdims, &chunk,
+                                    H5T_NATIVE_INT, NULL);
+        h->time = create_extendable(g, "time", H5T_IEEE_F64LE, 1, &dims, &maxdims, &chunk,
+                                    H5T_NATIVE_INT, NULL);
+        ok = h->step >= 0 && h->time >= 0 && write_unit(h->time, "s") == 0;
+    } else if (ok) {
+        ok = H5Lcreate_hard(h->step, ".", g, "step", H5P_DEFAULT, H5P_DEFAULT) >= 0 &&
+             H5Lcreate_hard(h->time, ".", g, "time", H5P_DEFAULT, H5P_DEFAULT) >= 0;
+    }
+    if (ok) {
+        hsize_t k = (hsize_t)c->ncomp;
+        hsize_t dims[3] = {0, 0, k};
+        hsize_t maxdims[3] = {H5S_UNLIMITED, H5S_UNLIMITED, k};
+        hsize_t chunk[3] = {FRAME_CHUNK_T, FRAME_CHUNK_N, k};
+        const void *fill = c->integer ? (const void *)&minus_one : (const void *)&nan_fill;
+        h->value[f] = create_extendable(g, "value", file_type(c), c->ncomp > 1 ? 3 : 2, dims,
+                                        maxdims, chunk, mem_type(c), fill);
+        ok = h->value[f] >= 0 && write_unit(h->value[f], c->unit) == 0;
+    }
+    if (g >= 0)
+        H5Gclose(g);
+    return ok ? 0 : -1;
+}
+
+static cf_status write_particles_group(cf_h5 *h, cf_error *err)
+{
+    hid_t particles = make_group(h->file, "particles");
+    hid_t frags = particles >= 0 ? make_group(particles, "fragments") : H5I_INVALID_HID;
+    cf_status st = CF_OK;
+    if (frags < 0 || write_box(frags) < 0)
+        st = h5_fail(err, h->path, "creating /particles/fragments");
+    for (int f = 0; f < FLD_COUNT && st == CF_OK; ++f)
+        if (write_field_group(h, frags, f) < 0)
+            st = h5_fail(err, h->path, "creating /particles/fragments/%s", FIELDS[f].name);
+    if (frags >= 0)
+        H5Gclose(frags);
+    if (particles >= 0)
+        H5Gclose(particles);
+    return st;
+}
+
+/* A group of row-appendable columns (/fragments, /handoffs). */
+static cf_status write_row_group(cf_h5 *h, const char *name, const column_def *cols, int ncols,
+                                 hid_t *out, cf_error *err)
+{
+    hid_t g = make_group(h->file, name);
+    int ok = g >= 0;
+    for (int i = 0; i < ncols && ok; ++i) {
+        out[i] = create_rows(g, cols[i].name, file_type(&cols[i]), cols[i].ncomp);
+        ok = out[i] >= 0 && write_unit(out[i], cols[i].unit) == 0;
+    }
+    if (g >= 0)
+        H5Gclose(g);
+    return ok ? CF_OK : h5_fail(err, h->path, "creating /%s", name);
+}
+
+static cf_status build_layout(cf_h5 *h, const char *scene_name, const char *scene_text,
+                              cf_error *err)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    if (fapl < 0)
+        return h5_fail(err, h->path, "creating the file access properties");
+#if H5_VERSION_GE(1, 12, 1) || (H5_VERS_MAJOR == 1 && H5_VERS_MINOR == 10 && H5_VERS_RELEASE >= 7)
+    /* Without a lock another process can open the file read-only while the
+     * run goes on (to watch progress); it sees the state of the last flush. */
+    H5Pset_file_locking(fapl, 0, 1);
+#endif
+    h->file = H5Fcreate(h->path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    if (h->file < 0)
+        return h5_fail(err, h->path, "creating the file");
+
+    hid_t root = H5Gopen2(h->file, "/", H5P_DEFAULT);
+    int ok = root >= 0 && write_string_attr(root, "creator", "cohfrac") == 0 &&
+             write_string_attr(root, "version", COHFRAC_VERSION) == 0 &&
+             write_string_attr(root, "units", "SI") == 0 &&
+             write_string_attr(root, "up_axis", "+z") == 0 &&
+             write_string_attr(root, "quaternion_order", "wxyz") == 0 &&
+             write_string_attr(root, "scene_name", scene_name) == 0;
+    if (root >= 0)
+        H5Gclose(root);
+    if (!ok)
+        return h5_fail(err, h->path, "writing the root attributes");
+
+    if (write_h5md_group(h->file) < 0)
+        return h5_fail(err, h->path, "writing /h5md");
+
+    hid_t params = make_group(h->file, "parameters");
+    ok = params >= 0 && write_string_dataset(params, "scene", scene_text) == 0;
+    if (params >= 0)
+        H5Gclose(params);
+    if (!ok)
+        return h5_fail(err, h->path, "writing /parameters/scene");
+
+    cf_status st = write_particles_group(h, err);
+    if (st == CF_OK)
+        st = write_row_group(h, "fragments", FRAGMENT_COLUMNS, FR_COUNT, h->fragment, err);
+    if (st == CF_OK)
+        st = write_row_group(h, "handoffs", HANDOFF_COLUMNS, HO_COUNT, h->handoff, err);
+    if (st != CF_OK)
+        return st;
+    h->obs_group = make_group(h->file, "observables");
+    if (h->obs_group < 0)
+        return h5_fail(err, h->path, "creating /observables");
+    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+        return h5_fail(err, h->path, "flushing the new file");
+    return CF_OK;
+}
+
+static cf_status open_impl(const char *path, const char *scene_name, const char *scene_text,
+                           cf_h5 **out, cf_error *err)
+{
+    if (!out)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_open: no place to return the handle");
+    *out = NULL;
+    if (!path || !*path)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_open: the output path is empty");
+    cf_status st = make_parent_dirs(path, err);
+    if (st != CF_OK)
+        return st;
+    cf_h5 *h = calloc(1, sizeof *h);
+    if (!h)
+        return no_memory(err, path);
+    init_handles(h);
+    h->path = strdup(path);
+    if (!h->path) {
+        free(h);
+        return no_memory(err, path);
+    }
+    st = build_layout(h, scene_name, scene_text, err);
+    if (st != CF_OK) {
+        close_handles(h);
+        H5Eclear2(H5E_DEFAULT);
+        free_handle(h);
+        return st;
+    }
+    *out = h;
+    return CF_OK;
+}
+
+cf_status cf_h5_open(const char *path, const char *scene_name, const char *scene_text,
+                     cf_h5 **out, cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = open_impl(path, scene_name, scene_text, out, err);
+    quiet_end(&q);
+    return st;
+}
+
+/* ---- frames ------------------------------------------------------------ */
+
+static const double *field_values(const cf_frag_frame *f, int field)
+{
+    switch (field) {
+    case FLD_POSITION:
+        return f->com;
+    case FLD_ORIENTATION:
+        return f->quat;
+    case FLD_VELOCITY:
+        return f->v;
+    case FLD_ANGVEL:
+        return f->w;
+    default:
+        return NULL;
+    }
+}
+
+static cf_status write_frame_impl(cf_h5 *h, long step, double time, const cf_frag_frame *frags,
+                                  int n, cf_error *err)
+{
+    if (!h)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_frame: no output file is open");
+    if (n < 0 || (n > 0 && !frags))
+        return cf_error_set(err, CF_ERR_OUTPUT,
+                            "output file '%s': frame at step %ld has an invalid fragment list "
+                            "(n = %d)",
+                            h->path, step, n);
+    int lo = INT_MAX, hi = -1;
+    for (int i = 0; i < n; ++i) {
+        int id = frags[i].id;
+        if (id < 0)
+            return cf_error_set(err, CF_ERR_OUTPUT,
+                                "output file '%s': frame at step %ld: fragment id %d is negative",
+                                h->path, step, id);
+        if (id < lo)
+            lo = id;
+        if (id > hi)
+            hi = id;
+    }
+    /* Only the span [lo, hi] of alive ids is written (dead columns inside it
+     * get the fill value); columns outside it are not touched at all. */
+    size_t width = n > 0 ? (size_t)(hi - lo) + 1 : 0;
+    void *fp = h->frames, *ap = h->alive;
+    int grown = grow_scratch(h, 3 * width, 4 * width) == 0 &&
+                grow(&fp, &h->frames_cap, (size_t)h->nframes + 1, sizeof(frame_record)) == 0;
+    h->frames = fp;
+    grown = grown && grow(&ap, &h->alive_cap, h->nalive + (size_t)n, sizeof(int)) == 0;
+    h->alive = ap;
+    if (!grown)
+        return no_memory(err, h->path);
+
+    int *col_id = h->ibuf, *col_mode = h->ibuf + width, *col_src = h->ibuf + 2 * width;
+    for (size_t c = 0; c < width; ++c)
+        col_id[c] = col_mode[c] = col_src[c] = -1;
+    for (int i = 0; i < n; ++i) {
+        size_t c = (size_t)(frags[i].id - lo);
+        if (col_src[c] >= 0)
+            return cf_error_set(err, CF_ERR_OUTPUT,
+                                "output file '%s': frame at step %ld lists fragment %d twice",
+                                h->path, step, frags[i].id);
+        col_src[c] = i;
+        col_id[c] = frags[i].id;
+        col_mode[c] = frags[i].mode;
+    }
+
+    hsize_t T = h->nframes;
+    hsize_t ncols = h->ncols;
+    if (h->nfragments > ncols)
+        ncols = h->nfragments;
+    if (n > 0 && (hsize_t)hi + 1 > ncols)
+        ncols = (hsize_t)hi + 1;
+
+    for (int f = 0; f < FLD_COUNT; ++f) {
+        const column_def *c = &FIELDS[f];
+        hsize_t dims[3] = {T + 1, ncols, (hsize_t)c->ncomp};
+        if (H5Dset_extent(h->value[f], dims) < 0)
+            return h5_fail(err, h->path, "extending /particles/fragments/%s/value to %llu frames",
+                           c->name, (unsigned long long)(T + 1));
+        if (width == 0)
+            continue;
+        const void *buf = f == FLD_ID ? (const void *)col_id : (const void *)col_mode;
+        if (!c->integer) {
+            for (size_t col = 0; col < width; ++col) {
+                const double *v = col_src[col] >= 0 ? field_values(&frags[col_src[col]], f) : NULL;
+                for (int k = 0; k < c->ncomp; ++k)
+                    h->dbuf[col * (size_t)c->ncomp + (size_t)k] = v ? v[k] : NAN;
+            }
+            buf = h->dbuf;
+        }
+        if (write_frame_block(h->value[f], T, (hsize_t)lo, (hsize_t)width, c->ncomp, mem_type(c),
+                              buf) < 0)
+            return h5_fail(err, h->path, "writing frame %llu of /particles/fragments/%s/value",
+                           (unsigned long long)T, c->name);
+    }
+    /* step last: its length is the number of complete frames. */
+    int64_t step64 = (int64_t)step;
+    if (append_rows(h->time, T, 1, H5T_NATIVE_DOUBLE, &time) < 0)
+        return h5_fail(err, h->path, "appending to /particles/fragments/id/time");
+    if (append_rows(h->step, T, 1, H5T_NATIVE_INT64, &step64) < 0)
+        return h5_fail(err, h->path, "appending to /particles/fragments/id/step");
+    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+        return h5_fail(err, h->path, "flushing frame %llu", (unsigned long long)T);
+
+    frame_record *r = &h->frames[T];
+    r->time = time;
+    r->ncols = ncols;
+    r->first = h->nalive;
+    r->count = (hsize_t)n;
+    for (size_t c = 0; c < width; ++c)
+        if (col_src[c] >= 0)
+            h->alive[h->nalive++] = lo + (int)c;
+    h->nframes = T + 1;
+    h->ncols = ncols;
+    return CF_OK;
+}
+
+cf_status cf_h5_write_frame(cf_h5 *h, long step, double time, const cf_frag_frame *frags, int n,
+                            cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = write_frame_impl(h, step, time, frags, n, err);
+    quiet_end(&q);
+    return st;
+}
+
+/* ---- fragment records -------------------------------------------------- */
+
+static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, cf_error *err)
+{
+    if (!h)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_add_fragments: no output file is open");
+    if (n < 0 || (n > 0 && !info))
+        return cf_error_set(err, CF_ERR_OUTPUT,
+                            "output file '%s': invalid fragment record list (n = %d)", h->path, n);
+    if (n == 0)
+        return CF_OK;
+    size_t un = (size_t)n;
+    if (grow_scratch(h, 3 * un, 5 * un) < 0)
+        return no_memory(err, h->path);
+    /* Rows are stored by id; the batch may list the new ids in any order. */
+    long long base = (long long)h->nfragments;
+    int *src = h->ibuf, *parent = h->ibuf + un, *ntets = h->ibuf + 2 * un;
+    for (size_t i = 0; i < un; ++i)
+        src[i] = -1;
+    for (int i = 0; i < n; ++i) {
+        long long id = info[i].id;
+        if (id < base || id >= base + n || src[id - base] >= 0)
+            return cf_error_set(err, CF_ERR_OUTPUT,
+                                "output file '%s': fragment id %lld is not new: this batch must "
+                                "hold ids %lld..%lld, each once",
+                                h->path, id, base, base + n - 1);
+        if (info[i].parent < -1 || info[i].parent >= info[i].id)
+            return cf_error_set(err, CF_ERR_OUTPUT,
+                                "output file '%s': fragment %d has parent %d; the parent must be "
+                                "-1 or an earlier fragment",
+                                h->path, info[i].id, info[i].parent);
+        src[id - base] = i;
+    }
+    double *birth = h->dbuf, *mass = h->dbuf + un, *inertia = h->dbuf + 2 * un;
+    for (size_t r = 0; r < un; ++r) {
+        const cf_frag_info *fi = &info[src[r]];
+        parent[r] = fi->parent;
+        ntets[r] = fi->n_tets;
+        birth[r] = fi->birth_time;
+        mass[r] = fi->mass;
+        for (int k = 0; k < 3; ++k)
+            inertia[3 * r + (size_t)k] = fi->inertia_principal[k];
+    }
+    const void *bufs[FR_COUNT] = {parent, birth, mass, ntets, inertia};
+    for (int c = 0; c < FR_COUNT; ++c)
+        if (append_rows(h->fragment[c], h->nfragments, un, mem_type(&FRAGMENT_COLUMNS[c]),
+                        bufs[c]) < 0)
+            return h5_fail(err, h->path, "appending to /fragments/%s", FRAGMENT_COLUMNS[c].name);
+    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+        return h5_fail(err, h->path, "flushing /fragments");
+    h->nfragments += un;
+    return CF_OK;
+}
+
+cf_status cf_h5_add_fragments(cf_h5 *h, const cf_frag_info *info, int n, cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = add_fragments_impl(h, info, n, err);
+    quiet_end(&q);
+    return st;
+}
+
+/* ---- observables ------------------------------------------------------- */
+
+static observable *find_observable(cf_h5 *h, const char *name)
+{
+    /* Callers write the same few names in the same order every frame, so
+     * the entry after the last hit is usually the one. */
+    for (size_t k = 0; k < h->nobs; ++k) {
+        size_t i = (h->obs_last + 1 + k) % h->nobs;
+        if (strcmp(h->obs[i].name, name) == 0) {
+            h->obs_last = i;
+            return &h->obs[i];
+        }
+    }
+    return NULL;
+}
+
+static cf_status create_observable(cf_h5 *h, const char *name, observable **out, cf_error *err)
+{
+    void *p = h->obs;
+    if (grow(&p, &h->obs_cap, h->nobs + 1, sizeof(observable)) < 0)
+        return no_memory(err, h->path);
+    h->obs = p;
+    observable *o = &h->obs[h->nobs];
+    o->name = strdup(name);
+    if (!o->name)
+        return no_memory(err, h->path);
+    o->step = o->time = o->value = H5I_INVALID_HID;
+    o->n = 0;
+    hid_t g = make_group(h->obs_group, name);
+    if (g >= 0) {
+        o->step = create_rows(g, "step", H5T_STD_I64LE, 1);
+        o->time = create_rows(g, "time", H5T_IEEE_F64LE, 1);
+        o->value = create_rows(g, "value", H5T_IEEE_F64LE, 1);
+        H5Gclose(g);
+    }
+    if (g < 0 || o->step < 0 || o->time < 0 || o->value < 0 || write_unit(o->time, "s") < 0) {
+        int ignored = 0;
+        close_dataset(&o->step, &ignored);
+        close_dataset(&o->time, &ignored);
+        close_dataset(&o->value, &ignored);
+        free(o->name);
+        return h5_fail(err, h->path, "creating /observables/%s", name);
+    }
+    h->obs_last = h->nobs++;
+    *out = o;
+    return CF_OK;
+}
+
+static cf_status write_observable_impl(cf_h5 *h, const char *name, long step, double time,
+                                       double value, cf_error *err)
+{
+    if (!h)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_observable: no output file is open");
+    if (!name || !*name || strchr(name, '/') || strcmp(name, ".") == 0 ||
+        strcmp(name, "..") == 0 || strlen(name) > 200)
+        return cf_error_set(err, CF_ERR_OUTPUT,
+                            "output file '%s': observable name '%s' is not usable (it must be "
+                            "1-200 characters, without '/', and not '.' or '..')",
+                            h->path, name ? name : "(null)");
+    observable *o = find_observable(h, name);
+    if (!o) {
+        cf_status st = create_observable(h, name, &o, err);
+        if (st != CF_OK)
+            return st;
+    }
+    /* step last, as for frames.  Samples reach the disk with the next flush
+     * (the next frame, fragment batch, hand-off or close). */
+    int64_t step64 = (int64_t)step;
+    if (append_rows(o->value, o->n, 1, H5T_NATIVE_DOUBLE, &value) < 0 ||
+        append_rows(o->time, o->n, 1, H5T_NATIVE_DOUBLE, &time) < 0 ||
+        append_rows(o->step, o->n, 1, H5T_NATIVE_INT64, &step64) < 0)
+        return h5_fail(err, h->path, "appending to /observables/%s", name);
+    o->n++;
+    return CF_OK;
+}
+
+cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double time,
+                                 double value, cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = write_observable_impl(h, name, step, time, value, err);
+    quiet_end(&q);
+    return st;
+}
+
+/* ---- hand-offs --------------------------------------------------------- */
+
+static cf_status add_handoff_impl(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
+{
+    if (!h)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_add_handoff: no output file is open");
+    if (!r)
+        return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': no hand-off record given",
+                            h->path);
+    const void *bufs[HO_COUNT] = {&r->fragment, &r->direction, &r->momentum_error,
+                                  &r->handoff_loss, &r->time};
+    for (int c = 0; c < HO_COUNT; ++c)
+        if (append_rows(h->handoff[c], h->nhandoffs, 1, mem_type(&HANDOFF_COLUMNS[c]), bufs[c]) <
+            0)
+            return h5_fail(err, h->path, "appending to /handoffs/%s", HANDOFF_COLUMNS[c].name);
+    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+        return h5_fail(err, h->path, "flushing /handoffs");
+    h->nhandoffs++;
+    return CF_OK;
+}
+
+cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = add_handoff_impl(h, r, err);
+    quiet_end(&q);
+    return st;
+}
+
+/* ---- XDMF sidecar ------------------------------------------------------ */
+
+/* `<path minus .h5>.xdmf`; `.hdf5` is stripped too, anything else kept. */
+static char *sidecar_path(const char *path)
+{
+    size_t len = strlen(path), stem = len;
+    if (len > 3 && strcmp(path + len - 3, ".h5") == 0)
+        stem = len - 3;
+    else if (len > 5 && strcmp(path + len - 5, ".hdf5") == 0)
+        stem = len - 5;
+    char *x = malloc(stem + sizeof ".xdmf");
+    if (x) {
+        memcpy(x, path, stem);
+        memcpy(x + stem, ".xdmf", sizeof ".xdmf");
+    }
+    return x;
+}
+
+/* `s` with the five XML special characters escaped (malloc'd). */
+static char *xml_escape(const char *s)
+{
+    char *out = malloc(6 * strlen(s) + 1);
+    if (!out)
+        return NULL;
+    char *o = out;
+    for (; *s; ++s) {
+        const char *rep = NULL;
+        switch (*s) {
+        case '&':
+            rep = "&amp;";
+            break;
+        case '<':
+            rep = "&lt;";
+            break;
+        case '>':
+            rep = "&gt;";
+            break;
+        case '"':
+            rep = "&quot;";
+            break;
+        case '\'':
+            rep = "&apos;";
+            break;
+        default:
+            *o++ = *s;
+        }
+        if (rep) {
+            size_t n = strlen(rep);
+            memcpy(o, rep, n);
+            o += n;
+        }
+    }
+    *o = '\0';
+    return out;
+}
+
+/* The XDMF topology cells of frame t are its alive columns; they are kept in
+ * /xdmf/polyvertex so dead or unborn columns (NaN) are not drawn. */
+static cf_status write_connectivity(cf_h5 *h, cf_error *err)
+{
+    if (h->nalive == 0)
+        return CF_OK;
+    hsize_t n = (hsize_t)h->nalive;
+    hid_t g = make_group(h->file, "xdmf");
+    hid_t s = H5Screate_simple(1, &n, NULL);
+    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
+    hid_t d = H5I_INVALID_HID;
+    int ok = g >= 0 && s >= 0 && dcpl >= 0 &&
+             (d = H5Dcreate2(g, "polyvertex", H5T_STD_I32LE, s, H5P_DEFAULT, dcpl, H5P_DEFAULT)) >=
+                 0 &&
+             H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, h->alive) >= 0;
+    if (d >= 0)
+        H5Dclose(d);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (s >= 0)
+        H5Sclose(s);
+    if (g >= 0)
+        H5Gclose(g);
+    return ok ? CF_OK : h5_fail(err, h->path, "writing /xdmf/polyvertex");
+}
+
+/* What every grid of the sidecar refers to. */
+typedef struct xdmf_ctx {
+    FILE *fp;
+    const char *href;               /* XML-escaped base name of the .h5 */
+    hsize_t dims[FLD_COUNT][2];     /* actual [T][N] of each value dataset */
+} xdmf_ctx;
+
+/* A DataItem reading frame t, columns [0, cols) of a [T][N](,k) dataset.
+ * XDMF 3 takes the selection in the content itself,
+ * "file:/dataset|start:stride:count:dataspace", which ParaView's XDMF 3
+ * readers honour for geometry and attributes alike. */
+static void put_frame_slab(const xdmf_ctx *x, hsize_t t, hsize_t cols, int field)
+{
+    const column_def *c = &FIELDS[field];
+    FILE *fp = x->fp;
+    unsigned long long T = (unsigned long long)x->dims[field][0];
+    unsigned long long N = (unsigned long long)x->dims[field][1];
+    unsigned long long tt = (unsigned long long)t, cc = (unsigned long long)cols;
+    const char *type = c->integer ? "NumberType=\"Int\" Precision=\"4\""
+                                  : "NumberType=\"Float\" Precision=\"8\"";
+    if (c->ncomp > 1)
+        fprintf(fp,
+                "          <DataItem Dimensions=\"%llu %d\" %s Format=\"HDF\">%s:/particles/"
+                "fragments/%s/value|%llu 0 0:1 1 1:1 %llu %d:%llu %llu %d</DataItem>\n",
+                cc, c->ncomp, type, x->href, c->name, tt, cc, c->ncomp, T, N, c->ncomp);
+    else
+        fprintf(fp,
+                "          <DataItem Dimensions=\"%llu\" %s Format=\"HDF\">%s:/particles/"
+                "fragments/%s/value|%llu 0:1 1:1 %llu:%llu %llu</DataItem>\n",
+                cc, type, x->href, c->name, tt, cc, T, N);
+}
+
+static void put_attribute(const xdmf_ctx *x, hsize_t t, hsize_t cols, int field)
+{
+    fprintf(x->fp, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n",
+            FIELDS[field].name, FIELDS[field].ncomp == 3 ? "Vector" : "Scalar");
+    put_frame_slab(x, t, cols, field);
+    fputs("        </Attribute>\n", x->fp);
+}
+
+static void put_xdmf(const xdmf_ctx *x, const cf_h5 *h)
+{
+    FILE *fp = x->fp;
+    fputs("<?xml version=\"1.0\" ?>\n"
+          "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+          "  <Domain>\n"
+          "    <Grid Name=\"fragments\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+          fp);
+    unsigned long long M = (unsigned long long)h->nalive;
+    for (hsize_t t = 0; t < h->nframes; ++t) {
+        const frame_record *r = &h->frames[t];
+        if (r->count == 0)
+            continue; /* readers do not accept a grid without points */
+        unsigned long long n = (unsigned long long)r->count;
+        fprintf(fp,
+                "      <Grid Name=\"frame_%06llu\" GridType=\"Uniform\">\n"
+                "        <Time Value=\"%.17g\"/>\n"
+                "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%llu\" "
+                "NodesPerElement=\"1\">\n"
+                "          <DataItem Dimensions=\"%llu\" NumberType=\"Int\" Precision=\"4\" "
+                "Format=\"HDF\">%s:/xdmf/polyvertex|%llu:1:%llu:%llu</DataItem>\n"
+                "        </Topology>\n"
+                "        <Geometry GeometryType=\"XYZ\">\n",
+                (unsigned long long)t, r->time, n, n, x->href, (unsigned long long)r->first, n,
+                M);
+        put_frame_slab(x, t, r->ncols, FLD_POSITION);
+        fputs("        </Geometry>\n", fp);
+        put_attribute(x, t, r->ncols, FLD_ID);
+        put_attribute(x, t, r->ncols, FLD_MODE);
+        put_attribute(x, t, r->ncols, FLD_VELOCITY);
+        put_attribute(x, t, r->ncols, FLD_ANGVEL);
+        fputs("      </Grid>\n", fp);
+    }
+    fputs("    </Grid>\n  </Domain>\n</Xdmf>\n", fp);
+}
+
+/* The sidecar is written under a temporary name and renamed, so a reader
+ * never sees half of it. */
+static cf_status write_xdmf(const cf_h5 *h, cf_error *err)
+{
+    xdmf_ctx x = {0};
+    /* Read the extents back: after a failed frame they can exceed nframes. */
+    for (int f = 0; f < FLD_COUNT; ++f) {
+        hsize_t dims[3] = {0, 0, 0};
+        hid_t s = H5Dget_space(h->value[f]);
+        int ok = s >= 0 && H5Sget_simple_extent_dims(s, dims, NULL) >= 0;
+        if (s >= 0)
+            H5Sclose(s);
+        if (!ok)
+            return h5_fail(err, h->path, "reading the extent of /particles/fragments/%s/value",
+                           FIELDS[f].name);
+        x.dims[f][0] = dims[0];
+        x.dims[f][1] = dims[1];
+    }
+    const char *slash = strrchr(h->path, '/');
+    char *href = xml_escape(slash ? slash + 1 : h->path);
+    char *xpath = sidecar_path(h->path);
+    char *tmp = xpath ? malloc(strlen(xpath) + sizeof ".tmp") : NULL;
+    cf_status st = CF_OK;
+    if (!href || !tmp) {
+        st = no_memory(err, h->path);
+        goto done;
+    }
+    strcpy(tmp, xpath);
+    strcat(tmp, ".tmp");
+    x.href = href;
+    x.fp = fopen(tmp, "w");
+    if (!x.fp) {
+        st = cf_error_set(err, CF_ERR_OUTPUT, "XDMF sidecar '%s': cannot create it: %s", tmp,
+                          strerror(errno));
+        goto done;
+    }
+    put_xdmf(&x, h);
+    int write_failed = ferror(x.fp);
+    if (fclose(x.fp) != 0 || write_failed) {
+        st = cf_error_set(err, CF_ERR_OUTPUT, "XDMF sidecar '%s': writing it failed: %s", tmp,
+                          strerror(errno));
+        remove(tmp);
+    } else if (rename(tmp, xpath) != 0) {
+        st = cf_error_set(err, CF_ERR_OUTPUT, "XDMF sidecar '%s': cannot rename '%s' to it: %s",
+                          xpath, tmp, strerror(errno));
+        remove(tmp);
+    }
+done:
+    free(tmp);
+    free(xpath);
+    free(href);
+    return st;
+}
+
+/* ---- close ------------------------------------------------------------- */
+
+cf_status cf_h5_close(cf_h5 *h, cf_error *err)
+{
+    if (!h)
+        return CF_OK;
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = CF_OK;
+    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+        st = h5_fail(err, h->path, "flushing before close");
+    if (st == CF_OK)
+        st = write_connectivity(h, err);
+    if (st == CF_OK)
+        st = write_xdmf(h, err);
+    if (close_handles(h) < 0 && st == CF_OK)
+        st = h5_fail(err, h->path, "closing the file");
+    H5Eclear2(H5E_DEFAULT);
+    free_handle(h);
+    quiet_end(&q);
+    return st;
+}

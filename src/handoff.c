@@ -1,0 +1,286 @@
+/* Hand-off between rigid mode (Bullet, or the pbd rigid backend) and
+ * fracture mode (DESIGN §5). */
+#include "sim.h"
+
+#include "linalg.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+int cf_fragment_new(cf_sim *sim, int parent, double birth_time)
+{
+    if (sim->n_frag == sim->cap_frag) {
+        int cap = sim->cap_frag ? 2 * sim->cap_frag : 16;
+        cf_fragment *p = realloc(sim->frag, (size_t)cap * sizeof *p);
+        if (!p)
+            return -1;
+        sim->frag = p, sim->cap_frag = cap;
+    }
+    cf_fragment *f = &sim->frag[sim->n_frag];
+    memset(f, 0, sizeof *f);
+    f->parent = parent;
+    f->birth_time = birth_time;
+    f->mode = CF_MODE_RIGID;
+    f->body = -1;
+    f->q_match[0] = 1;
+    return sim->n_frag++;
+}
+
+/* Mass and centre of mass from the tets (identical to the lumped ones); the
+ * inertia of the lumped masses, the solver's own discretisation, so that a
+ * hand-off preserves linear and angular momentum and never adds kinetic
+ * energy (the tet second moment of DESIGN §5 would give a single tet 1/5 of
+ * its lumped inertia, and the rigid spin 5 times the energy). */
+void cf_fragment_rest_props(cf_sim *sim, int fi)
+{
+    cf_fragment *f = &sim->frag[fi];
+    cf_mass_props mp;
+    double I[9];
+    cf_tet_mass_props(&sim->solid, f->tets, f->nt, sim->solid.X, &mp);
+    f->mass = mp.mass;
+    memcpy(f->com_rest, mp.com, sizeof mp.com);
+    cf_nodes_inertia(&sim->solid, f->nodes.v, f->nodes.n, sim->solid.X, mp.com, I);
+    sym3_eigen(I, f->principal, f->Q);
+}
+
+/* Rotation of the Bullet body frame: rest->current R times principal axes Q. */
+cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const double R[9],
+                               const double v[3], const double w[3], cf_error *err)
+{
+    cf_fragment *f = &sim->frag[fi];
+    const cf_solid *s = &sim->solid;
+    double *pts = malloc((size_t)f->nodes.n * 3 * sizeof(double));
+    if (!pts)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a fragment hull");
+    for (int i = 0; i < f->nodes.n; i++) {
+        double r[3];
+        v3_sub(&s->X[3 * f->nodes.v[i]], f->com_rest, r);
+        m3_tmulv(f->Q, r, &pts[3 * i]); /* principal frame */
+    }
+    cfb_state st;
+    double RQ[9];
+    m3_mul(R, f->Q, RQ);
+    mat_to_quat(RQ, st.quat);
+    memcpy(st.pos, pos, sizeof st.pos);
+    memcpy(st.v, v, sizeof st.v);
+    memcpy(st.w, w, sizeof st.w);
+    /* Small margin: Bullet's default 4 cm would hold fragments off the ground. */
+    double margin = 1e-3 * cbrt(f->mass / s->mat.rho);
+    f->body = cfb_add_hull_body(sim->bullet, f->mass, f->principal, pts, f->nodes.n, margin, &st,
+                                s->mat.friction, s->mat.restitution);
+    free(pts);
+    if (f->body < 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused fragment %d: %s", fi,
+                            cfb_last_error());
+    return CF_OK;
+}
+
+void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[3], double w[3])
+{
+    cf_fragment *f = &sim->frag[fi];
+    if (f->body >= 0) {
+        cfb_state st;
+        double Rb[9];
+        cfb_get_state(sim->bullet, f->body, &st);
+        quat_to_mat(st.quat, Rb);
+        m3_mul_nt(Rb, f->Q, R);
+        memcpy(com, st.pos, sizeof st.pos);
+        memcpy(v, st.v, sizeof st.v);
+        memcpy(w, st.w, sizeof st.w);
+        return;
+    }
+    cf_node_state ns;
+    cf_nodes_state(&sim->solid, f->nodes.v, f->nodes.n, f->q_match, &ns);
+    memcpy(com, ns.com, sizeof ns.com);
+    memcpy(R, ns.R, sizeof ns.R);
+    memcpy(v, ns.v, sizeof ns.v);
+    cf_nodes_angular_velocity(&sim->solid, f->nodes.v, f->nodes.n, ns.com, ns.L, w);
+}
+
+static cf_status record_handoff(cf_sim *sim, int fi, int direction, double merr, double loss,
+                                cf_error *err)
+{
+    sim->n_handoffs++;
+    if (merr > sim->max_momentum_error)
+        sim->max_momentum_error = merr;
+    sim->total_handoff_loss += loss;
+    if (!sim->h5)
+        return CF_OK;
+    cf_handoff_record r = {sim->t, fi, direction, merr, loss};
+    return cf_h5_add_handoff(sim->h5, &r, err);
+}
+
+/* Fragment's cohesive elements: those whose two tets both belong to it. */
+static int collect_cohesive(cf_sim *sim, cf_fragment *f)
+{
+    const cf_solid *s = &sim->solid;
+    int id = (int)(f - sim->frag);
+    f->coh.n = 0;
+    for (int c = 0; c < s->n_coh; c++)
+        if (s->tet_frag[s->coh[c].tet[0]] == id && s->tet_frag[s->coh[c].tet[1]] == id &&
+            cf_int_list_push(&f->coh, c))
+            return -1;
+    return 0;
+}
+
+cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_error *err)
+{
+    cf_fragment *f = &sim->frag[fi];
+    cf_solid *s = &sim->solid;
+    if (st) { /* from Bullet: x = R (X - X_cm) + c, v = v_c + w x (x - c) */
+        double Rb[9], R[9];
+        quat_to_mat(st->quat, Rb);
+        m3_mul_nt(Rb, f->Q, R);
+        for (int i = 0; i < f->nodes.n; i++) {
+            int a = f->nodes.v[i];
+            double r[3], x[3], wr[3];
+            v3_sub(&s->X[3 * a], f->com_rest, r);
+            m3_mulv(R, r, x);
+            v3_cross(st->w, x, wr);
+            for (int k = 0; k < 3; k++) {
+                s->x[3 * a + k] = st->pos[k] + x[k];
+                s->v[3 * a + k] = st->v[k] + wr[k];
+            }
+        }
+        cfb_remove_body(sim->bullet, f->body);
+        f->body = -1;
+    }
+    f->mode = CF_MODE_FRACTURE;
+    f->steps = f->quiet = 0;
+    f->t_enter = sim->t;
+    if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
+    double merr = 0;
+    if (st) {
+        cf_node_state ns;
+        cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &ns);
+        double d[3], P = f->mass * v3_norm(st->v);
+        for (int k = 0; k < 3; k++)
+            d[k] = ns.M * ns.v[k] - f->mass * st->v[k];
+        merr = P > 0 ? v3_norm(d) / P : v3_norm(d);
+    }
+    return record_handoff(sim, fi, 0, merr, 0.0, err);
+}
+
+/* Give the new fragment `ci` the tets of component `c` and their nodes. */
+static int take_component(cf_sim *sim, int ci, const int *tets, const int *comp, int nt, int c,
+                          unsigned char *seen)
+{
+    cf_fragment *f = &sim->frag[ci];
+    cf_solid *s = &sim->solid;
+    int count = 0;
+    for (int i = 0; i < nt; i++)
+        count += comp[i] == c;
+    f->tets = malloc((size_t)count * sizeof(int));
+    if (!f->tets)
+        return -1;
+    f->nt = 0;
+    for (int i = 0; i < nt; i++) {
+        if (comp[i] != c)
+            continue;
+        int t = tets[i];
+        f->tets[f->nt++] = t;
+        s->tet_frag[t] = ci;
+        for (int j = 0; j < 4; j++) {
+            int a = s->tet[4 * t + j];
+            if (!seen[a]) {
+                seen[a] = 1;
+                if (cf_int_list_push(&f->nodes, a))
+                    return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* Momentum-preserving rigid velocities: v = P/M, w = (R I_rest R^T)^-1 L. */
+static void rigid_velocity(const cf_fragment *f, const cf_node_state *ns, double w[3])
+{
+    double RQ[9], D[9] = {0}, I[9], tmp[9], Iinv[9];
+    m3_mul(ns->R, f->Q, RQ);
+    D[0] = f->principal[0], D[4] = f->principal[1], D[8] = f->principal[2];
+    m3_mul(RQ, D, tmp);
+    m3_mul_nt(tmp, RQ, I);
+    w[0] = w[1] = w[2] = 0;
+    if (m3_inv(I, Iinv) != 0)
+        m3_mulv(Iinv, ns->L, w);
+}
+
+cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
+{
+    cf_solid *s = &sim->solid;
+    cf_fragment *f = &sim->frag[fi];
+    int nt = f->nt;
+    int *tets = f->tets;
+    int *comp = malloc((size_t)nt * sizeof(int));
+    unsigned char *seen = calloc((size_t)s->n_nodes, 1);
+    if (!comp || !seen) {
+        free(comp), free(seen);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
+    }
+    int k = cf_label_components(s, tets, nt, comp);
+    cf_node_state before;
+    cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &before);
+    double P_before[3] = {before.M * before.v[0], before.M * before.v[1], before.M * before.v[2]};
+    double P_after[3] = {0, 0, 0}, ke_after = 0;
+
+    /* One component: the fragment stays itself; several: children. */
+    int first = fi;
+    if (k > 1) {
+        f->mode = CF_MODE_DEAD;
+        first = sim->n_frag;
+        for (int c = 0; c < k; c++)
+            if (cf_fragment_new(sim, fi, sim->t) < 0) {
+                free(comp), free(seen);
+                return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
+            }
+        f = &sim->frag[fi]; /* the array may have moved */
+    }
+    f->tets = NULL; /* the old lists are handed out to the components below */
+    f->nt = 0;
+    f->nodes.n = 0;
+    for (int c = 0; c < k; c++) {
+        int ci = first + c;
+        if (take_component(sim, ci, tets, comp, nt, c, seen)) {
+            free(comp), free(seen);
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
+        }
+        cf_fragment *g = &sim->frag[ci];
+        cf_fragment_rest_props(sim, ci);
+        g->mode = CF_MODE_RIGID;
+        memcpy(g->q_match, sim->frag[fi].q_match, sizeof g->q_match);
+        cf_node_state ns;
+        cf_nodes_state(s, g->nodes.v, g->nodes.n, g->q_match, &ns);
+        double w[3];
+        rigid_velocity(g, &ns, w);
+        v3_axpy(ns.M, ns.v, P_after);
+        ke_after += 0.5 * ns.M * v3_dot(ns.v, ns.v) + 0.5 * v3_dot(w, ns.L);
+        if (sim->bullet) {
+            cf_status st = cf_fragment_add_body(sim, ci, ns.com, ns.R, ns.v, w, err);
+            if (st != CF_OK) {
+                free(comp), free(seen);
+                return st;
+            }
+        } else {
+            if (cf_bars_build(&g->bars, s, g->tets, g->nt)) {
+                free(comp), free(seen);
+                return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
+            }
+            g->steps = 0;
+        }
+    }
+    /* Siblings born in one split do not collide with each other: their single
+     * convex hulls overlap where the crack surface is not convex. */
+    if (sim->bullet && k > 1)
+        for (int a = 0; a < k; a++)
+            cfb_set_family(sim->bullet, sim->frag[first + a].body, fi);
+    if (sim->bullet || k > 1)
+        cf_bars_free(&sim->frag[fi].bars);
+    free(tets), free(comp), free(seen);
+    double d[3];
+    v3_sub(P_after, P_before, d);
+    double pn = v3_norm(P_before);
+    double merr = pn > 0 ? v3_norm(d) / pn : v3_norm(d);
+    double loss = before.ke - ke_after;
+    return record_handoff(sim, fi, 1, merr, loss, err);
+}

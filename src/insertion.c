@@ -1,0 +1,228 @@
+#include "insertion.h"
+
+#include "linalg.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+int cf_int_list_push(cf_int_list *l, int value)
+{
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 64;
+        int *v = realloc(l->v, (size_t)cap * sizeof(int));
+        if (!v)
+            return -1;
+        l->v = v, l->cap = cap;
+    }
+    l->v[l->n++] = value;
+    return 0;
+}
+
+/* Current unit normal of face k of tet t (outward from t). */
+static void face_normal(const cf_solid *s, int t, int k, double n[3])
+{
+    const int *T = &s->tet[4 * t];
+    const double *a = &s->x[3 * T[CF_TET_FACE[k][0]]], *b = &s->x[3 * T[CF_TET_FACE[k][1]]],
+                 *c = &s->x[3 * T[CF_TET_FACE[k][2]]];
+    double e1[3], e2[3];
+    v3_sub(b, a, e1), v3_sub(c, a, e2), v3_cross(e1, e2, n);
+    double l = v3_norm(n);
+    for (int i = 0; i < 3; i++)
+        n[i] = l > 0 ? n[i] / l : 0;
+}
+
+/* Largest eigenvalue of a symmetric 3x3 matrix (trigonometric closed form). */
+static double max_principal(const double A[9])
+{
+    double p1 = A[1] * A[1] + A[2] * A[2] + A[5] * A[5];
+    if (p1 == 0)
+        return fmax(A[0], fmax(A[4], A[8]));
+    double q = (A[0] + A[4] + A[8]) / 3;
+    double p2 = (A[0] - q) * (A[0] - q) + (A[4] - q) * (A[4] - q) + (A[8] - q) * (A[8] - q) + 2 * p1;
+    double p = sqrt(p2 / 6), B[9];
+    for (int k = 0; k < 9; k++)
+        B[k] = (A[k] - ((k % 4) == 0 ? q : 0)) / p;
+    double r = fmax(-1.0, fmin(1.0, m3_det(B) / 2));
+    return q + 2 * p * cos(acos(r) / 3);
+}
+
+/* Volume-averaged nodal maximum principal stress of the nodes of `tets`
+ * (written at the node's index of `out`, which has s->n_nodes entries). */
+static int nodal_principal(const cf_solid *s, const int *tets, int nt, double *out)
+{
+    double *acc = calloc((size_t)s->n_nodes * 10, sizeof(double));
+    if (!acc)
+        return -1;
+    for (int i = 0; i < nt; i++) {
+        int t = tets[i];
+        for (int j = 0; j < 4; j++) {
+            double *a = &acc[10 * s->tet[4 * t + j]];
+            for (int k = 0; k < 9; k++)
+                a[k] += s->vol[t] * s->sigma[9 * t + k];
+            a[9] += s->vol[t];
+        }
+    }
+    for (int i = 0; i < nt; i++)
+        for (int j = 0; j < 4; j++) {
+            int n = s->tet[4 * tets[i] + j];
+            double sig[9];
+            for (int k = 0; k < 9; k++)
+                sig[k] = acc[10 * n + k] / acc[10 * n + 9];
+            out[n] = max_principal(sig);
+        }
+    free(acc);
+    return 0;
+}
+
+int cf_insertion_candidates(const cf_solid *s, const int *tets, int nt, cf_criterion rule, int *out)
+{
+    double *nodal = NULL;
+    if (rule == CF_CRITERION_SOURCE) {
+        nodal = malloc((size_t)s->n_nodes * sizeof(double));
+        if (!nodal || nodal_principal(s, tets, nt, nodal)) {
+            free(nodal);
+            return -1;
+        }
+    }
+    int count = 0;
+    double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
+    for (int i = 0; i < nt; i++) {
+        int ta = tets[i];
+        for (int k = 0; k < 4; k++) {
+            int f = s->tet_facet[4 * ta + k];
+            const int *F = &s->facet[4 * f];
+            if (F[2] < 0 || s->cracked[f] || F[0] != ta)
+                continue;
+            if (rule == CF_CRITERION_SOURCE) {
+                int all = 1;
+                for (int j = 0; j < 3; j++)
+                    all &= nodal[s->tet[4 * ta + CF_TET_FACE[k][j]]] >= 0.9 * smax;
+                if (all)
+                    out[count++] = f;
+                continue;
+            }
+            int tb = F[2];
+            double sig[9], n[3], t[3];
+            for (int j = 0; j < 9; j++)
+                sig[j] = 0.5 * (s->sigma[9 * ta + j] + s->sigma[9 * tb + j]);
+            face_normal(s, ta, k, n);
+            m3_mulv(sig, n, t);
+            double sn = v3_dot(n, t);
+            double tau2 = v3_dot(t, t) - sn * sn;
+            double tau = tau2 > 0 ? sqrt(tau2) : 0;
+            if (sn >= smax || tau >= tmax)
+                out[count++] = f;
+        }
+    }
+    free(nodal);
+    return count;
+}
+
+/* Slot of original vertex o in tet t, or -1. */
+static int slot_of(const cf_solid *s, int t, int o)
+{
+    for (int j = 0; j < 4; j++)
+        if (s->tet0[4 * t + j] == o)
+            return j;
+    return -1;
+}
+
+static int uf_find(int *parent, int i)
+{
+    while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+/* Split the star of node copy `n` of original vertex `o` into its
+ * components (tets joined through uncracked facets containing o); every
+ * component but the one with the lowest tet gets a new copy of the node. */
+static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
+{
+    int lo = s->vt_start[o], hi = s->vt_start[o + 1];
+    int *buf = malloc(3 * (size_t)(hi - lo) * sizeof(int));
+    if (!buf)
+        return -1;
+    int *star = buf, *parent = buf + (hi - lo), *copy_of_root = buf + 2 * (hi - lo);
+    int ns = 0, rc = 0;
+    for (int i = lo; i < hi; i++) {
+        int t = s->vt_list[i];
+        if (s->tet[4 * t + slot_of(s, t, o)] == n)
+            star[ns++] = t;
+    }
+    for (int i = 0; i < ns; i++)
+        parent[i] = i;
+    for (int i = 0; i < ns; i++) {
+        int t = star[i], j = slot_of(s, t, o);
+        for (int k = 0; k < 4; k++) {
+            if (k == j) /* the face opposite o does not contain o */
+                continue;
+            int f = s->tet_facet[4 * t + k];
+            const int *F = &s->facet[4 * f];
+            if (F[2] < 0 || s->cracked[f])
+                continue;
+            int other = F[0] == t ? F[2] : F[0];
+            for (int q = 0; q < ns; q++)
+                if (star[q] == other) {
+                    int ra = uf_find(parent, i), rb = uf_find(parent, q);
+                    if (ra != rb)
+                        parent[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+                }
+        }
+    }
+    int keep = uf_find(parent, 0);
+    for (int i = 0; i < ns; i++)
+        copy_of_root[i] = -1;
+    for (int i = 0; i < ns; i++) {
+        int r = uf_find(parent, i);
+        if (r == keep)
+            continue;
+        if (copy_of_root[r] < 0) {
+            int c = cf_solid_copy_node(s, n);
+            if (c < 0 || cf_int_list_push(nodes, c)) {
+                rc = -1;
+                break;
+            }
+            copy_of_root[r] = c;
+        }
+        s->tet[4 * star[i] + slot_of(s, star[i], o)] = copy_of_root[r];
+    }
+    /* Re-lump only the copies of o: the other nodes of these tets keep theirs. */
+    for (int i = 0; i < ns; i++)
+        s->m[s->tet[4 * star[i] + slot_of(s, star[i], o)]] = 0;
+    for (int i = 0; i < ns; i++)
+        s->m[s->tet[4 * star[i] + slot_of(s, star[i], o)]] += s->mat.rho * s->vol[star[i]] / 4.0;
+    free(buf);
+    return rc;
+}
+
+int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes)
+{
+    const int *F = &s->facet[4 * f];
+    int ta = F[0], fa = F[1], tb = F[2];
+    s->cracked[f] = 1;
+    cf_cohesive ce;
+    memset(&ce, 0, sizeof ce);
+    ce.tet[0] = ta, ce.tet[1] = tb;
+    for (int i = 0; i < 3; i++) {
+        int sa = CF_TET_FACE[fa][i];
+        int o = s->tet0[4 * ta + sa];
+        ce.slot[0][i] = sa;
+        ce.slot[1][i] = slot_of(s, tb, o);
+        int na = s->tet[4 * ta + sa];
+        int nb = s->tet[4 * tb + ce.slot[1][i]];
+        if (split_star(s, o, na, nodes))
+            return -1;
+        if (nb != na && split_star(s, o, nb, nodes))
+            return -1;
+    }
+    if (s->n_coh == s->cap_coh) {
+        int cap = s->cap_coh ? 2 * s->cap_coh : 256;
+        cf_cohesive *c = realloc(s->coh, (size_t)cap * sizeof *c);
+        if (!c)
+            return -1;
+        s->coh = c, s->cap_coh = cap;
+    }
+    s->coh[s->n_coh++] = ce;
+    return 0;
+}

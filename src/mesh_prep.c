@@ -1,0 +1,596 @@
+/* cohfrac — `cohfrac mesh`: closed surface -> checked Tet4 mesh.
+ *
+ * Pipeline: load the surface, report and repair self-intersections, check
+ * it is closed, coarsen it by quadric decimation when the wanted tet count
+ * needs a coarser boundary, run the `tetgen` program (never linked: AGPL),
+ * orient every tet positively, check the tet volume against the surface's
+ * enclosed volume and write <output>.node/.ele plus a stamp for caching.
+ *
+ * Size selection for target_tets = N > 0 (everything is deterministic, so
+ * the same input always gives the same mesh):
+ *   - tetgen always runs with "-pYq2.0F": -Y keeps the (repaired or
+ *     decimated) surface exactly, so the volume check is exact and the mesh
+ *     is as fine at the boundary as the surface is; q2.0 is the radius-edge
+ *     bound.
+ *   - With -Y the count is dominated by the surface: about TETS_PER_TRI tets
+ *     per surface triangle.  If the full surface would give more than 1.05 N,
+ *     it is decimated to F = 0.9 N / TETS_PER_TRI triangles (then corrected
+ *     from the measured count, at most 3 times), aiming a little low.
+ *   - The remaining gap is closed with a maximum tet volume -a: modelling
+ *     N(a) = N0 + C / a, the first guess is C = V (the enclosed volume) and
+ *     later guesses fit the last two runs; accepted within ±5 %, at most 6
+ *     runs, otherwise the closest run is kept.
+ * target_tets = 0 runs plain "tetgen -pqF" on the full surface.
+ */
+#define _XOPEN_SOURCE 700 /* POSIX 2008 + realpath */
+
+#include "cohfrac/mesh.h"
+#include "cohfrac/surface.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <math.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+extern char **environ;
+
+/* Bump when the pipeline changes in a way that changes its output, so old
+ * cached meshes are rebuilt. */
+#define PREP_VERSION "cohfrac-mesh 1 (repair valence3; qem; tetgen -pYq2.0 [-a])"
+#define TETS_PER_TRI 2.4 /* tetgen -pYq2.0 tets per surface triangle (bunny: 2.3-2.5) */
+#define BASE_OPTS "pYq2.0"
+#define TOL 0.05
+#define MAX_A_RUNS 6
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static char *str_cat(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    char *s = malloc(la + lb + 1);
+    if (s) {
+        memcpy(s, a, la);
+        memcpy(s + la, b, lb + 1);
+    }
+    return s;
+}
+
+/* mkdir -p of the directory part of `path`. */
+static cf_status make_parent_dirs(const char *path, cf_error *err)
+{
+    char *d = str_cat(path, "");
+    if (!d)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    char *slash = strrchr(d, '/');
+    if (!slash || slash == d) {
+        free(d);
+        return CF_OK;
+    }
+    *slash = '\0';
+    for (char *p = d + 1;; p++) {
+        if (*p == '/' || *p == '\0') {
+            char c = *p;
+            *p = '\0';
+            if (mkdir(d, 0777) != 0 && errno != EEXIST) {
+                cf_status st = cf_error_set(err, CF_ERR_OUTPUT,
+                                            "cannot create directory %s (%s)", d, strerror(errno));
+                free(d);
+                return st;
+            }
+            *p = c;
+            if (!c)
+                break;
+        }
+    }
+    free(d);
+    return CF_OK;
+}
+
+/* Remove the temporary directory and the files in it (all ours). */
+static void remove_tree(const char *dir)
+{
+    DIR *D = opendir(dir);
+    if (D) {
+        struct dirent *e;
+        while ((e = readdir(D))) {
+            if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+                continue;
+            char path[PATH_MAX];
+            if (snprintf(path, sizeof path, "%s/%s", dir, e->d_name) < (int)sizeof path)
+                remove(path);
+        }
+        closedir(D);
+    }
+    rmdir(dir);
+}
+
+/* ---- stamp -------------------------------------------------------------- */
+
+/* The lines that decide whether a cached mesh is still valid. */
+static cf_status stamp_key(const cf_mesh_prep_opts *o, char *key, size_t n, cf_error *err)
+{
+    struct stat st;
+    if (stat(o->input, &st) != 0)
+        return cf_error_set(err, CF_ERR_FILE_OPEN, "%s: cannot read (%s)", o->input,
+                            strerror(errno));
+    char *real = realpath(o->input, NULL);
+    snprintf(key, n,
+             "version %s\ninput %s\ninput_size %lld\ninput_mtime %lld.%09ld\ntarget_tets %d\n",
+             PREP_VERSION, real ? real : o->input, (long long)st.st_size,
+             (long long)st.st_mtim.tv_sec, (long)st.st_mtim.tv_nsec, o->target_tets);
+    free(real);
+    return CF_OK;
+}
+
+/* Are <output>.node/.ele there, newer than the input, and was the stamp
+ * written for exactly this key? */
+static int cache_valid(const cf_mesh_prep_opts *o, const char *key)
+{
+    char *sp = str_cat(o->output, ".stamp"), *np = str_cat(o->output, ".node"),
+         *ep = str_cat(o->output, ".ele");
+    int ok = 0;
+    struct stat si, sn, se;
+    FILE *f = sp ? fopen(sp, "r") : NULL;
+    if (f && np && ep && stat(o->input, &si) == 0 && stat(np, &sn) == 0 && stat(ep, &se) == 0 &&
+        sn.st_mtime >= si.st_mtime && se.st_mtime >= si.st_mtime) {
+        size_t kl = strlen(key);
+        char *buf = malloc(kl + 1);
+        if (buf && fread(buf, 1, kl, f) == kl) {
+            buf[kl] = '\0';
+            ok = !strcmp(buf, key);
+        }
+        free(buf);
+    }
+    if (f)
+        fclose(f);
+    free(sp);
+    free(np);
+    free(ep);
+    return ok;
+}
+
+/* ---- running tetgen ---------------------------------------------------- */
+
+/* Last `max` bytes of a log file, for error messages. */
+static void log_tail(const char *path, char *out, size_t max)
+{
+    out[0] = '\0';
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    long from = n > (long)max - 1 ? n - (long)max + 1 : 0;
+    fseek(f, from, SEEK_SET);
+    size_t got = fread(out, 1, max - 1, f);
+    out[got] = '\0';
+    fclose(f);
+}
+
+/* Run `tetgen -<opts> <dir>/surf.off`, output to <dir>/surf.1.*; load it. */
+static cf_status run_tetgen(const char *dir, const char *opts, cf_mesh *m, double *secs,
+                            cf_error *err)
+{
+    char in[PATH_MAX], logp[PATH_MAX], base[PATH_MAX], flag[128];
+    snprintf(in, sizeof in, "%s/surf.off", dir);
+    snprintf(logp, sizeof logp, "%s/tetgen.log", dir);
+    snprintf(base, sizeof base, "%s/surf.1", dir);
+    snprintf(flag, sizeof flag, "-%s", opts);
+    const char *prog = getenv("COHFRAC_TETGEN");
+    if (!prog || !*prog)
+        prog = "tetgen";
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 1, logp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    char *argv[] = {(char *)prog, flag, in, NULL};
+    pid_t pid;
+    double t0 = now_s();
+    int rc = posix_spawnp(&pid, prog, &fa, NULL, argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL,
+                            "cannot run '%s' (%s): install TetGen (Debian: apt install tetgen) "
+                            "or point COHFRAC_TETGEN at the program",
+                            prog, strerror(rc));
+    int status;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR)
+            return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for %s failed (%s)", prog,
+                                strerror(errno));
+    *secs = now_s() - t0;
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        char tail[600];
+        log_tail(logp, tail, sizeof tail);
+        if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+            return cf_error_set(err, CF_ERR_EXTERNAL,
+                                "'%s' not found: install TetGen (apt install tetgen) or set "
+                                "COHFRAC_TETGEN",
+                                prog);
+        return cf_error_set(err, CF_ERR_EXTERNAL,
+                            "'%s %s' failed (%s %d); its output ends:\n%s", prog, flag,
+                            WIFEXITED(status) ? "exit status" : "signal",
+                            WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), tail);
+    }
+    cf_status st = cf_mesh_load_tetgen_unchecked(base, m, err);
+    if (st != CF_OK) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", err ? err->msg : "");
+        return cf_error_set(err, CF_ERR_EXTERNAL, "tetgen %s wrote an unreadable mesh: %s", flag,
+                            msg);
+    }
+    return CF_OK;
+}
+
+/* ---- surface stages ------------------------------------------------------ */
+
+static cf_status copy_surface(const cf_surface *a, cf_surface *b, cf_error *err)
+{
+    b->n_verts = a->n_verts, b->n_tris = a->n_tris;
+    b->v = malloc((size_t)a->n_verts * 3 * sizeof(double));
+    b->tri = malloc((size_t)a->n_tris * 3 * sizeof(int));
+    if (!b->v || !b->tri) {
+        cf_surface_free(b);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    memcpy(b->v, a->v, (size_t)a->n_verts * 3 * sizeof(double));
+    memcpy(b->tri, a->tri, (size_t)a->n_tris * 3 * sizeof(int));
+    return CF_OK;
+}
+
+/* Message listing up to 6 intersecting pairs with their corner vertices. */
+static void describe_pairs(const cf_surface *s, const int *pairs, int n, char *out, size_t len)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (int k = 0; k < n && k < 6 && used < len; k++) {
+        const int *A = &s->tri[3 * pairs[2 * k]], *B = &s->tri[3 * pairs[2 * k + 1]];
+        int w = snprintf(out + used, len - used, "%sfaces %d (%d %d %d) and %d (%d %d %d)",
+                         k ? "; " : "", pairs[2 * k], A[0], A[1], A[2], pairs[2 * k + 1], B[0],
+                         B[1], B[2]);
+        if (w < 0)
+            break;
+        used += (size_t)w;
+    }
+    if (n > 6 && used < len)
+        snprintf(out + used, len - used, "; ... (%d pairs)", n);
+}
+
+/* Self-intersection check with a report; CF_ERR_SURFACE_INTERSECT if any. */
+static cf_status check_intersections(const cf_surface *s, const char *what, int verbose,
+                                     cf_error *err)
+{
+    int pairs[2 * 64];
+    int n = cf_surface_self_intersections(s, pairs, 64);
+    if (n < 0)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory in the self-intersection test");
+    if (n == 0)
+        return CF_OK;
+    char list[700];
+    describe_pairs(s, pairs, n, list, sizeof list);
+    if (verbose)
+        fprintf(stderr, "  %s: %d intersecting face pair(s) remain: %s\n", what, n, list);
+    return cf_error_set(err, CF_ERR_SURFACE_INTERSECT,
+                        "%s intersects itself (0-based faces and vertices): %s. Repair the "
+                        "surface (e.g. remove the offending faces and close the hole) and retry",
+                        what, list);
+}
+
+/* Load, repair, close-check and orient the input surface. */
+static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, cf_error *err)
+{
+    cf_status st = cf_surface_load(o->input, s, err);
+    if (st != CF_OK)
+        return st;
+    int v = o->verbose;
+    if (v)
+        fprintf(stderr, "cohfrac mesh: %s: %d vertices, %d triangles\n", o->input, s->n_verts,
+                s->n_tris);
+    int pairs[2 * 64];
+    int n = cf_surface_self_intersections(s, pairs, 64);
+    if (n < 0)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    if (n > 0) {
+        if (v) {
+            fprintf(stderr, "  %d intersecting face pair(s) (0-based faces and vertices):\n", n);
+            for (int k = 0; k < n && k < 64; k++) {
+                const int *A = &s->tri[3 * pairs[2 * k]], *B = &s->tri[3 * pairs[2 * k + 1]];
+                fprintf(stderr, "    faces %d (%d %d %d) and %d (%d %d %d)\n", pairs[2 * k],
+                        A[0], A[1], A[2], pairs[2 * k + 1], B[0], B[1], B[2]);
+            }
+        }
+        int r = cf_surface_repair_valence3(s);
+        if (r < 0)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+        if (v)
+            fprintf(stderr, "  repair: removed %d valence-3 vertex(es); now %d vertices, %d "
+                            "triangles\n",
+                    r, s->n_verts, s->n_tris);
+        if ((st = check_intersections(s, o->input, v, err)) != CF_OK)
+            return st;
+        if (v)
+            fprintf(stderr, "  no intersections left\n");
+    }
+    if (cf_surface_remove_unused(s) < 0)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    char why[300];
+    int closed = cf_surface_check_closed(s, why, sizeof why);
+    if (closed < 0)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    if (!closed)
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s is not a closed manifold surface: %s (0-based indices). Close "
+                            "the holes and fix the orientation, then retry",
+                            o->input, why);
+    double vol = cf_surface_volume(s);
+    if (vol < 0) {
+        cf_surface_flip(s); /* inside-out: tetgen does not care, our volume check does */
+        vol = -vol;
+        if (v)
+            fprintf(stderr, "  surface was oriented inwards; flipped\n");
+    }
+    if (!(vol > 0))
+        return cf_error_set(err, CF_ERR_MESH_PARSE, "%s encloses no volume", o->input);
+    if (v)
+        fprintf(stderr, "  closed manifold, enclosed volume %.9g\n", vol);
+    return CF_OK;
+}
+
+/* Decimate a copy of `full` to about `tris` triangles, without
+ * self-intersections (retrying with more triangles if needed). */
+static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int verbose,
+                         cf_error *err)
+{
+    for (int attempt = 0; attempt < 4; attempt++) {
+        cf_status st = copy_surface(full, out, err);
+        if (st != CF_OK)
+            return st;
+        double t0 = now_s();
+        int got = cf_surface_decimate(out, tris);
+        if (got < 0) {
+            cf_surface_free(out);
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory in decimation");
+        }
+        int n = cf_surface_self_intersections(out, NULL, 0);
+        char why[300];
+        int closed = cf_surface_check_closed(out, why, sizeof why);
+        if (verbose)
+            fprintf(stderr,
+                    "  decimated to %d triangles, %d vertices (asked %d) in %.2f s; volume "
+                    "%.9g; %d intersecting pairs\n",
+                    got, out->n_verts, tris, now_s() - t0, cf_surface_volume(out), n);
+        if (n == 0 && closed == 1)
+            return CF_OK;
+        cf_surface_free(out);
+        if (n < 0 || closed < 0)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+        tris = (int)(tris * 1.15) & ~1;
+    }
+    return cf_error_set(err, CF_ERR_SURFACE_INTERSECT,
+                        "decimating the surface to about %d triangles keeps making it intersect "
+                        "itself: ask for more tets (--target-tets) or give a coarser surface",
+                        tris);
+}
+
+/* One tetgen run on `s` written to <dir>/surf.off. */
+typedef struct trial {
+    char opts[64];
+    cf_mesh m;
+} trial;
+
+static cf_status tetgen_trial(const char *dir, const char *opts, trial *t, int verbose,
+                              cf_error *err)
+{
+    snprintf(t->opts, sizeof t->opts, "%s", opts);
+    double secs = 0;
+    cf_status st = run_tetgen(dir, t->opts, &t->m, &secs, err);
+    if (st == CF_OK && verbose)
+        fprintf(stderr, "  tetgen -%s: %d nodes, %d tets (%.2f s)\n", t->opts, t->m.n_nodes,
+                t->m.n_tets, secs);
+    return st;
+}
+
+static double miss(int n, int target) { return fabs(log((double)n / (double)target)); }
+
+/* Surface choice and tetgen runs for target_tets > 0; see the top comment.
+ * `s` is the clean full surface; on success `best` holds the mesh and
+ * `used` the surface it was made from (a decimated copy or `s` itself). */
+static cf_status fit_size(const cf_surface *s, int target, const char *dir, int verbose,
+                          trial *best, cf_surface *dec, const cf_surface **used, cf_error *err)
+{
+    char off[PATH_MAX];
+    snprintf(off, sizeof off, "%s/surf.off", dir);
+    const cf_surface *cur = s;
+    cf_status st;
+    trial t = {{0}, {0}};
+    *used = s;
+    int n_tris = s->n_tris;
+    int n = -1; /* tets of the last -pYq2.0 run on `cur` */
+    if (TETS_PER_TRI * s->n_tris > 2.0 * target) {
+        /* Clearly too fine: decimate right away from the estimate. */
+        n_tris = (int)(0.9 * target / TETS_PER_TRI) & ~1;
+    }
+    for (int round = 0; round < 4; round++) {
+        cf_mesh_free(&t.m);
+        if (n_tris < s->n_tris) {
+            cf_surface_free(dec);
+            if ((st = coarsen(s, n_tris < 8 ? 8 : n_tris, dec, verbose, err)) != CF_OK)
+                return st;
+            cur = dec;
+        } else {
+            cur = s;
+        }
+        if ((st = cf_surface_write_off(cur, off, err)) != CF_OK ||
+            (st = tetgen_trial(dir, BASE_OPTS "F", &t, verbose, err)) != CF_OK)
+            return st;
+        n = t.m.n_tets;
+        if (n <= (1 + TOL) * target || cur->n_tris <= 8)
+            break;
+        if (cur != s && cur->n_tris > n_tris + n_tris / 10)
+            break; /* decimation stalled: cannot get coarser */
+        /* tets grow about linearly with surface triangles at fixed q */
+        n_tris = (int)((double)cur->n_tris * 0.9 * target / n) & ~1;
+    }
+    *used = cur;
+    *best = t;
+    if (n >= (1 - TOL) * target)
+        return CF_OK;
+    /* Fill with a maximum volume: N(a) ~ N0 + C / a. */
+    double V = cf_surface_volume(cur);
+    double a_prev = INFINITY, n_prev = n, C = V;
+    double a = C / (target - n);
+    for (int run = 0; run < MAX_A_RUNS; run++) {
+        char opts[64];
+        snprintf(opts, sizeof opts, BASE_OPTS "a%.3gF", a);
+        a = strtod(strchr(opts, 'a') + 1, NULL); /* exactly the value tetgen gets */
+        trial u = {{0}, {0}};
+        if ((st = tetgen_trial(dir, opts, &u, verbose, err)) != CF_OK) {
+            cf_mesh_free(&best->m);
+            return st;
+        }
+        int nu = u.m.n_tets;
+        if (miss(nu, target) < miss(best->m.n_tets, target)) {
+            cf_mesh_free(&best->m);
+            *best = u;
+        } else {
+            cf_mesh_free(&u.m);
+        }
+        if (fabs((double)nu / target - 1) <= TOL)
+            break;
+        /* Fit N = N0 + C / a through this run and the previous one. */
+        double inv_p = isinf(a_prev) ? 0.0 : 1.0 / a_prev, inv = 1.0 / a;
+        double Cfit = (nu - n_prev) / (inv - inv_p);
+        double N0 = nu - Cfit * inv;
+        double next = (Cfit > 0 && target > N0) ? Cfit / (target - N0) : (nu < target ? a / 2 : a * 2);
+        /* keep steps moderate: within a factor of 4 */
+        if (next > 4 * a)
+            next = 4 * a;
+        if (next < a / 4)
+            next = a / 4;
+        a_prev = a, n_prev = nu, a = next;
+    }
+    return CF_OK;
+}
+
+/* ---- the command ---------------------------------------------------------- */
+
+static cf_status write_stamp(const cf_mesh_prep_opts *o, const char *key, const char *opts,
+                             int n_tris, const cf_mesh *m, cf_error *err)
+{
+    char *sp = str_cat(o->output, ".stamp"), *tmp = str_cat(o->output, ".stamp.tmp");
+    FILE *f = tmp ? fopen(tmp, "w") : NULL;
+    cf_status st = CF_OK;
+    if (!f) {
+        st = cf_error_set(err, CF_ERR_OUTPUT, "%s: cannot write (%s)", tmp ? tmp : "stamp",
+                          strerror(errno));
+    } else {
+        fprintf(f, "%s", key);
+        fprintf(f, "# informational\ntetgen -%s\nsurface_triangles %d\nnodes %d\ntets %d\n",
+                opts, n_tris, m->n_nodes, m->n_tets);
+        int bad = ferror(f);
+        bad |= fclose(f) != 0;
+        if (bad || rename(tmp, sp) != 0)
+            st = cf_error_set(err, CF_ERR_OUTPUT, "%s: write failed", sp);
+    }
+    free(sp);
+    free(tmp);
+    return st;
+}
+
+cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
+{
+    if (!o || !o->input || !o->output || !*o->output)
+        return cf_error_set(err, CF_ERR_USAGE, "cohfrac mesh needs an input surface and -o OUT");
+    if (o->target_tets < 0)
+        return cf_error_set(err, CF_ERR_USAGE, "--target-tets must be >= 0 (got %d)",
+                            o->target_tets);
+    double t_start = now_s();
+    char key[PATH_MAX + 512];
+    cf_status st = stamp_key(o, key, sizeof key, err);
+    if (st != CF_OK)
+        return st;
+    if (cache_valid(o, key)) {
+        if (o->verbose)
+            fprintf(stderr, "cohfrac mesh: %s.node/.ele up to date (cached)\n", o->output);
+        return CF_OK;
+    }
+    if ((st = make_parent_dirs(o->output, err)) != CF_OK)
+        return st;
+
+    cf_surface s = {0}, dec = {0};
+    const cf_surface *used = &s;
+    trial best = {{0}, {0}};
+    char dir[PATH_MAX] = "";
+    if ((st = load_clean_surface(o, &s, err)) != CF_OK)
+        goto out;
+    const char *tmpdir = getenv("TMPDIR");
+    snprintf(dir, sizeof dir, "%s/cohfrac-mesh-XXXXXX", tmpdir && *tmpdir ? tmpdir : "/tmp");
+    if (!mkdtemp(dir)) {
+        st = cf_error_set(err, CF_ERR_OUTPUT, "cannot create a temporary directory %s (%s)", dir,
+                          strerror(errno));
+        dir[0] = '\0';
+        goto out;
+    }
+    if (o->target_tets == 0) {
+        char off[PATH_MAX];
+        snprintf(off, sizeof off, "%s/surf.off", dir);
+        if ((st = cf_surface_write_off(&s, off, err)) != CF_OK ||
+            (st = tetgen_trial(dir, "pqF", &best, o->verbose, err)) != CF_OK)
+            goto out;
+    } else if ((st = fit_size(&s, o->target_tets, dir, o->verbose, &best, &dec, &used, err)) !=
+               CF_OK) {
+        goto out;
+    }
+
+    /* Orientation: flip what tetgen wrote the other way round, then insist
+     * on positive, non-degenerate tets. */
+    int flipped = cf_mesh_orient_positive(&best.m);
+    if (o->verbose)
+        fprintf(stderr, "  orientation: %d of %d tets flipped to det[x1-x0,x2-x0,x3-x0] > 0\n",
+                flipped, best.m.n_tets);
+    if ((st = cf_mesh_check(&best.m, "tetgen output", err)) != CF_OK)
+        goto out;
+    double vs = cf_surface_volume(used), vm = cf_mesh_volume(&best.m);
+    double rel = fabs(vm - vs) / vs;
+    if (o->verbose)
+        fprintf(stderr, "  volume: tets %.12g, surface %.12g (relative difference %.2g)\n", vm,
+                vs, rel);
+    if (!(rel <= 1e-6)) {
+        st = cf_error_set(err, CF_ERR_EXTERNAL,
+                          "tetgen -%s: tet volume %.12g differs from the surface's enclosed "
+                          "volume %.12g by %.2g (relative): tetgen did not fill the surface; "
+                          "check the surface is closed and does not intersect itself",
+                          best.opts, vm, vs, rel);
+        goto out;
+    }
+    if ((st = cf_mesh_write_tetgen(&best.m, o->output, err)) != CF_OK ||
+        (st = write_stamp(o, key, best.opts, used->n_tris, &best.m, err)) != CF_OK)
+        goto out;
+    if (o->verbose)
+        fprintf(stderr, "cohfrac mesh: wrote %s.node/.ele: %d nodes, %d tets (tetgen -%s) in "
+                        "%.1f s\n",
+                o->output, best.m.n_nodes, best.m.n_tets, best.opts, now_s() - t_start);
+out:
+    if (dir[0])
+        remove_tree(dir);
+    cf_mesh_free(&best.m);
+    cf_surface_free(&dec);
+    cf_surface_free(&s);
+    return st;
+}

@@ -1,0 +1,39 @@
+/* Position based dynamics (DESIGN §4, source §6.2; Müller et al. 2007) and
+ * the obstacles of the collision constraints. */
+#ifndef COHFRAC_PBD_H
+#define COHFRAC_PBD_H
+
+#include "cohfrac/scene.h"
+#include "solid.h"
+
+/* One bar per unique edge of the current tets, rest length from s->X. */
+typedef struct cf_bars {
+    int n;
+    int *ends;     /* [n][2] node indices, ascending pairs, sorted */
+    double *rest;  /* [n] m */
+} cf_bars;
+
+/* (Re)build the bars of `tets`.  Returns 0, or -1 when out of memory. */
+int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt);
+void cf_bars_free(cf_bars *b);
+
+/* One Gauss-Seidel sweep over the bars on s->p, in bar order:
+ * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
+void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
+
+/* Obstacles at time t (moving ones at constant velocity). */
+typedef struct cf_obstacles {
+    int n;
+    const cf_obstacle *o;
+} cf_obstacles;
+
+/* Move p of node i out of every obstacle along the obstacle's normal by its
+ * penetration depth, evaluated at time t.  Returns the index of the last
+ * obstacle that was hit, or -1.  `normal` receives its outward normal. */
+int cf_obstacles_project(const cf_obstacles *obs, double t, double p[3], double normal[3]);
+
+/* Signed distance of point p from obstacle j at time t (negative inside) and
+ * the outward normal there. */
+double cf_obstacle_distance(const cf_obstacle *o, double t, const double p[3], double normal[3]);
+
+#endif

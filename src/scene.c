@@ -1,0 +1,1277 @@
+/* cohfrac — scene loading.
+ *
+ * A scene is a Lua 5.4 script that returns a table.  Loading runs in four
+ * steps:
+ *   1. run the script in a sandboxed state (base, string, table, math only;
+ *      text chunks only);
+ *   2. apply the `key.path=value` overrides to the returned table;
+ *   3. walk the table against the schema in cohfrac/scene.h, in schema order,
+ *      filling a cf_scene and every default;
+ *   4. print the filled scene back as Lua text (`resolved`).
+ *
+ * Steps 2 and 3 run inside lua_pcall so that a Lua memory error cannot
+ * unwind through C code unprotected, and every table access is raw so that
+ * metatables set by the script cannot run code behind our back.
+ */
+#define _XOPEN_SOURCE 700 /* realpath (XSI), stat */
+
+#include "cohfrac/scene.h"
+
+#include <lauxlib.h>
+#include <lua.h>
+#include <lualib.h>
+
+#include <assert.h>
+#include <ctype.h>
+#include <errno.h>
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
+#define TRY(x)                                                                 \
+    do {                                                                       \
+        cf_status try_status_ = (x);                                           \
+        if (try_status_ != CF_OK)                                              \
+            return try_status_;                                                \
+    } while (0)
+
+/* ---------------------------------------------------------------- schema */
+
+/* Key lists in schema order: they drive unknown-key checks and the
+ * "allowed:" lists in messages; resolved_text() writes keys in this order. */
+static const char *const top_keys[] = {"name",   "duration",  "gravity", "material",
+                                       "bodies", "obstacles", "solver",  "output"};
+static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
+                                            "sigma_max", "alpha", "G_II", "tau_max",
+                                            "beta",  "friction", "restitution"};
+static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
+                                        "velocity", "angular_velocity"};
+static const char *const plane_keys[] = {"type", "point", "normal"};
+static const char *const sphere_keys[] = {"type", "center", "radius", "velocity"};
+static const char *const box_keys[] = {"type", "center", "half_extents", "velocity"};
+static const char *const solver_keys[] = {
+    "rigid_backend",     "dt_rigid",         "rigid_substeps", "dt_fracture",
+    "check_interval",    "quiet_steps",      "max_fracture_time",
+    "impact_threshold",  "elasticity",       "criterion",      "pbd",
+    "threads"};
+static const char *const pbd_keys[] = {"k_stiffness", "iterations", "k_damping"};
+static const char *const output_keys[] = {"file", "frame_interval"};
+
+/* Enum spellings, indexed by the enum values of scene.h. */
+static const char *const obstacle_names[] = {"plane", "sphere", "box"};
+static const char *const backend_names[] = {"bullet", "pbd"};
+static const char *const elasticity_names[] = {"corotational", "linear"};
+static const char *const criterion_names[] = {"traction", "source"};
+_Static_assert(CF_OBSTACLE_PLANE == 0 && CF_OBSTACLE_SPHERE == 1 && CF_OBSTACLE_BOX == 2,
+               "obstacle_names follows cf_obstacle_type");
+_Static_assert(CF_RIGID_BULLET == 0 && CF_RIGID_PBD == 1, "backend_names follows cf_rigid_backend");
+_Static_assert(CF_ELASTICITY_COROTATIONAL == 0 && CF_ELASTICITY_LINEAR == 1,
+               "elasticity_names follows cf_elasticity");
+_Static_assert(CF_CRITERION_TRACTION == 0 && CF_CRITERION_SOURCE == 1,
+               "criterion_names follows cf_criterion");
+
+/* An allowed interval for a number; `why` is appended to the message. */
+typedef struct range {
+    double lo, hi;
+    int lo_closed, hi_closed;
+    const char *why;
+} range;
+
+static const range POSITIVE = {0.0, INFINITY, 0, 0, NULL};
+static const range NON_NEGATIVE = {0.0, INFINITY, 1, 0, NULL};
+static const range AT_LEAST_ONE = {1.0, INFINITY, 1, 0, NULL};
+static const range UNIT = {0.0, 1.0, 1, 1, NULL};
+static const range POISSON = {-1.0, 0.5, 0, 0,
+                              "(Poisson's ratio of a stable isotropic solid)"};
+static const range PPR_SHAPE = {1.0, INFINITY, 0, 0,
+                                "(the PPR cohesive law needs shape parameters alpha, beta > 1)"};
+
+static const double ZERO3[3] = {0.0, 0.0, 0.0};
+static const double GRAVITY[3] = {0.0, 0.0, -9.81};
+static const double UP[3] = {0.0, 0.0, 1.0};
+static const double IDENTITY_QUAT[4] = {1.0, 0.0, 0.0, 0.0};
+
+/* ---------------------------------------------------------------- loader */
+
+typedef struct loader {
+    lua_State *L;
+    const char *file;     /* scene path as given: every message starts with it */
+    char dir[1024];       /* the scene file's directory: relative mesh paths start here */
+    const char *mesh_dir; /* where prepared meshes live; may be NULL */
+    const char *const *overrides;
+    int n_overrides;
+    cf_scene *s;
+    cf_error *err;
+    cf_status status;   /* result of the protected part */
+    char path[512];     /* key path of the table being read, e.g. "solver.pbd" */
+    size_t path_len;
+    char key[768];      /* scratch: the full path of one key, for messages */
+} loader;
+
+static cf_status fail(loader *ld, cf_status code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static cf_status fail(loader *ld, cf_status code, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return cf_error_set(ld->err, code, "%s: %s", ld->file, msg);
+}
+
+/* Full path of `key` inside the current table ("solver.pbd.iterations"). */
+static const char *kp(loader *ld, const char *key)
+{
+    if (ld->path_len == 0)
+        snprintf(ld->key, sizeof ld->key, "%s", key);
+    else
+        snprintf(ld->key, sizeof ld->key, "%s.%s", ld->path, key);
+    return ld->key;
+}
+
+static size_t path_push_key(loader *ld, const char *key)
+{
+    size_t old = ld->path_len;
+    snprintf(ld->path + old, sizeof ld->path - old, old ? ".%s" : "%s", key);
+    ld->path_len = strlen(ld->path);
+    return old;
+}
+
+static size_t path_push_index(loader *ld, int i)
+{
+    size_t old = ld->path_len;
+    snprintf(ld->path + old, sizeof ld->path - old, "[%d]", i);
+    ld->path_len = strlen(ld->path);
+    return old;
+}
+
+static void path_pop(loader *ld, size_t old)
+{
+    ld->path_len = old;
+    ld->path[old] = '\0';
+}
+
+/* Pushes t[key] without metamethods; returns its Lua type. */
+static int raw_get(lua_State *L, int t, const char *key)
+{
+    lua_pushstring(L, key);
+    return lua_rawget(L, t);
+}
+
+/* Edit distance between two short keys, for "did you mean" hints. */
+static int edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    int prev[64], cur[64];
+    if (la > 63 || lb > 63)
+        return INT_MAX;
+    for (size_t j = 0; j <= lb; j++)
+        prev[j] = (int)j;
+    for (size_t i = 1; i <= la; i++) {
+        cur[0] = (int)i;
+        for (size_t j = 1; j <= lb; j++) {
+            int best = prev[j - 1] + (a[i - 1] != b[j - 1]);
+            if (prev[j] + 1 < best)
+                best = prev[j] + 1;
+            if (cur[j - 1] + 1 < best)
+                best = cur[j - 1] + 1;
+            cur[j] = best;
+        }
+        memcpy(prev, cur, (lb + 1) * sizeof prev[0]);
+    }
+    return prev[lb];
+}
+
+/* "a, b, c" and, when one name is close to `given`, " (did you mean 'b'?)". */
+static void list_names(const char *const *names, int n, const char *given, char *list,
+                       size_t list_size, char *hint, size_t hint_size)
+{
+    size_t len = 0;
+    int best = INT_MAX, best_i = -1;
+    list[0] = '\0';
+    hint[0] = '\0';
+    for (int i = 0; i < n; i++) {
+        int w = snprintf(list + len, list_size - len, "%s%s", i ? ", " : "", names[i]);
+        if (w > 0)
+            len += (size_t)w < list_size - len ? (size_t)w : list_size - len - 1;
+        if (given) {
+            int d = edit_distance(given, names[i]);
+            if (d < best) {
+                best = d;
+                best_i = i;
+            }
+        }
+    }
+    /* Two edits catch most typos without suggesting unrelated keys. */
+    if (best_i >= 0 && best > 0 && best <= 2)
+        snprintf(hint, hint_size, " (did you mean '%s'?)", names[best_i]);
+}
+
+/* The key at stack index -2 is not in `allowed`: report it. */
+static cf_status unknown_key(loader *ld, const char *const *allowed, int n)
+{
+    lua_State *L = ld->L;
+    char name[1024], list[512], hint[128];
+    const char *given = NULL;
+    switch (lua_type(L, -2)) {
+    case LUA_TSTRING:
+        given = lua_tostring(L, -2);
+        snprintf(name, sizeof name, "%s", kp(ld, given));
+        break;
+    case LUA_TNUMBER:
+        if (lua_isinteger(L, -2))
+            snprintf(name, sizeof name, "%s[%lld]", ld->path, (long long)lua_tointeger(L, -2));
+        else
+            snprintf(name, sizeof name, "%s[%g]", ld->path, (double)lua_tonumber(L, -2));
+        break;
+    default:
+        snprintf(name, sizeof name, "%s[<%s>]", ld->path, luaL_typename(L, -2));
+        break;
+    }
+    list_names(allowed, n, given, list, sizeof list, hint, sizeof hint);
+    return fail(ld, CF_ERR_SCENE_KEY, "unknown key '%s'; allowed: %s%s", name, list, hint);
+}
+
+/* Every key of the table at `t` must be one of `allowed`. */
+static cf_status check_keys(loader *ld, int t, const char *const *allowed, int n)
+{
+    lua_State *L = ld->L;
+    lua_pushnil(L);
+    while (lua_next(L, t)) {
+        int ok = 0;
+        if (lua_type(L, -2) == LUA_TSTRING) {
+            size_t len;
+            const char *k = lua_tolstring(L, -2, &len);
+            for (int i = 0; i < n && !ok; i++)
+                ok = strlen(allowed[i]) == len && memcmp(allowed[i], k, len) == 0;
+        }
+        if (!ok)
+            return unknown_key(ld, allowed, n);
+        lua_pop(L, 1);
+    }
+    return CF_OK;
+}
+
+/* The shortest of %.15g..%.17g that reads back as v: "0.1", not
+ * "0.10000000000000001", yet 0.49999999999999994 is not shown as 0.5. */
+static const char *shortest(char buf[40], double v)
+{
+    for (int prec = 15; prec <= 17; prec++) {
+        snprintf(buf, 40, "%.*g", prec, v);
+        if (strtod(buf, NULL) == v)
+            break;
+    }
+    return buf;
+}
+
+static cf_status check_range(loader *ld, const char *key, double v, const range *r)
+{
+    char rule[128], got[40];
+    int ok = (r->lo_closed ? v >= r->lo : v > r->lo) && (r->hi_closed ? v <= r->hi : v < r->hi);
+    if (ok)
+        return CF_OK;
+    if (isinf(r->hi))
+        snprintf(rule, sizeof rule, "%s %g", r->lo_closed ? ">=" : ">", r->lo);
+    else if (isinf(r->lo))
+        snprintf(rule, sizeof rule, "%s %g", r->hi_closed ? "<=" : "<", r->hi);
+    else
+        snprintf(rule, sizeof rule, "in %c%g, %g%c", r->lo_closed ? '[' : '(', r->lo, r->hi,
+                 r->hi_closed ? ']' : ')');
+    return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must be %s%s%s, got %s", kp(ld, key), rule,
+                r->why ? " " : "", r->why ? r->why : "", shortest(got, v));
+}
+
+/* A number at t[key]; absent: *def, or a missing-key error when def is NULL. */
+static cf_status get_num(loader *ld, int t, const char *key, const double *def, const range *r,
+                         double *out)
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key);
+    if (ty == LUA_TNIL) {
+        lua_pop(L, 1);
+        if (!def)
+            return fail(ld, CF_ERR_SCENE_KEY, "missing required key '%s'", kp(ld, key));
+        *out = *def;
+    } else {
+        if (ty != LUA_TNUMBER)
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a number, got %s", kp(ld, key),
+                        lua_typename(L, ty));
+        *out = (double)lua_tonumber(L, -1);
+        lua_pop(L, 1);
+        if (!isfinite(*out))
+            return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must be a finite number, got %g",
+                        kp(ld, key), *out);
+    }
+    return check_range(ld, key, *out, r);
+}
+
+/* An integer at t[key] (a float with an integral value is accepted). */
+static cf_status get_int(loader *ld, int t, const char *key, int def, const range *r, int *out)
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key);
+    if (ty == LUA_TNIL) {
+        lua_pop(L, 1);
+        *out = def;
+    } else {
+        int is_int = 0;
+        lua_Integer v;
+        if (ty != LUA_TNUMBER)
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be an integer, got %s", kp(ld, key),
+                        lua_typename(L, ty));
+        v = lua_tointegerx(L, -1, &is_int);
+        if (!is_int)
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be an integer, got %g", kp(ld, key),
+                        (double)lua_tonumber(L, -1));
+        lua_pop(L, 1);
+        if (v < INT_MIN || v > INT_MAX)
+            return fail(ld, CF_ERR_SCENE_VALUE, "'%s' is out of range, got %lld", kp(ld, key),
+                        (long long)v);
+        *out = (int)v;
+    }
+    return check_range(ld, key, *out, r);
+}
+
+/* A non-empty string without NUL bytes that fits in `size` bytes. */
+static cf_status get_str(loader *ld, int t, const char *key, const char *def, char *out,
+                         size_t size)
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key);
+    size_t len;
+    const char *v;
+    if (ty == LUA_TNIL) {
+        lua_pop(L, 1);
+        if (!def)
+            return fail(ld, CF_ERR_SCENE_KEY, "missing required key '%s'", kp(ld, key));
+        v = def;
+        len = strlen(def);
+    } else {
+        if (ty != LUA_TSTRING)
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a string, got %s", kp(ld, key),
+                        lua_typename(L, ty));
+        v = lua_tolstring(L, -1, &len);
+    }
+    if (len == 0)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must not be empty", kp(ld, key));
+    if (strlen(v) != len)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must not contain NUL bytes", kp(ld, key));
+    if (len >= size)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s' is too long (%zu bytes, at most %zu)",
+                    kp(ld, key), len, size - 1);
+    memcpy(out, v, len + 1);
+    if (ty != LUA_TNIL)
+        lua_pop(L, 1);
+    return CF_OK;
+}
+
+/* One of `names` at t[key]; *out is its index.  def < 0: required. */
+static cf_status get_enum(loader *ld, int t, const char *key, const char *const *names, int n,
+                          int def, int *out)
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key);
+    const char *v;
+    char list[256], hint[128];
+    if (ty == LUA_TNIL) {
+        lua_pop(L, 1);
+        if (def < 0)
+            return fail(ld, CF_ERR_SCENE_KEY, "missing required key '%s'", kp(ld, key));
+        *out = def;
+        return CF_OK;
+    }
+    if (ty != LUA_TSTRING)
+        return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a string, got %s", kp(ld, key),
+                    lua_typename(L, ty));
+    v = lua_tostring(L, -1);
+    for (int i = 0; i < n; i++) {
+        if (strcmp(v, names[i]) == 0) {
+            *out = i;
+            lua_pop(L, 1);
+            return CF_OK;
+        }
+    }
+    list_names(names, n, v, list, sizeof list, hint, sizeof hint);
+    return fail(ld, CF_ERR_SCENE_VALUE, "'%s' is \"%s\"; allowed: %s%s", kp(ld, key), v, list,
+                hint);
+}
+
+/* A list of exactly n numbers; def NULL: required. */
+static cf_status get_vec(loader *ld, int t, const char *key, int n, const double *def,
+                         double *out)
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key), v, count = 0;
+    const char *what = n == 4 ? "a list of 4 numbers (quaternion w, x, y, z)"
+                              : "a list of 3 numbers";
+    if (ty == LUA_TNIL) {
+        lua_pop(L, 1);
+        if (!def)
+            return fail(ld, CF_ERR_SCENE_KEY, "missing required key '%s'", kp(ld, key));
+        memcpy(out, def, (size_t)n * sizeof out[0]);
+        return CF_OK;
+    }
+    if (ty != LUA_TTABLE)
+        return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be %s, got %s", kp(ld, key), what,
+                    lua_typename(L, ty));
+    v = lua_gettop(L);
+    lua_pushnil(L);
+    while (lua_next(L, v)) {
+        count++;
+        lua_pop(L, 1);
+    }
+    if (count != n)
+        return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be %s, got a table of %d entries",
+                    kp(ld, key), what, count);
+    for (int i = 0; i < n; i++) {
+        int ety = lua_rawgeti(L, v, i + 1);
+        if (ety != LUA_TNUMBER)
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be %s, got %s at [%d]", kp(ld, key),
+                        what, lua_typename(L, ety), i + 1);
+        out[i] = (double)lua_tonumber(L, -1);
+        lua_pop(L, 1);
+        if (!isfinite(out[i]))
+            return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must hold finite numbers, got %g at [%d]",
+                        kp(ld, key), out[i], i + 1);
+    }
+    lua_pop(L, 1);
+    return CF_OK;
+}
+
+/* Scale v to unit length.  A vector already within rounding of unit length
+ * is kept as it is, so that loading the resolved text again reproduces the
+ * same bits (normalising twice can move the last bit). */
+static cf_status normalise(loader *ld, const char *key, double *v, int n, const char *what)
+{
+    double m = 0.0, sum = 0.0, norm;
+    for (int i = 0; i < n; i++)
+        m = fmax(m, fabs(v[i]));
+    if (m == 0.0)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must be a non-zero %s, got all zeros",
+                    kp(ld, key), what);
+    /* Dividing by the largest component first avoids overflow in the squares. */
+    for (int i = 0; i < n; i++)
+        sum += (v[i] / m) * (v[i] / m);
+    norm = sqrt(sum);
+    if (fabs(m * norm - 1.0) > 8.0 * DBL_EPSILON)
+        for (int i = 0; i < n; i++)
+            v[i] = (v[i] / m) / norm;
+    return CF_OK;
+}
+
+/* Pushes the table at t[key]; when absent, an empty one, so that every
+ * default inside applies. */
+static cf_status push_table(loader *ld, int t, const char *key)
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key);
+    if (ty == LUA_TNIL) {
+        lua_pop(L, 1);
+        lua_newtable(L);
+    } else if (ty != LUA_TTABLE) {
+        return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a table, got %s", kp(ld, key),
+                    lua_typename(L, ty));
+    }
+    return CF_OK;
+}
+
+/* Pushes the list at t[key] (an empty one when absent) and counts it: its
+ * keys must be exactly 1..n and every entry a table. */
+static cf_status push_list(loader *ld, int t, const char *key, int *n)
+{
+    lua_State *L = ld->L;
+    lua_Integer count = 0, max = 0;
+    int li;
+    TRY(push_table(ld, t, key));
+    li = lua_gettop(L);
+    lua_pushnil(L);
+    while (lua_next(L, li)) {
+        if (!lua_isinteger(L, -2) || lua_tointeger(L, -2) < 1) {
+            char k[256];
+            if (lua_type(L, -2) == LUA_TSTRING)
+                snprintf(k, sizeof k, "key '%s'", lua_tostring(L, -2));
+            else
+                snprintf(k, sizeof k, "a %s key", luaL_typename(L, -2));
+            return fail(ld, CF_ERR_SCENE_TYPE,
+                        "'%s' must be a list of tables ({ {...}, {...} }), found %s",
+                        kp(ld, key), k);
+        }
+        if (lua_type(L, -1) != LUA_TTABLE) {
+            char item[1024];
+            snprintf(item, sizeof item, "%s[%lld]", kp(ld, key), (long long)lua_tointeger(L, -2));
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a table, got %s", item,
+                        luaL_typename(L, -1));
+        }
+        count++;
+        if (lua_tointeger(L, -2) > max)
+            max = lua_tointeger(L, -2);
+        lua_pop(L, 1);
+    }
+    if (max != count) {
+        lua_Integer hole = 1;
+        while (lua_rawgeti(L, li, hole) != LUA_TNIL) {
+            lua_pop(L, 1);
+            hole++;
+        }
+        return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a list without holes; [%lld] is missing",
+                    kp(ld, key), (long long)hole);
+    }
+    if (count > INT_MAX / 2)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s' has too many entries", kp(ld, key));
+    *n = (int)count;
+    return CF_OK;
+}
+
+/* ---------------------------------------------------------------- meshes */
+
+static int is_file(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t ls = strlen(s), lx = strlen(suffix);
+    return ls >= lx && strcmp(s + ls - lx, suffix) == 0;
+}
+
+/* Turn the `mesh` value into an absolute TetGen base path (no extension).
+ * The directory part goes through realpath so that the resolved scene loads
+ * the same mesh from any working directory; the file name is kept as given
+ * (not following a symlinked .node), so the .ele beside it still matches. */
+static cf_status resolve_mesh(loader *ld, const char *key, const char *name, char *out,
+                              size_t size)
+{
+    char base[2048], node[2100], dir[2048];
+    const char *slash = strrchr(name, '/');
+    const char *leaf = slash ? slash + 1 : name;
+    int prepared = !slash && !strchr(leaf, '.');
+    char *real, *cut;
+    int w;
+
+    if (prepared) {
+        if (!ld->mesh_dir || !*ld->mesh_dir)
+            return fail(ld, CF_ERR_FILE_OPEN,
+                        "%s: prepared mesh '%s' cannot be found: no mesh directory was given "
+                        "(or give a path to a .node file)",
+                        kp(ld, key), name);
+        w = snprintf(base, sizeof base, "%s/%s", ld->mesh_dir, name);
+    } else if (name[0] == '/') {
+        w = snprintf(base, sizeof base, "%s", name);
+    } else {
+        w = snprintf(base, sizeof base, "%s/%s", ld->dir, name);
+    }
+    if (w < 0 || (size_t)w >= sizeof base)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s': mesh path too long", kp(ld, key));
+    if (ends_with(base, ".node"))
+        base[strlen(base) - 5] = '\0';
+    else if (ends_with(base, ".ele"))
+        base[strlen(base) - 4] = '\0';
+    snprintf(node, sizeof node, "%s.node", base);
+
+    if (!is_file(node)) {
+        if (prepared) {
+            /* The bunny is the one mesh we know a source surface for. */
+            const char *src = strncmp(name, "bunny", 5) == 0
+                                  ? "/usr/share/glmark2/models/bunny.obj"
+                                  : "<surface.obj>";
+            return fail(ld, CF_ERR_FILE_OPEN,
+                        "%s: prepared mesh '%s' not found in %s: run `cohfrac mesh %s -o %s/%s` "
+                        "or `make run`",
+                        kp(ld, key), name, ld->mesh_dir, src, ld->mesh_dir, name);
+        }
+        return fail(ld, CF_ERR_FILE_OPEN,
+                    "%s: mesh '%s' not found: no file %s (a TetGen .node/.ele pair; relative "
+                    "paths start at the scene file's directory)",
+                    kp(ld, key), name, node);
+    }
+
+    cut = strrchr(base, '/'); /* present: every branch above put one in */
+    assert(cut);
+    if (cut == base) {
+        snprintf(dir, sizeof dir, "/");
+    } else {
+        memcpy(dir, base, (size_t)(cut - base));
+        dir[cut - base] = '\0';
+    }
+    real = realpath(dir, NULL);
+    if (!real)
+        return fail(ld, CF_ERR_FILE_OPEN, "%s: cannot resolve directory %s: %s", kp(ld, key), dir,
+                    strerror(errno));
+    w = snprintf(out, size, "%s%s%s", real, ends_with(real, "/") ? "" : "/", cut + 1);
+    free(real);
+    if (w < 0 || (size_t)w >= size)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s': resolved mesh path too long", kp(ld, key));
+    return CF_OK;
+}
+
+/* ---------------------------------------------------------------- sections */
+
+static cf_status read_material(loader *ld, int t, cf_material *m)
+{
+    static const double E = 1e6, nu = 0.3, rho = 2400.0, G_I = 22.0, sigma = 1e4, alpha = 2.0,
+                        friction = 0.5, restitution = 0.0;
+    static const range restitution_range = {0.0, 1.0, 1, 1, NULL};
+    TRY(check_keys(ld, t, material_keys, COUNT(material_keys)));
+    TRY(get_num(ld, t, "E", &E, &POSITIVE, &m->E));
+    TRY(get_num(ld, t, "nu", &nu, &POISSON, &m->nu));
+    TRY(get_num(ld, t, "rho", &rho, &POSITIVE, &m->rho));
+    TRY(get_num(ld, t, "G_I", &G_I, &POSITIVE, &m->G_I));
+    TRY(get_num(ld, t, "sigma_max", &sigma, &POSITIVE, &m->sigma_max));
+    TRY(get_num(ld, t, "alpha", &alpha, &PPR_SHAPE, &m->alpha));
+    /* Mode II defaults to mode I (DESIGN.md §3.5). */
+    TRY(get_num(ld, t, "G_II", &m->G_I, &POSITIVE, &m->G_II));
+    TRY(get_num(ld, t, "tau_max", &m->sigma_max, &POSITIVE, &m->tau_max));
+    TRY(get_num(ld, t, "beta", &m->alpha, &PPR_SHAPE, &m->beta));
+    TRY(get_num(ld, t, "friction", &friction, &NON_NEGATIVE, &m->friction));
+    TRY(get_num(ld, t, "restitution", &restitution, &restitution_range, &m->restitution));
+    return CF_OK;
+}
+
+static cf_status read_body(loader *ld, int t, cf_body_def *b)
+{
+    static const double one = 1.0;
+    char mesh[1024];
+    TRY(check_keys(ld, t, body_keys, COUNT(body_keys)));
+    TRY(get_str(ld, t, "mesh", NULL, mesh, sizeof mesh));
+    TRY(resolve_mesh(ld, "mesh", mesh, b->mesh, sizeof b->mesh));
+    TRY(get_num(ld, t, "scale", &one, &POSITIVE, &b->scale));
+    TRY(get_vec(ld, t, "position", 3, ZERO3, b->position));
+    TRY(get_vec(ld, t, "orientation", 4, IDENTITY_QUAT, b->orientation));
+    TRY(normalise(ld, "orientation", b->orientation, 4, "quaternion"));
+    TRY(get_vec(ld, t, "velocity", 3, ZERO3, b->velocity));
+    TRY(get_vec(ld, t, "angular_velocity", 3, ZERO3, b->angular_velocity));
+    return CF_OK;
+}
+
+static cf_status read_obstacle(loader *ld, int t, cf_obstacle *o)
+{
+    int type;
+    TRY(get_enum(ld, t, "type", obstacle_names, COUNT(obstacle_names), -1, &type));
+    o->type = (cf_obstacle_type)type;
+    switch (o->type) {
+    case CF_OBSTACLE_PLANE:
+        TRY(check_keys(ld, t, plane_keys, COUNT(plane_keys)));
+        TRY(get_vec(ld, t, "point", 3, ZERO3, o->point));
+        TRY(get_vec(ld, t, "normal", 3, UP, o->normal));
+        TRY(normalise(ld, "normal", o->normal, 3, "vector"));
+        break;
+    case CF_OBSTACLE_SPHERE:
+        TRY(check_keys(ld, t, sphere_keys, COUNT(sphere_keys)));
+        TRY(get_vec(ld, t, "center", 3, NULL, o->center));
+        TRY(get_num(ld, t, "radius", NULL, &POSITIVE, &o->radius));
+        TRY(get_vec(ld, t, "velocity", 3, ZERO3, o->velocity));
+        break;
+    case CF_OBSTACLE_BOX:
+        TRY(check_keys(ld, t, box_keys, COUNT(box_keys)));
+        TRY(get_vec(ld, t, "center", 3, NULL, o->center));
+        TRY(get_vec(ld, t, "half_extents", 3, NULL, o->half_extents));
+        for (int i = 0; i < 3; i++)
+            if (!(o->half_extents[i] > 0.0))
+                return fail(ld, CF_ERR_SCENE_VALUE,
+                            "'%s' must have every component > 0, got {%g, %g, %g}",
+                            kp(ld, "half_extents"), o->half_extents[0], o->half_extents[1],
+                            o->half_extents[2]);
+        TRY(get_vec(ld, t, "velocity", 3, ZERO3, o->velocity));
+        break;
+    }
+    return CF_OK;
+}
+
+static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
+{
+    static const double dt_rigid = 1e-3, dt_fracture = 5e-6, max_fracture_time = 0.05,
+                        impact_threshold = 0.2, k_stiffness = 0.9, k_damping = 1.0;
+    int backend, elasticity, criterion, top;
+    size_t old;
+    TRY(check_keys(ld, t, solver_keys, COUNT(solver_keys)));
+    TRY(get_enum(ld, t, "rigid_backend", backend_names, COUNT(backend_names), CF_RIGID_BULLET,
+                 &backend));
+    s->rigid_backend = (cf_rigid_backend)backend;
+    TRY(get_num(ld, t, "dt_rigid", &dt_rigid, &POSITIVE, &s->dt_rigid));
+    TRY(get_int(ld, t, "rigid_substeps", 5, &AT_LEAST_ONE, &s->rigid_substeps));
+    TRY(get_num(ld, t, "dt_fracture", &dt_fracture, &POSITIVE, &s->dt_fracture));
+    if (s->dt_fracture > s->dt_rigid)
+        return fail(ld, CF_ERR_SCENE_VALUE,
+                    "'%s' must not exceed solver.dt_rigid (%g), got %g", kp(ld, "dt_fracture"),
+                    s->dt_rigid, s->dt_fracture);
+    TRY(get_int(ld, t, "check_interval", 1, &AT_LEAST_ONE, &s->check_interval));
+    TRY(get_int(ld, t, "quiet_steps", 400, &AT_LEAST_ONE, &s->quiet_steps));
+    TRY(get_num(ld, t, "max_fracture_time", &max_fracture_time, &POSITIVE,
+                &s->max_fracture_time));
+    TRY(get_num(ld, t, "impact_threshold", &impact_threshold, &NON_NEGATIVE,
+                &s->impact_threshold));
+    TRY(get_enum(ld, t, "elasticity", elasticity_names, COUNT(elasticity_names),
+                 CF_ELASTICITY_COROTATIONAL, &elasticity));
+    s->elasticity = (cf_elasticity)elasticity;
+    TRY(get_enum(ld, t, "criterion", criterion_names, COUNT(criterion_names),
+                 CF_CRITERION_TRACTION, &criterion));
+    s->criterion = (cf_criterion)criterion;
+
+    TRY(push_table(ld, t, "pbd"));
+    top = lua_gettop(ld->L);
+    old = path_push_key(ld, "pbd");
+    TRY(check_keys(ld, top, pbd_keys, COUNT(pbd_keys)));
+    TRY(get_num(ld, top, "k_stiffness", &k_stiffness, &UNIT, &s->k_stiffness));
+    TRY(get_int(ld, top, "iterations", 3, &AT_LEAST_ONE, &s->iterations));
+    TRY(get_num(ld, top, "k_damping", &k_damping, &UNIT, &s->k_damping));
+    path_pop(ld, old);
+    lua_pop(ld->L, 1);
+
+    TRY(get_int(ld, t, "threads", 0, &NON_NEGATIVE, &s->threads));
+    return CF_OK;
+}
+
+static cf_status read_output(loader *ld, int t, const char *name, cf_output_settings *o)
+{
+    static const double frame_interval = 0.01;
+    char def[sizeof o->file];
+    TRY(check_keys(ld, t, output_keys, COUNT(output_keys)));
+    snprintf(def, sizeof def, "out/%s.h5", name); /* name < 128 bytes: fits */
+    TRY(get_str(ld, t, "file", def, o->file, sizeof o->file));
+    TRY(get_num(ld, t, "frame_interval", &frame_interval, &POSITIVE, &o->frame_interval));
+    return CF_OK;
+}
+
+/* Runs `call` with the sub-table t[key] on top of the stack and the key
+ * path extended by `key`. */
+#define WITH_TABLE(ld, t, key, call)                                                        \
+    do {                                                                                    \
+        size_t old_;                                                                        \
+        TRY(push_table(ld, t, key));                                                        \
+        old_ = path_push_key(ld, key);                                                      \
+        TRY(call);                                                                          \
+        path_pop(ld, old_);                                                                 \
+        lua_pop((ld)->L, 1);                                                                \
+    } while (0)
+
+static cf_status read_scene(loader *ld, int t)
+{
+    static const double duration = 1.0;
+    lua_State *L = ld->L;
+    cf_scene *s = ld->s;
+    int n, li;
+
+    TRY(check_keys(ld, t, top_keys, COUNT(top_keys)));
+    TRY(get_str(ld, t, "name", "scene", s->name, sizeof s->name));
+    TRY(get_num(ld, t, "duration", &duration, &POSITIVE, &s->duration));
+    TRY(get_vec(ld, t, "gravity", 3, GRAVITY, s->gravity));
+    WITH_TABLE(ld, t, "material", read_material(ld, lua_gettop(L), &s->material));
+
+    if (raw_get(L, t, "bodies") == LUA_TNIL)
+        return fail(ld, CF_ERR_SCENE_KEY, "missing required key 'bodies' (a list of solids)");
+    lua_pop(L, 1);
+    TRY(push_list(ld, t, "bodies", &n));
+    if (n == 0)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'bodies' is empty; a scene needs at least one body");
+    li = lua_gettop(L);
+    s->bodies = calloc((size_t)n, sizeof s->bodies[0]);
+    if (!s->bodies)
+        return fail(ld, CF_ERR_NOMEM, "out of memory for %d bodies", n);
+    for (int i = 0; i < n; i++) {
+        size_t old = path_push_key(ld, "bodies");
+        path_push_index(ld, i + 1);
+        lua_rawgeti(L, li, i + 1);
+        TRY(read_body(ld, lua_gettop(L), &s->bodies[i]));
+        lua_pop(L, 1);
+        path_pop(ld, old);
+        s->n_bodies = i + 1;
+    }
+    lua_pop(L, 1);
+
+    TRY(push_list(ld, t, "obstacles", &n));
+    li = lua_gettop(L);
+    if (n > 0) {
+        s->obstacles = calloc((size_t)n, sizeof s->obstacles[0]);
+        if (!s->obstacles)
+            return fail(ld, CF_ERR_NOMEM, "out of memory for %d obstacles", n);
+    }
+    for (int i = 0; i < n; i++) {
+        size_t old = path_push_key(ld, "obstacles");
+        path_push_index(ld, i + 1);
+        lua_rawgeti(L, li, i + 1);
+        TRY(read_obstacle(ld, lua_gettop(L), &s->obstacles[i]));
+        lua_pop(L, 1);
+        path_pop(ld, old);
+        s->n_obstacles = i + 1;
+    }
+    lua_pop(L, 1);
+
+    WITH_TABLE(ld, t, "solver", read_solver(ld, lua_gettop(L), &s->solver));
+    WITH_TABLE(ld, t, "output", read_output(ld, lua_gettop(L), s->name, &s->output));
+    return CF_OK;
+}
+
+/* ---------------------------------------------------------------- overrides */
+
+typedef struct segment {
+    char name[64];      /* a key, or "" for a list index */
+    lua_Integer index;  /* 1-based list index when name is "" */
+} segment;
+
+enum { MAX_SEGMENTS = 32 };
+
+/* Parse "a.b[2].c" (the part before '=') into segments. */
+static cf_status parse_key_path(loader *ld, const char *ov, const char *p, const char *end,
+                                segment *seg, int *n_seg)
+{
+    int n = 0;
+    while (p < end && isspace((unsigned char)*p))
+        p++;
+    while (end > p && isspace((unsigned char)end[-1]))
+        end--;
+    if (p == end)
+        return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': empty key path before '='",
+                    ov);
+    for (;;) {
+        const char *s = p;
+        if (p < end && (isalpha((unsigned char)*p) || *p == '_'))
+            for (p++; p < end && (isalnum((unsigned char)*p) || *p == '_'); p++)
+                ;
+        if (p == s)
+            return fail(ld, CF_ERR_SCENE_OVERRIDE,
+                        "bad override '%s': expected a key name at character %d", ov,
+                        (int)(s - ov) + 1);
+        if (n == MAX_SEGMENTS || (size_t)(p - s) >= sizeof seg[0].name)
+            return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': key path too long", ov);
+        memcpy(seg[n].name, s, (size_t)(p - s));
+        seg[n].name[p - s] = '\0';
+        seg[n++].index = 0;
+        while (p < end && *p == '[') {
+            lua_Integer v = 0;
+            const char *d = ++p;
+            for (; p < end && isdigit((unsigned char)*p) && v <= INT_MAX; p++)
+                v = v * 10 + (*p - '0');
+            if (p == d || p >= end || *p != ']' || v < 1 || v > INT_MAX)
+                return fail(ld, CF_ERR_SCENE_OVERRIDE,
+                            "bad override '%s': bad list index at character %d (write "
+                            "name[1], name[2], ...; lists start at 1)",
+                            ov, (int)(d - ov));
+            p++;
+            if (n == MAX_SEGMENTS)
+                return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': key path too long",
+                            ov);
+            seg[n].name[0] = '\0';
+            seg[n++].index = v;
+        }
+        if (p == end)
+            break;
+        if (*p != '.')
+            return fail(ld, CF_ERR_SCENE_OVERRIDE,
+                        "bad override '%s': unexpected '%c' in the key path", ov, *p);
+        p++;
+    }
+    *n_seg = n;
+    return CF_OK;
+}
+
+static void push_segment(lua_State *L, const segment *s)
+{
+    if (s->name[0])
+        lua_pushstring(L, s->name);
+    else
+        lua_pushinteger(L, s->index);
+}
+
+/* Apply one "key.path=value" to the scene table at `scene`. */
+static cf_status apply_override(loader *ld, int scene, const char *ov)
+{
+    lua_State *L = ld->L;
+    segment seg[MAX_SEGMENTS];
+    int base = lua_gettop(L), n_seg, value, cur, ty;
+    const char *eq = strchr(ov, '='), *v;
+    luaL_Buffer code;
+
+    if (!eq)
+        return fail(ld, CF_ERR_SCENE_OVERRIDE,
+                    "bad override '%s': expected key.path=value (e.g. solver.dt_rigid=1e-3)", ov);
+    TRY(parse_key_path(ld, ov, ov, eq, seg, &n_seg));
+    for (v = eq + 1; *v && isspace((unsigned char)*v); v++)
+        ;
+    if (!*v)
+        return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': no value after '='", ov);
+
+    /* The value is a Lua expression evaluated in the same sandbox. */
+    luaL_buffinit(L, &code);
+    luaL_addstring(&code, "return ");
+    luaL_addstring(&code, eq + 1);
+    luaL_pushresult(&code);
+    if (luaL_loadbufferx(L, lua_tostring(L, -1), lua_rawlen(L, -1), "=override", "t") != LUA_OK)
+        return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': the value does not parse: %s",
+                    ov, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "?");
+    if (lua_pcall(L, 0, 1, 0) != LUA_OK)
+        return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': the value fails: %s", ov,
+                    lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "?");
+    if (lua_isnil(L, -1))
+        return fail(ld, CF_ERR_SCENE_OVERRIDE,
+                    "bad override '%s': the value is nil (strings need quotes: "
+                    "name=\"drop\")",
+                    ov);
+    value = lua_gettop(L);
+
+    /* Walk down, creating missing tables on the way. */
+    cur = scene;
+    for (int i = 0; i + 1 < n_seg; i++) {
+        push_segment(L, &seg[i]);
+        ty = lua_rawget(L, cur);
+        if (ty == LUA_TNIL) {
+            lua_pop(L, 1);
+            lua_newtable(L);
+            push_segment(L, &seg[i]);
+            lua_pushvalue(L, -2);
+            lua_rawset(L, cur);
+        } else if (ty != LUA_TTABLE) {
+            return fail(ld, CF_ERR_SCENE_OVERRIDE,
+                        "bad override '%s': part %d of the key path is a %s, not a table", ov,
+                        i + 1, lua_typename(L, ty));
+        }
+        cur = lua_gettop(L);
+    }
+    push_segment(L, &seg[n_seg - 1]);
+    lua_pushvalue(L, value);
+    lua_rawset(L, cur);
+    lua_settop(L, base);
+    return CF_OK;
+}
+
+/* The protected part: overrides, then the schema walk.  Arguments: the
+ * loader (light userdata) and the scene table. */
+static int build_protected(lua_State *L)
+{
+    loader *ld = lua_touserdata(L, 1);
+    cf_status st = CF_OK;
+    luaL_checkstack(L, 40, "scene nesting");
+    for (int i = 0; i < ld->n_overrides && st == CF_OK; i++)
+        st = apply_override(ld, 2, ld->overrides[i]);
+    lua_settop(L, 2);
+    if (st == CF_OK)
+        st = read_scene(ld, 2);
+    ld->status = st;
+    return 0;
+}
+
+/* ---------------------------------------------------------------- sandbox */
+
+static int open_sandbox(lua_State *L)
+{
+    static const luaL_Reg libs[] = {{LUA_GNAME, luaopen_base},
+                                    {LUA_STRLIBNAME, luaopen_string},
+                                    {LUA_TABLIBNAME, luaopen_table},
+                                    {LUA_MATHLIBNAME, luaopen_math}};
+    /* Base functions that reach files, compile code or tune the collector. */
+    static const char *const removed[] = {"dofile", "loadfile", "load", "require",
+                                          "collectgarbage"};
+    for (int i = 0; i < COUNT(libs); i++) {
+        luaL_requiref(L, libs[i].name, libs[i].func, 1);
+        lua_pop(L, 1);
+    }
+    for (int i = 0; i < COUNT(removed); i++) {
+        lua_pushnil(L);
+        lua_setglobal(L, removed[i]);
+    }
+    return 0;
+}
+
+/* Lua's message, prefixed with the scene file unless it already names it. */
+static cf_status lua_failure(loader *ld, cf_status code, const char *hint)
+{
+    lua_State *L = ld->L;
+    const char *msg = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : NULL;
+    char buf[768];
+    if (!msg) {
+        snprintf(buf, sizeof buf, "(error object is a %s value)", luaL_typename(L, -1));
+        msg = buf;
+    }
+    if (!hint)
+        hint = "";
+    if (strncmp(msg, ld->file, strlen(ld->file)) == 0)
+        return cf_error_set(ld->err, code, "%s%s", msg, hint);
+    return cf_error_set(ld->err, code, "%s: %s%s", ld->file, msg, hint);
+}
+
+/* ---------------------------------------------------------------- resolved text */
+
+typedef struct text {
+    char *p;
+    size_t len, cap;
+    int oom;
+} text;
+
+static void put(text *b, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static void put(text *b, const char *fmt, ...)
+{
+    va_list ap;
+    int n;
+    if (b->oom)
+        return;
+    va_start(ap, fmt);
+    n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0) {
+        b->oom = 1;
+        return;
+    }
+    if (b->len + (size_t)n + 1 > b->cap) {
+        size_t cap = b->cap ? b->cap : 1024;
+        char *p;
+        while (cap < b->len + (size_t)n + 1)
+            cap *= 2;
+        p = realloc(b->p, cap);
+        if (!p) {
+            b->oom = 1;
+            return;
+        }
+        b->p = p;
+        b->cap = cap;
+    }
+    va_start(ap, fmt);
+    vsnprintf(b->p + b->len, b->cap - b->len, fmt, ap);
+    va_end(ap);
+    b->len += (size_t)n;
+}
+
+/* %.17g reads back to the same double; ".0" keeps integral values floats
+ * (and -0.0 negative) when Lua reads them back. */
+static const char *num(char buf[40], double v)
+{
+    snprintf(buf, 40, "%.17g", v);
+    /* Whatever the locale's decimal point, Lua wants '.'. */
+    for (char *c = buf; *c; c++)
+        if (!isdigit((unsigned char)*c) && *c != '-' && *c != '+' && *c != 'e')
+            *c = '.';
+    if (!strpbrk(buf, ".e"))
+        strcat(buf, ".0");
+    return buf;
+}
+
+static void put_num(text *b, int ind, const char *key, double v)
+{
+    char n[40];
+    put(b, "%*s%s = %s,\n", ind, "", key, num(n, v));
+}
+
+static void put_vec(text *b, int ind, const char *key, const double *v, int n)
+{
+    char s[40];
+    put(b, "%*s%s = {", ind, "", key);
+    for (int i = 0; i < n; i++)
+        put(b, "%s%s", i ? ", " : "", num(s, v[i]));
+    put(b, "},\n");
+}
+
+static void put_str(text *b, int ind, const char *key, const char *s)
+{
+    put(b, "%*s%s = \"", ind, "", key);
+    for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
+        if (*c == '"' || *c == '\\')
+            put(b, "\\%c", *c);
+        else if (*c == '\n')
+            put(b, "\\n");
+        else if (*c < 0x20 || *c == 0x7f)
+            put(b, "\\%03d", *c); /* three digits: a following digit cannot join */
+        else
+            put(b, "%c", *c);
+    }
+    put(b, "\",\n");
+}
+
+/* The whole scene as Lua text in schema order; NULL when out of memory. */
+static char *resolved_text(const cf_scene *s)
+{
+    text b = {0};
+    const cf_material *m = &s->material;
+    const cf_solver_settings *v = &s->solver;
+    put(&b, "return {\n");
+    put_str(&b, 2, "name", s->name);
+    put_num(&b, 2, "duration", s->duration);
+    put_vec(&b, 2, "gravity", s->gravity, 3);
+    put(&b, "  material = {\n");
+    put_num(&b, 4, "E", m->E);
+    put_num(&b, 4, "nu", m->nu);
+    put_num(&b, 4, "rho", m->rho);
+    put_num(&b, 4, "G_I", m->G_I);
+    put_num(&b, 4, "sigma_max", m->sigma_max);
+    put_num(&b, 4, "alpha", m->alpha);
+    put_num(&b, 4, "G_II", m->G_II);
+    put_num(&b, 4, "tau_max", m->tau_max);
+    put_num(&b, 4, "beta", m->beta);
+    put_num(&b, 4, "friction", m->friction);
+    put_num(&b, 4, "restitution", m->restitution);
+    put(&b, "  },\n  bodies = {\n");
+    for (int i = 0; i < s->n_bodies; i++) {
+        const cf_body_def *d = &s->bodies[i];
+        put(&b, "    {\n");
+        put_str(&b, 6, "mesh", d->mesh);
+        put_num(&b, 6, "scale", d->scale);
+        put_vec(&b, 6, "position", d->position, 3);
+        put_vec(&b, 6, "orientation", d->orientation, 4);
+        put_vec(&b, 6, "velocity", d->velocity, 3);
+        put_vec(&b, 6, "angular_velocity", d->angular_velocity, 3);
+        put(&b, "    },\n");
+    }
+    put(&b, "  },\n  obstacles = {\n");
+    for (int i = 0; i < s->n_obstacles; i++) {
+        const cf_obstacle *o = &s->obstacles[i];
+        put(&b, "    {\n");
+        put_str(&b, 6, "type", obstacle_names[o->type]);
+        if (o->type == CF_OBSTACLE_PLANE) {
+            put_vec(&b, 6, "point", o->point, 3);
+            put_vec(&b, 6, "normal", o->normal, 3);
+        } else {
+            put_vec(&b, 6, "center", o->center, 3);
+            if (o->type == CF_OBSTACLE_SPHERE)
+                put_num(&b, 6, "radius", o->radius);
+            else
+                put_vec(&b, 6, "half_extents", o->half_extents, 3);
+            put_vec(&b, 6, "velocity", o->velocity, 3);
+        }
+        put(&b, "    },\n");
+    }
+    put(&b, "  },\n  solver = {\n");
+    put_str(&b, 4, "rigid_backend", backend_names[v->rigid_backend]);
+    put_num(&b, 4, "dt_rigid", v->dt_rigid);
+    put(&b, "    rigid_substeps = %d,\n", v->rigid_substeps);
+    put_num(&b, 4, "dt_fracture", v->dt_fracture);
+    put(&b, "    check_interval = %d,\n", v->check_interval);
+    put(&b, "    quiet_steps = %d,\n", v->quiet_steps);
+    put_num(&b, 4, "max_fracture_time", v->max_fracture_time);
+    put_num(&b, 4, "impact_threshold", v->impact_threshold);
+    put_str(&b, 4, "elasticity", elasticity_names[v->elasticity]);
+    put_str(&b, 4, "criterion", criterion_names[v->criterion]);
+    put(&b, "    pbd = {\n");
+    put_num(&b, 6, "k_stiffness", v->k_stiffness);
+    put(&b, "      iterations = %d,\n", v->iterations);
+    put_num(&b, 6, "k_damping", v->k_damping);
+    put(&b, "    },\n");
+    put(&b, "    threads = %d,\n", v->threads);
+    put(&b, "  },\n  output = {\n");
+    put_str(&b, 4, "file", s->output.file);
+    put_num(&b, 4, "frame_interval", s->output.frame_interval);
+    put(&b, "  },\n}\n");
+    if (b.oom) {
+        free(b.p);
+        return NULL;
+    }
+    return b.p;
+}
+
+/* ---------------------------------------------------------------- API */
+
+static cf_status load(loader *ld)
+{
+    lua_State *L = ld->L;
+    FILE *f = fopen(ld->file, "r");
+    int rc;
+    if (!f)
+        return fail(ld, CF_ERR_FILE_OPEN, "cannot open the scene file: %s", strerror(errno));
+    fclose(f);
+
+    lua_pushcfunction(L, open_sandbox);
+    if (lua_pcall(L, 0, 0, 0) != LUA_OK)
+        return fail(ld, CF_ERR_NOMEM, "cannot set up the Lua state");
+
+    /* Mode "t": precompiled chunks bypass the parser's checks and can crash
+     * the VM, so only source text is accepted. */
+    rc = luaL_loadfilex(L, ld->file, "t");
+    if (rc == LUA_ERRFILE)
+        return lua_failure(ld, CF_ERR_FILE_OPEN, NULL);
+    if (rc == LUA_ERRMEM)
+        return fail(ld, CF_ERR_NOMEM, "out of memory while parsing");
+    if (rc != LUA_OK)
+        return lua_failure(ld, CF_ERR_SCENE_SYNTAX,
+                           lua_type(L, -1) == LUA_TSTRING &&
+                                   strstr(lua_tostring(L, -1), "binary chunk")
+                               ? " (scenes must be Lua source text)"
+                               : NULL);
+    if (lua_pcall(L, 0, 1, 0) != LUA_OK) {
+        const char *msg = lua_tostring(L, -1);
+        return lua_failure(ld, CF_ERR_SCENE_SYNTAX,
+                           msg && strstr(msg, "(global '")
+                               ? " (scenes run sandboxed: only the base, string, table and "
+                                 "math libraries are available)"
+                               : NULL);
+    }
+    if (!lua_istable(L, -1))
+        return fail(ld, CF_ERR_SCENE_TYPE, "the script must return a table, got %s",
+                    luaL_typename(L, -1));
+
+    lua_pushcfunction(L, build_protected);
+    lua_pushlightuserdata(L, ld);
+    lua_pushvalue(L, -3);
+    rc = lua_pcall(L, 2, 0, 0);
+    if (rc == LUA_ERRMEM)
+        return fail(ld, CF_ERR_NOMEM, "out of memory while reading the scene");
+    if (rc != LUA_OK)
+        return lua_failure(ld, CF_ERR_SCENE_SYNTAX, NULL);
+    if (ld->status != CF_OK)
+        return ld->status;
+
+    ld->s->resolved = resolved_text(ld->s);
+    if (!ld->s->resolved)
+        return fail(ld, CF_ERR_NOMEM, "out of memory for the resolved scene");
+    return CF_OK;
+}
+
+cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
+                        const char *mesh_dir, cf_scene *out, cf_error *err)
+{
+    loader ld;
+    const char *slash;
+    cf_status st;
+
+    assert(path && out && (n_overrides == 0 || overrides));
+    memset(out, 0, sizeof *out);
+    memset(&ld, 0, sizeof ld);
+    ld.file = path;
+    ld.mesh_dir = mesh_dir;
+    ld.overrides = overrides;
+    ld.n_overrides = n_overrides;
+    ld.s = out;
+    ld.err = err;
+
+    slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(ld.dir, sizeof ld.dir, ".");
+    else if (slash == path)
+        snprintf(ld.dir, sizeof ld.dir, "/");
+    else if ((size_t)(slash - path) < sizeof ld.dir)
+        snprintf(ld.dir, sizeof ld.dir, "%.*s", (int)(slash - path), path);
+    else
+        return fail(&ld, CF_ERR_FILE_OPEN, "scene path too long");
+
+    ld.L = luaL_newstate();
+    if (!ld.L)
+        return fail(&ld, CF_ERR_NOMEM, "cannot create a Lua state");
+    st = load(&ld);
+    lua_close(ld.L);
+    if (st != CF_OK)
+        cf_scene_free(out);
+    return st;
+}
+
+void cf_scene_free(cf_scene *s)
+{
+    if (!s)
+        return;
+    free(s->bodies);
+    free(s->obstacles);
+    free(s->resolved);
+    memset(s, 0, sizeof *s);
+}

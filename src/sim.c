@@ -1,0 +1,541 @@
+/* The driver: builds what a scene asks for and runs the rigid-step loop
+ * (DESIGN §1, §5).  Each rigid step: Bullet (or the pbd rigid backend)
+ * moves the rigid fragments; a fragment hit harder than the impact threshold
+ * is rolled back to the start of the step and re-done in fracture mode,
+ * sub-cycled at dt_fracture; a fracture-mode fragment quiet for quiet_steps
+ * steps is split into its components and handed back to rigid mode. */
+#include "sim.h"
+
+#include "linalg.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Place a body's mesh: x' = position + scale R (x - bbox centre). */
+static void place_mesh(cf_mesh *m, const cf_body_def *b)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < m->n_nodes; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], m->x[3 * i + k]);
+            hi[k] = fmax(hi[k], m->x[3 * i + k]);
+        }
+    double c[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])}, R[9];
+    quat_to_mat(b->orientation, R);
+    for (int i = 0; i < m->n_nodes; i++) {
+        double r[3], y[3];
+        v3_sub(&m->x[3 * i], c, r);
+        m3_mulv(R, r, y);
+        for (int k = 0; k < 3; k++)
+            m->x[3 * i + k] = b->position[k] + b->scale * y[k];
+    }
+}
+
+/* All bodies' meshes, placed and concatenated; body[t] is each tet's body. */
+static cf_status load_bodies(const cf_scene *sc, cf_mesh *all, int **body, cf_error *err)
+{
+    memset(all, 0, sizeof *all);
+    *body = NULL;
+    for (int b = 0; b < sc->n_bodies; b++) {
+        cf_mesh m;
+        cf_status st = cf_mesh_load_tetgen(sc->bodies[b].mesh, &m, err);
+        if (st != CF_OK) {
+            cf_mesh_free(all);
+            free(*body);
+            return st;
+        }
+        place_mesh(&m, &sc->bodies[b]);
+        double *x = realloc(all->x, (size_t)(all->n_nodes + m.n_nodes) * 3 * sizeof(double));
+        int *t = realloc(all->tets, (size_t)(all->n_tets + m.n_tets) * 4 * sizeof(int));
+        int *bt = realloc(*body, (size_t)(all->n_tets + m.n_tets) * sizeof(int));
+        if (x)
+            all->x = x;
+        if (t)
+            all->tets = t;
+        if (bt)
+            *body = bt;
+        if (!x || !t || !bt) {
+            cf_mesh_free(&m);
+            cf_mesh_free(all);
+            free(*body);
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory loading %s", sc->bodies[b].mesh);
+        }
+        memcpy(&all->x[3 * all->n_nodes], m.x, (size_t)m.n_nodes * 3 * sizeof(double));
+        for (int i = 0; i < 4 * m.n_tets; i++)
+            all->tets[4 * all->n_tets + i] = m.tets[i] + all->n_nodes;
+        for (int i = 0; i < m.n_tets; i++)
+            (*body)[all->n_tets + i] = b;
+        all->n_nodes += m.n_nodes;
+        all->n_tets += m.n_tets;
+        cf_mesh_free(&m);
+    }
+    return CF_OK;
+}
+
+/* Body of an input node (-1 for a node no tet uses). */
+static int node_body(const cf_solid *s, const int *body, int a)
+{
+    return s->vt_start[a] < s->vt_start[a + 1] ? body[s->vt_list[s->vt_start[a]]] : -1;
+}
+
+/* Initial fragments: the connected components of each body. */
+static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *err)
+{
+    cf_solid *s = &sim->solid;
+    int nt = s->n_tets;
+    int *all = malloc((size_t)nt * sizeof(int)), *comp = malloc((size_t)nt * sizeof(int));
+    unsigned char *seen = calloc((size_t)s->n_nodes, 1);
+    if (!all || !comp || !seen) {
+        free(all), free(comp), free(seen);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    for (int t = 0; t < nt; t++)
+        all[t] = t;
+    int k = cf_label_components(s, all, nt, comp);
+    for (int c = 0; c < k; c++)
+        cf_fragment_new(sim, -1, 0.0);
+    for (int t = 0; t < nt; t++) {
+        cf_fragment *f = &sim->frag[comp[t]];
+        if (!f->tets)
+            f->tets = malloc((size_t)nt * sizeof(int)); /* trimmed below */
+        f->tets[f->nt++] = t;
+        s->tet_frag[t] = comp[t];
+        for (int j = 0; j < 4; j++) {
+            int a = s->tet[4 * t + j];
+            if (!seen[a]) {
+                seen[a] = 1;
+                cf_int_list_push(&f->nodes, a);
+            }
+        }
+    }
+    free(all), free(comp), free(seen);
+
+    /* Initial velocities: v = v_b + w_b x (x - com of the body). */
+    for (int b = 0; b < sim->scene->n_bodies; b++) {
+        const cf_body_def *bd = &sim->scene->bodies[b];
+        double M = 0, com[3] = {0, 0, 0};
+        for (int a = 0; a < s->n_nodes; a++)
+            if (node_body(s, body, a) == b) {
+                M += s->m[a];
+                v3_axpy(s->m[a], &s->x[3 * a], com);
+            }
+        for (int k2 = 0; k2 < 3; k2++)
+            com[k2] /= M;
+        for (int a = 0; a < s->n_nodes; a++)
+            if (node_body(s, body, a) == b) {
+                double r[3], wr[3];
+                v3_sub(&s->x[3 * a], com, r);
+                v3_cross(bd->angular_velocity, r, wr);
+                for (int k2 = 0; k2 < 3; k2++)
+                    s->v[3 * a + k2] = bd->velocity[k2] + wr[k2];
+            }
+    }
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        cf_fragment *f = &sim->frag[fi];
+        int *tt = realloc(f->tets, (size_t)f->nt * sizeof(int));
+        if (tt)
+            f->tets = tt;
+        cf_fragment_rest_props(sim, fi);
+        if (sim->bullet) {
+            const cf_body_def *bd = &sim->scene->bodies[body[f->tets[0]]];
+            cf_node_state ns;
+            cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &ns);
+            double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+            cf_status st = cf_fragment_add_body(sim, fi, f->com_rest, I3, ns.v,
+                                                bd->angular_velocity, err);
+            if (st != CF_OK)
+                return st;
+        } else if (cf_bars_build(&f->bars, s, f->tets, f->nt)) {
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory building bars");
+        }
+    }
+    return CF_OK;
+}
+
+static cf_status add_obstacles(cf_sim *sim, cf_error *err)
+{
+    const cf_scene *sc = sim->scene;
+    for (int j = 0; j < sc->n_obstacles; j++) {
+        const cf_obstacle *o = &sc->obstacles[j];
+        int id = -1;
+        double mu = sc->material.friction, e = sc->material.restitution;
+        if (o->type == CF_OBSTACLE_PLANE)
+            id = cfb_add_plane(sim->bullet, o->point, o->normal, mu, e);
+        else if (o->type == CF_OBSTACLE_SPHERE)
+            id = cfb_add_sphere(sim->bullet, o->center, o->radius, o->velocity, mu, e);
+        else
+            id = cfb_add_box(sim->bullet, o->center, o->half_extents, o->velocity, mu, e);
+        if (id < 0)
+            return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused obstacle %d: %s", j + 1,
+                                cfb_last_error());
+    }
+    return CF_OK;
+}
+
+static cf_status write_fragment_infos(cf_sim *sim, int first, cf_error *err)
+{
+    if (!sim->h5 || first >= sim->n_frag)
+        return CF_OK;
+    int n = sim->n_frag - first;
+    cf_frag_info *info = calloc((size_t)n, sizeof *info);
+    if (!info)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < n; i++) {
+        const cf_fragment *f = &sim->frag[first + i];
+        info[i].id = first + i;
+        info[i].parent = f->parent;
+        info[i].birth_time = f->birth_time;
+        info[i].mass = f->mass;
+        info[i].n_tets = f->nt;
+        memcpy(info[i].inertia_principal, f->principal, sizeof f->principal);
+    }
+    cf_status st = cf_h5_add_fragments(sim->h5, info, n, err);
+    free(info);
+    return st;
+}
+
+cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim **out,
+                        cf_error *err)
+{
+    *out = NULL;
+    cf_sim *sim = calloc(1, sizeof *sim);
+    if (!sim)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    sim->scene = scene;
+    sim->opt = *opt;
+    sim->wall_start = cf_wall_time();
+    int threads = opt->threads > 0 ? opt->threads : scene->solver.threads;
+    if (threads > 0)
+        omp_set_num_threads(threads);
+    sim->obs.n = scene->n_obstacles;
+    sim->obs.o = scene->obstacles;
+    cf_ppr_init(&sim->ppr, &scene->material);
+
+    cf_mesh all;
+    int *body = NULL;
+    cf_status st = load_bodies(scene, &all, &body, err);
+    if (st == CF_OK) {
+        st = cf_solid_init(&sim->solid, &all, &scene->material, body, err);
+        cf_mesh_free(&all);
+    }
+    if (st == CF_OK && scene->solver.rigid_backend == CF_RIGID_BULLET) {
+        sim->bullet = cfb_world_create(scene->gravity);
+        st = sim->bullet ? add_obstacles(sim, err)
+                         : cf_error_set(err, CF_ERR_EXTERNAL, "Bullet world: %s", cfb_last_error());
+    }
+    if (st == CF_OK)
+        st = make_initial_fragments(sim, body, err);
+    free(body);
+    if (st == CF_OK && scene->output.file[0]) {
+        st = cf_h5_open(scene->output.file, scene->name, scene->resolved, &sim->h5, err);
+        if (st == CF_OK)
+            st = write_fragment_infos(sim, 0, err);
+    }
+    if (st != CF_OK) {
+        cf_sim_destroy(sim);
+        return st;
+    }
+    *out = sim;
+    return CF_OK;
+}
+
+void cf_sim_destroy(cf_sim *sim)
+{
+    if (!sim)
+        return;
+    if (sim->h5)
+        cf_h5_close(sim->h5, NULL);
+    for (int i = 0; i < sim->n_frag; i++) {
+        cf_fragment *f = &sim->frag[i];
+        free(f->tets), free(f->nodes.v), free(f->coh.v), free(f->contact), free(f->vn_pre);
+        cf_bars_free(&f->bars);
+    }
+    free(sim->frag);
+    if (sim->bullet)
+        cfb_world_destroy(sim->bullet);
+    cf_solid_free(&sim->solid);
+    free(sim);
+}
+
+/* Kinetic energy of fragment fi (J). */
+static double fragment_kinetic_energy(cf_sim *sim, int fi)
+{
+    cf_fragment *f = &sim->frag[fi];
+    if (f->body < 0) {
+        cf_node_state ns;
+        cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
+        return ns.ke;
+    }
+    cfb_state st;
+    cfb_get_state(sim->bullet, f->body, &st);
+    double Rb[9], wb[3];
+    quat_to_mat(st.quat, Rb);
+    m3_tmulv(Rb, st.w, wb); /* body-frame angular velocity */
+    double e = 0.5 * f->mass * v3_dot(st.v, st.v);
+    for (int k = 0; k < 3; k++)
+        e += 0.5 * f->principal[k] * wb[k] * wb[k];
+    return e;
+}
+
+static cf_status write_frame(cf_sim *sim, cf_error *err)
+{
+    if (!sim->h5)
+        return CF_OK;
+    double t0 = cf_wall_time();
+    cf_frag_frame *fr = malloc((size_t)sim->n_frag * sizeof *fr);
+    if (!fr)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    int n = 0, n_fracture = 0;
+    double ke = 0;
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        cf_fragment *f = &sim->frag[fi];
+        if (f->mode == CF_MODE_DEAD)
+            continue;
+        double R[9];
+        cf_frag_frame *o = &fr[n++];
+        o->id = fi;
+        o->mode = f->mode;
+        cf_fragment_pose(sim, fi, o->com, R, o->v, o->w);
+        mat_to_quat(R, o->quat);
+        ke += fragment_kinetic_energy(sim, fi);
+        n_fracture += f->mode == CF_MODE_FRACTURE;
+    }
+    cf_status st = cf_h5_write_frame(sim->h5, sim->step, sim->t, fr, n, err);
+    free(fr);
+    const char *names[] = {"kinetic_energy", "fragment_count", "cohesive_elements",
+                           "fragments_in_fracture_mode", "handoff_momentum_error_max"};
+    double values[] = {ke, n, sim->solid.n_coh, n_fracture, sim->max_momentum_error};
+    for (int i = 0; i < 5 && st == CF_OK; i++)
+        st = cf_h5_write_observable(sim->h5, names[i], sim->step, sim->t, values[i], err);
+    sim->prof.output += cf_wall_time() - t0;
+    return st;
+}
+
+static int alive_fragments(const cf_sim *sim, int *in_fracture)
+{
+    int n = 0, nf = 0;
+    for (int i = 0; i < sim->n_frag; i++) {
+        n += sim->frag[i].mode != CF_MODE_DEAD;
+        nf += sim->frag[i].mode == CF_MODE_FRACTURE;
+    }
+    if (in_fracture)
+        *in_fracture = nf;
+    return n;
+}
+
+static void progress(cf_sim *sim, int final)
+{
+    if (!sim->opt.progress)
+        return;
+    double now = cf_wall_time(), el = now - sim->wall_start;
+    int tty = isatty(STDERR_FILENO);
+    if (!final && now - sim->last_progress < (tty ? 0.2 : 10.0))
+        return;
+    sim->last_progress = now;
+    double frac = sim->t / sim->scene->duration;
+    double eta = frac > 0 ? el * (1 - frac) / frac : 0;
+    int nf, n = alive_fragments(sim, &nf);
+    const char *mode = nf ? "fracture" : "rigid";
+    if (tty) {
+        char bar[31];
+        int fill = (int)(30 * frac);
+        for (int i = 0; i < 30; i++)
+            bar[i] = i < fill ? '#' : '.';
+        bar[30] = 0;
+        fprintf(stderr, "\r[%s] t=%.4f/%.4g s  %-8s  fragments %d  cohesive %d  ETA %.0f s   ",
+                bar, sim->t, sim->scene->duration, mode, n, sim->solid.n_coh, eta);
+        if (final)
+            fputc('\n', stderr);
+    } else {
+        fprintf(stderr, "t=%.4f/%.4g s (%3.0f%%)  %s  fragments %d  cohesive %d  ETA %.0f s\n",
+                sim->t, sim->scene->duration, 100 * frac, mode, n, sim->solid.n_coh, eta);
+    }
+}
+
+/* Divergence: a non-finite position or a node faster than 1e5 m/s. */
+static int nodes_sane(const cf_solid *s, const cf_fragment *f)
+{
+    for (int i = 0; i < f->nodes.n; i++) {
+        const double *x = &s->x[3 * f->nodes.v[i]], *v = &s->v[3 * f->nodes.v[i]];
+        if (!isfinite(x[0] + x[1] + x[2]) || !(v3_dot(v, v) < 1e10))
+            return 0;
+    }
+    return 1;
+}
+
+/* Advance the rigid fragments by one rigid step; detect impacts. */
+static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
+    int n = sim->n_frag;
+    double t0 = cf_wall_time();
+    if (sim->bullet) {
+        cfb_state *pre = malloc((size_t)n * sizeof *pre);
+        if (!pre)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+        for (int fi = 0; fi < n; fi++)
+            if (sim->frag[fi].body >= 0)
+                cfb_get_state(sim->bullet, sim->frag[fi].body, &pre[fi]);
+        cfb_step(sim->bullet, dt, set->rigid_substeps);
+        sim->prof.rigid += cf_wall_time() - t0;
+        sim->steps_rigid++;
+        for (int fi = 0; fi < n; fi++) {
+            cf_fragment *f = &sim->frag[fi];
+            if (f->body < 0 || f->mode != CF_MODE_RIGID)
+                continue;
+            double dv = cfb_contact_impulse(sim->bullet, f->body) / f->mass;
+            if (dv > set->impact_threshold) { /* redo this step in fracture mode */
+                double th = cf_wall_time();
+                cf_status st = cf_handoff_to_fracture(sim, fi, &pre[fi], err);
+                sim->prof.handoff += cf_wall_time() - th;
+                if (st != CF_OK) {
+                    free(pre);
+                    return st;
+                }
+            }
+        }
+        free(pre);
+        return CF_OK;
+    }
+    for (int fi = 0; fi < n; fi++) {
+        if (sim->frag[fi].mode != CF_MODE_RIGID)
+            continue;
+        if (cf_pbd_impact(sim, fi, dt)) {
+            cf_status st = cf_handoff_to_fracture(sim, fi, NULL, err);
+            if (st != CF_OK)
+                return st;
+            continue;
+        }
+        if (cf_solver_step(sim, fi, sim->t, dt, 0) != CF_OK)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory in the pbd rigid step");
+    }
+    sim->steps_rigid++;
+    sim->prof.rigid += cf_wall_time() - t0;
+    return CF_OK;
+}
+
+/* Sub-cycle every fracture-mode fragment through the rigid step. */
+static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
+    long n_sub = lround(dt / set->dt_fracture);
+    if (n_sub < 1)
+        n_sub = 1;
+    double h = dt / (double)n_sub;
+    int n = sim->n_frag;
+    for (int fi = 0; fi < n; fi++) {
+        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+            continue;
+        for (long k = 0; k < n_sub; k++) {
+            if (cf_solver_step(sim, fi, sim->t + (double)k * h, h, 1) != CF_OK)
+                return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
+            sim->steps_fracture++;
+        }
+        if (!nodes_sane(&sim->solid, &sim->frag[fi]))
+            return cf_error_set(err, CF_ERR_DIVERGED,
+                                "fragment %d diverged (node position not finite or speed above "
+                                "1e5 m/s) at t = %.6g s "
+                                "with dt_fracture/dt_cfl = %.3g: lower solver.dt_fracture or "
+                                "raise solver.pbd.iterations",
+                                fi, sim->t, set->dt_fracture / sim->solid.dt_cfl);
+    }
+    return CF_OK;
+}
+
+/* Fracture-mode fragments that have been quiet long enough go back to rigid mode. */
+static cf_status return_to_rigid(cf_sim *sim, cf_error *err)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
+    int n = sim->n_frag;
+    for (int fi = 0; fi < n; fi++) {
+        cf_fragment *f = &sim->frag[fi];
+        if (f->mode != CF_MODE_FRACTURE)
+            continue;
+        if (f->quiet < set->quiet_steps && sim->t - f->t_enter < set->max_fracture_time - 1e-12)
+            continue;
+        int first_new = sim->n_frag;
+        double th = cf_wall_time();
+        cf_status st = cf_handoff_to_rigid(sim, fi, err);
+        sim->prof.handoff += cf_wall_time() - th;
+        if (st == CF_OK)
+            st = write_fragment_infos(sim, first_new, err);
+        if (st != CF_OK)
+            return st;
+    }
+    return CF_OK;
+}
+
+cf_status cf_sim_run(cf_sim *sim, cf_error *err)
+{
+    const cf_scene *sc = sim->scene;
+    double dt = sc->solver.dt_rigid;
+    long n_steps = lround(ceil(sc->duration / dt - 1e-9));
+    if (sim->opt.progress)
+        fprintf(stderr, "cohfrac: %d nodes, %d tets, %d fragment(s); dt_cfl = %.4g s, "
+                        "dt_fracture/dt_cfl = %.4g, dt_rigid/dt_cfl = %.4g\n",
+                sim->solid.n_nodes, sim->solid.n_tets, sim->n_frag, sim->solid.dt_cfl,
+                sc->solver.dt_fracture / sim->solid.dt_cfl, dt / sim->solid.dt_cfl);
+    cf_status st = write_frame(sim, err);
+    sim->next_frame = sc->output.frame_interval;
+    while (st == CF_OK && sim->step < n_steps) {
+        st = rigid_step(sim, dt, err);
+        if (st == CF_OK)
+            st = fracture_steps(sim, dt, err);
+        sim->step++;
+        sim->t = (double)sim->step * dt;
+        if (st == CF_OK)
+            st = return_to_rigid(sim, err);
+        if (st == CF_OK && (sim->t >= sim->next_frame - 1e-9 * dt || sim->step == n_steps)) {
+            st = write_frame(sim, err);
+            while (sim->next_frame <= sim->t + 1e-9 * dt)
+                sim->next_frame += sc->output.frame_interval;
+        }
+        progress(sim, 0);
+    }
+    progress(sim, 1);
+    cf_error cerr;
+    if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK && st == CF_OK) {
+        *err = cerr;
+        st = cerr.code;
+    }
+    sim->h5 = NULL;
+    return st;
+}
+
+void cf_sim_print_summary(const cf_sim *sim, FILE *out)
+{
+    const cf_scene *sc = sim->scene;
+    const cf_profile *p = &sim->prof;
+    int nf, n = alive_fragments(sim, &nf);
+    double wall = cf_wall_time() - sim->wall_start;
+    fprintf(out, "\n== cohfrac summary: %s ==\n", sc->name);
+    fprintf(out, "simulated time     %.4g s in %ld rigid steps (dt_rigid %.3g s, backend %s)\n",
+            sim->t, sim->step, sc->solver.dt_rigid,
+            sc->solver.rigid_backend == CF_RIGID_BULLET ? "bullet" : "pbd");
+    fprintf(out, "mesh               %d tets, %d nodes (%d after duplication)\n",
+            sim->solid.n_tets, sim->solid.n_verts0, sim->solid.n_nodes);
+    fprintf(out, "time step          dt_fracture %.3g s = %.4g dt_cfl (dt_cfl %.4g s)\n",
+            sc->solver.dt_fracture, sc->solver.dt_fracture / sim->solid.dt_cfl, sim->solid.dt_cfl);
+    fprintf(out, "steps per mode     rigid %ld, fracture %ld (threads %d)\n", sim->steps_rigid,
+            sim->steps_fracture, omp_get_max_threads());
+    fprintf(out, "fragments          %d alive (%d in fracture mode), %d ever\n", n, nf,
+            sim->n_frag);
+    fprintf(out, "cohesive elements  %d\n", sim->solid.n_coh);
+    fprintf(out, "hand-offs          %d, max linear momentum error %.3g (relative), "
+                 "handoff_loss %.4g J\n",
+            sim->n_handoffs, sim->max_momentum_error, sim->total_handoff_loss);
+    double staged = p->rigid + p->stress + p->insertion + p->forces + p->pbd + p->handoff + p->output;
+    fprintf(out, "wall time          %.2f s\n", wall);
+    fprintf(out, "  rigid step %.2f s | stress %.2f s | insertion %.2f s | forces %.2f s | "
+                 "PBD %.2f s | hand-off %.2f s | output %.2f s | other %.2f s\n",
+            p->rigid, p->stress, p->insertion, p->forces, p->pbd, p->handoff, p->output,
+            wall - staged);
+    if (sim->steps_fracture > 0)
+        fprintf(out, "per fracture step  %.3f ms\n",
+                1e3 * (p->stress + p->insertion + p->forces + p->pbd) / (double)sim->steps_fracture);
+    if (sc->output.file[0])
+        fprintf(out, "output             %s\n", sc->output.file);
+}

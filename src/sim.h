@@ -1,0 +1,101 @@
+/* The simulation state shared by the driver (sim.c), the solver step
+ * (fracture.c) and the mode hand-offs (handoff.c). */
+#ifndef COHFRAC_SIM_PRIVATE_H
+#define COHFRAC_SIM_PRIVATE_H
+
+#include "cf_bullet.h"
+#include "cohesive_ppr.h"
+#include "cohfrac/h5_output.h"
+#include "cohfrac/sim.h"
+#include "fragments.h"
+#include "insertion.h"
+#include "pbd.h"
+#include "solid.h"
+
+typedef enum { CF_MODE_DEAD = -1, CF_MODE_RIGID = 0, CF_MODE_FRACTURE = 1 } cf_mode;
+
+typedef struct cf_fragment {
+    int parent;              /* -1 for an initial body */
+    double birth_time;       /* s */
+    cf_mode mode;
+    int *tets, nt;           /* ascending */
+    cf_int_list nodes;
+    /* Rest-shape mass properties: principal axes Q (columns), moments. */
+    double mass, com_rest[3], Q[9], principal[3];
+    int body;                /* Bullet body id, -1 when none */
+    double q_match[4];       /* shape-matching warm start */
+    /* In-house solver state (fracture mode, or pbd rigid mode). */
+    cf_bars bars;
+    cf_int_list coh;         /* its cohesive elements */
+    long steps, quiet;       /* solver steps in this mode; steps since the last insertion */
+    double t_enter;          /* s, when fracture mode began */
+    int *contact;            /* [nodes.n] obstacle in contact after the last projection, -1 */
+    double *vn_pre;          /* [nodes.n] normal velocity before projection, m/s */
+    int scratch_cap;
+} cf_fragment;
+
+typedef struct cf_profile {
+    double rigid, stress, insertion, forces, pbd, handoff, output; /* s of wall time */
+} cf_profile;
+
+struct cf_sim {
+    const cf_scene *scene;
+    cf_run_options opt;
+    cf_solid solid;
+    cf_ppr ppr;
+    cf_obstacles obs;
+    cf_fragment *frag;
+    int n_frag, cap_frag;
+    cfb_world *bullet;       /* NULL for the pbd rigid backend */
+    cf_h5 *h5;               /* NULL when no output is asked for */
+    double t;                /* s */
+    long step;               /* rigid steps done */
+    double next_frame;       /* s */
+    cf_profile prof;
+    long steps_rigid, steps_fracture;
+    int n_handoffs;
+    double max_momentum_error, total_handoff_loss;
+    double wall_start;
+    double last_progress;
+};
+
+double cf_wall_time(void);
+
+/* One step of the in-house solver on fragment f (source Table 6.2): with
+ * `fracture` set, stresses every check_interval steps, cohesive insertion,
+ * internal and cohesive forces; otherwise (pbd rigid mode) global damping
+ * instead.  Then prediction, PBD bars + collision constraints, velocity
+ * update, friction and restitution.  t: time at the start of the step (s).
+ * Returns CF_OK or CF_ERR_NOMEM. */
+cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture);
+
+/* Whether rigid fragment fi (nodes in the in-house solver) would hit an
+ * obstacle during the next step of length dt faster than the impact
+ * threshold (normal approach speed). */
+int cf_pbd_impact(const cf_sim *sim, int fi, double dt);
+
+/* Compute the rest-shape mass properties of fragment fi. */
+void cf_fragment_rest_props(cf_sim *sim, int fi);
+
+/* Rigid -> fracture: nodes from the Bullet state `st` (x = R X + c,
+ * v = v + w x r), body removed.  Records the hand-off. */
+cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_error *err);
+
+/* Fracture -> rigid: split fragment fi into its connected components; each
+ * becomes a rigid fragment (a Bullet body with momentum-preserving
+ * velocities, or a pbd rigid fragment).  Records momentum error and
+ * handoff_loss. */
+cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err);
+
+/* Add a Bullet body for rigid fragment fi with COM pos, rotation R (rest ->
+ * current), velocity v and angular velocity w. */
+cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const double R[9],
+                               const double v[3], const double w[3], cf_error *err);
+
+/* Centre of mass, rotation, velocities of fragment fi, whatever its mode. */
+void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[3], double w[3]);
+
+/* Append a new fragment; returns its index or -1 (out of memory). */
+int cf_fragment_new(cf_sim *sim, int parent, double birth_time);
+
+#endif

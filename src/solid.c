@@ -1,0 +1,230 @@
+#include "solid.h"
+
+#include "linalg.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+const int CF_TET_FACE[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+typedef struct {
+    int v[3];
+    int tet, face;
+} face_key;
+
+static int cmp_face(const void *a, const void *b)
+{
+    const face_key *x = a, *y = b;
+    for (int i = 0; i < 3; i++)
+        if (x->v[i] != y->v[i])
+            return x->v[i] < y->v[i] ? -1 : 1;
+    return x->tet != y->tet ? (x->tet < y->tet ? -1 : 1) : 0;
+}
+
+static void sort3(int v[3])
+{
+    int t;
+    if (v[0] > v[1]) t = v[0], v[0] = v[1], v[1] = t;
+    if (v[1] > v[2]) t = v[1], v[1] = v[2], v[2] = t;
+    if (v[0] > v[1]) t = v[0], v[0] = v[1], v[1] = t;
+}
+
+/* Facets by sorting the 4 faces of every tet on their vertex triple. */
+static int build_facets(cf_solid *s)
+{
+    int nt = s->n_tets, nfk = 4 * nt;
+    face_key *k = malloc((size_t)nfk * sizeof *k);
+    s->facet = malloc((size_t)nfk * 4 * sizeof(int));
+    s->tet_facet = malloc((size_t)nfk * sizeof(int));
+    if (!k || !s->facet || !s->tet_facet) {
+        free(k);
+        return -1;
+    }
+    for (int t = 0; t < nt; t++)
+        for (int f = 0; f < 4; f++) {
+            face_key *e = &k[4 * t + f];
+            for (int i = 0; i < 3; i++)
+                e->v[i] = s->tet0[4 * t + CF_TET_FACE[f][i]];
+            sort3(e->v);
+            e->tet = t, e->face = f;
+        }
+    qsort(k, (size_t)nfk, sizeof *k, cmp_face);
+    int nf = 0;
+    for (int i = 0; i < nfk;) {
+        int *F = &s->facet[4 * nf];
+        F[0] = k[i].tet, F[1] = k[i].face, F[2] = -1, F[3] = -1;
+        s->tet_facet[4 * k[i].tet + k[i].face] = nf;
+        if (i + 1 < nfk && !memcmp(k[i].v, k[i + 1].v, sizeof k[i].v)) {
+            F[2] = k[i + 1].tet, F[3] = k[i + 1].face;
+            s->tet_facet[4 * k[i + 1].tet + k[i + 1].face] = nf;
+            i += 2;
+        } else {
+            i += 1;
+        }
+        nf++;
+    }
+    free(k);
+    s->n_facets = nf;
+    s->cracked = calloc((size_t)nf, 1);
+    return s->cracked ? 0 : -1;
+}
+
+static int build_vertex_tets(cf_solid *s)
+{
+    int nv = s->n_verts0, nt = s->n_tets;
+    s->vt_start = calloc((size_t)nv + 1, sizeof(int));
+    s->vt_list = malloc((size_t)nt * 4 * sizeof(int));
+    if (!s->vt_start || !s->vt_list)
+        return -1;
+    for (int i = 0; i < 4 * nt; i++)
+        s->vt_start[s->tet0[i] + 1]++;
+    for (int v = 0; v < nv; v++)
+        s->vt_start[v + 1] += s->vt_start[v];
+    int *fill = malloc((size_t)nv * sizeof(int));
+    if (!fill)
+        return -1;
+    memcpy(fill, s->vt_start, (size_t)nv * sizeof(int));
+    for (int t = 0; t < nt; t++) /* ascending tet order within each list */
+        for (int j = 0; j < 4; j++)
+            s->vt_list[fill[s->tet0[4 * t + j]]++] = t;
+    free(fill);
+    return 0;
+}
+
+static double tri_area(const double *a, const double *b, const double *c)
+{
+    double e1[3], e2[3], n[3];
+    v3_sub(b, a, e1), v3_sub(c, a, e2), v3_cross(e1, e2, n);
+    return 0.5 * v3_norm(n);
+}
+
+cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat,
+                        const int *tet_body, cf_error *err)
+{
+    memset(s, 0, sizeof *s);
+    s->mat = *mat;
+    s->lambda = mat->E * mat->nu / ((1 + mat->nu) * (1 - 2 * mat->nu));
+    s->mu = mat->E / (2 * (1 + mat->nu));
+    int nn = mesh->n_nodes, nt = mesh->n_tets;
+    s->n_nodes = s->n_verts0 = nn;
+    s->cap_nodes = nn + nn / 4 + 16;
+    s->n_tets = nt;
+    size_t c3 = (size_t)s->cap_nodes * 3 * sizeof(double);
+    s->X = malloc(c3), s->x = malloc(c3), s->v = calloc(1, c3), s->p = malloc(c3), s->f = calloc(1, c3);
+    s->m = calloc((size_t)s->cap_nodes, sizeof(double));
+    s->origin = malloc((size_t)s->cap_nodes * sizeof(int));
+    s->tet = malloc((size_t)nt * 4 * sizeof(int));
+    s->tet0 = malloc((size_t)nt * 4 * sizeof(int));
+    s->Dm_inv = malloc((size_t)nt * 9 * sizeof(double));
+    s->vol = malloc((size_t)nt * sizeof(double));
+    s->rq = malloc((size_t)nt * 4 * sizeof(double));
+    s->sigma = calloc((size_t)nt * 9, sizeof(double));
+    s->tf = calloc((size_t)nt * 12, sizeof(double));
+    s->tet_frag = malloc((size_t)nt * sizeof(int));
+    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->origin || !s->tet ||
+        !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->sigma || !s->tf || !s->tet_frag) {
+        cf_solid_free(s);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
+    }
+    memcpy(s->X, mesh->x, (size_t)nn * 3 * sizeof(double));
+    memcpy(s->x, mesh->x, (size_t)nn * 3 * sizeof(double));
+    memcpy(s->p, mesh->x, (size_t)nn * 3 * sizeof(double));
+    for (int i = 0; i < nn; i++)
+        s->origin[i] = i;
+    memcpy(s->tet, mesh->tets, (size_t)nt * 4 * sizeof(int));
+    memcpy(s->tet0, mesh->tets, (size_t)nt * 4 * sizeof(int));
+    memcpy(s->tet_frag, tet_body, (size_t)nt * sizeof(int));
+
+    double c_d = sqrt(mat->E * (1 - mat->nu) / (mat->rho * (1 + mat->nu) * (1 - 2 * mat->nu)));
+    s->dt_cfl = INFINITY;
+    for (int t = 0; t < nt; t++) {
+        const int *T = &s->tet[4 * t];
+        const double *x0 = &s->X[3 * T[0]], *x1 = &s->X[3 * T[1]], *x2 = &s->X[3 * T[2]],
+                     *x3 = &s->X[3 * T[3]];
+        double Dm[9];
+        for (int r = 0; r < 3; r++)
+            Dm[3 * r] = x1[r] - x0[r], Dm[3 * r + 1] = x2[r] - x0[r], Dm[3 * r + 2] = x3[r] - x0[r];
+        double det = m3_inv(Dm, &s->Dm_inv[9 * t]);
+        s->vol[t] = det / 6.0;
+        if (!(s->vol[t] > 0)) {
+            cf_solid_free(s);
+            return cf_error_set(err, CF_ERR_MESH_INVERTED,
+                                "tet %d has volume %.3g m^3 (inverted or degenerate): fix the mesh",
+                                t, det / 6.0);
+        }
+        s->rq[4 * t] = 1, s->rq[4 * t + 1] = s->rq[4 * t + 2] = s->rq[4 * t + 3] = 0;
+        double area = tri_area(x1, x2, x3) + tri_area(x0, x3, x2) + tri_area(x0, x1, x3) +
+                      tri_area(x0, x2, x1);
+        double h = 6.0 * s->vol[t] / area; /* twice the inradius */
+        if (h / c_d < s->dt_cfl)
+            s->dt_cfl = h / c_d;
+    }
+    if (build_facets(s) || build_vertex_tets(s)) {
+        cf_solid_free(s);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets", nt);
+    }
+    int *all = malloc((size_t)nt * sizeof(int));
+    if (!all) {
+        cf_solid_free(s);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    for (int t = 0; t < nt; t++)
+        all[t] = t;
+    cf_solid_lump_masses(s, all, nt);
+    free(all);
+    return CF_OK;
+}
+
+void cf_solid_free(cf_solid *s)
+{
+    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->origin, s->tet, s->tet0,
+                    s->Dm_inv, s->vol, s->rq, s->sigma, s->tf, s->tet_frag, s->facet,
+                    s->tet_facet, s->cracked, s->vt_start, s->vt_list, s->coh};
+    for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
+        free(ptrs[i]);
+    memset(s, 0, sizeof *s);
+}
+
+static int grow(void **p, size_t elem, int newcap)
+{
+    void *q = realloc(*p, elem * (size_t)newcap);
+    if (!q)
+        return -1;
+    *p = q;
+    return 0;
+}
+
+int cf_solid_copy_node(cf_solid *s, int n)
+{
+    if (s->n_nodes == s->cap_nodes) {
+        int cap = s->cap_nodes * 3 / 2 + 16;
+        size_t v3 = 3 * sizeof(double);
+        if (grow((void **)&s->X, v3, cap) || grow((void **)&s->x, v3, cap) ||
+            grow((void **)&s->v, v3, cap) || grow((void **)&s->p, v3, cap) ||
+            grow((void **)&s->f, v3, cap) || grow((void **)&s->m, sizeof(double), cap) ||
+            grow((void **)&s->origin, sizeof(int), cap))
+            return -1;
+        s->cap_nodes = cap;
+    }
+    int k = s->n_nodes++;
+    memcpy(&s->X[3 * k], &s->X[3 * n], 3 * sizeof(double));
+    memcpy(&s->x[3 * k], &s->x[3 * n], 3 * sizeof(double));
+    memcpy(&s->v[3 * k], &s->v[3 * n], 3 * sizeof(double));
+    memcpy(&s->p[3 * k], &s->p[3 * n], 3 * sizeof(double));
+    s->f[3 * k] = s->f[3 * k + 1] = s->f[3 * k + 2] = 0;
+    s->m[k] = 0;
+    s->origin[k] = s->origin[n];
+    return k;
+}
+
+void cf_solid_lump_masses(cf_solid *s, const int *tets, int nt)
+{
+    for (int i = 0; i < nt; i++)
+        for (int j = 0; j < 4; j++)
+            s->m[s->tet[4 * tets[i] + j]] = 0;
+    for (int i = 0; i < nt; i++) {
+        double q = s->mat.rho * s->vol[tets[i]] / 4.0;
+        for (int j = 0; j < 4; j++)
+            s->m[s->tet[4 * tets[i] + j]] += q;
+    }
+}

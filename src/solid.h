@@ -1,0 +1,74 @@
+/* The solid: every node, tet, facet and cohesive element of the scene's
+ * bodies in one set of arrays (structure of arrays, SI units).
+ *
+ * Nodes grow by node duplication (DESIGN §3.4); tets never change count but
+ * their node indices move to duplicated copies.  `tet0` keeps the original
+ * vertex of every slot, so topology questions are asked on the reference
+ * mesh.  Face k of a tet is the face opposite its node k, with the vertex
+ * order of CF_TET_FACE[k] (outward normal for a positive tet). */
+#ifndef COHFRAC_SOLID_H
+#define COHFRAC_SOLID_H
+
+#include "cohfrac/mesh.h"
+#include "cohfrac/scene.h"
+
+extern const int CF_TET_FACE[4][3];
+
+/* One extrinsic cohesive element on facet (tet[0], face[0]) | (tet[1], face[1]).
+ * Node pair i joins slot[0][i] of tet[0] with slot[1][i] of tet[1]; the
+ * nodes are read through the tets so they follow later duplications. */
+typedef struct cf_cohesive {
+    int tet[2];
+    int slot[2][3];
+    double dn_max[3], dt_max[3]; /* PPR history: largest openings, m */
+    unsigned char failed[3];     /* complete failure per node pair */
+} cf_cohesive;
+
+typedef struct cf_solid {
+    cf_material mat;
+    double lambda, mu;        /* Lamé, Pa */
+
+    int n_nodes, cap_nodes;
+    double *X;                /* [n][3] rest positions, m */
+    double *x, *v, *p, *f;    /* [n][3] position m, velocity m/s, PBD prediction m, force N */
+    double *m;                /* [n] lumped mass, kg */
+    int *origin;              /* [n] original vertex of each copy */
+
+    int n_verts0;             /* vertices of the input meshes */
+    int n_tets;
+    int *tet;                 /* [nt][4] current node of each slot */
+    int *tet0;                /* [nt][4] original vertex of each slot */
+    double *Dm_inv;           /* [nt][9] inverse rest edge matrix, 1/m */
+    double *vol;              /* [nt] rest volume, m^3 */
+    double *rq;               /* [nt][4] corotational rotation (warm start) */
+    double *sigma;            /* [nt][9] Cauchy stress at the last check, Pa */
+    double *tf;               /* [nt][12] internal force on each slot, N */
+    int *tet_frag;            /* [nt] fragment id */
+
+    int n_facets;
+    int *facet;               /* [nf][4] tetA, faceA, tetB, faceB (tetB = -1 on the boundary) */
+    int *tet_facet;           /* [nt][4] facet of face k */
+    unsigned char *cracked;   /* [nf] */
+    int *vt_start, *vt_list;  /* original vertex -> tets (CSR, ascending) */
+
+    int n_coh, cap_coh;
+    cf_cohesive *coh;
+
+    double dt_cfl;            /* s, DESIGN §3.2 */
+} cf_solid;
+
+/* Build the solid from meshes already placed in the world frame.
+ * `tet_body` ([nt]) gives each tet's initial fragment id.
+ * Errors: CF_ERR_MESH_INVERTED (tet index), CF_ERR_NOMEM. */
+cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat,
+                        const int *tet_body, cf_error *err);
+void cf_solid_free(cf_solid *s);
+
+/* Append a copy of node n (same X, x, v, p; mass 0).  Returns the new index
+ * or -1 when out of memory. */
+int cf_solid_copy_node(cf_solid *s, int n);
+
+/* Recompute the lumped mass of the nodes of `tets` (sum of rho V/4). */
+void cf_solid_lump_masses(cf_solid *s, const int *tets, int nt);
+
+#endif

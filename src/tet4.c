@@ -1,0 +1,105 @@
+#include "tet4.h"
+
+#include "linalg.h"
+
+void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3])
+{
+    const double *Di = &s->Dm_inv[9 * t];
+    for (int i = 0; i < 3; i++) {
+        g[i + 1][0] = Di[3 * i], g[i + 1][1] = Di[3 * i + 1], g[i + 1][2] = Di[3 * i + 2];
+    }
+    for (int c = 0; c < 3; c++)
+        g[0][c] = -(g[1][c] + g[2][c] + g[3][c]);
+}
+
+/* Deformation gradient F = Ds Dm^-1 of tet t at positions x. */
+static void deformation_gradient(const cf_solid *s, int t, double F[9])
+{
+    const int *T = &s->tet[4 * t];
+    const double *x0 = &s->x[3 * T[0]];
+    double Ds[9];
+    for (int j = 0; j < 3; j++) {
+        const double *xj = &s->x[3 * T[j + 1]];
+        for (int r = 0; r < 3; r++)
+            Ds[3 * r + j] = xj[r] - x0[r];
+    }
+    m3_mul(Ds, &s->Dm_inv[9 * t], F);
+}
+
+/* Strain (symmetric part minus identity) -> linear elastic stress. */
+static void hooke(const cf_solid *s, const double A[9], double sig[9], double *energy_density)
+{
+    double eps[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            eps[3 * i + j] = 0.5 * (A[3 * i + j] + A[3 * j + i]) - (i == j);
+    double tr = eps[0] + eps[4] + eps[8];
+    double w = 0;
+    for (int k = 0; k < 9; k++) {
+        sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : 0);
+        w += 0.5 * sig[k] * eps[k];
+    }
+    if (energy_density)
+        *energy_density = w;
+}
+
+/* Stress in the element frame and the rotation that takes it to the world. */
+static void element_stress(const cf_solid *s, int t, cf_elasticity kind, double q[4], double R[9],
+                           double sig[9], double *w)
+{
+    double F[9];
+    deformation_gradient(s, t, F);
+    if (kind == CF_ELASTICITY_COROTATIONAL) {
+        double S[9];
+        polar_rotation(F, q, 30, R); /* exits early once converged */
+        m3_mul_tn(R, F, S);
+        hooke(s, S, sig, w);
+    } else {
+        R[0] = R[4] = R[8] = 1, R[1] = R[2] = R[3] = R[5] = R[6] = R[7] = 0;
+        hooke(s, F, sig, w);
+    }
+}
+
+void cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int want_stress)
+{
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < nt; i++) {
+        int t = tets[i];
+        double R[9], sig[9], P[9], g[4][3];
+        element_stress(s, t, kind, &s->rq[4 * t], R, sig, NULL);
+        m3_mul(R, sig, P); /* f_i = -V R sigma grad N_i */
+        cf_tet4_gradients(s, t, g);
+        double *tf = &s->tf[12 * t];
+        for (int a = 0; a < 4; a++) {
+            double fa[3];
+            m3_mulv(P, g[a], fa);
+            for (int c = 0; c < 3; c++)
+                tf[3 * a + c] = -s->vol[t] * fa[c];
+        }
+        if (want_stress)
+            m3_mul_nt(P, R, &s->sigma[9 * t]); /* R sigma R^T */
+    }
+}
+
+void cf_tet4_scatter(cf_solid *s, const int *tets, int nt)
+{
+    for (int i = 0; i < nt; i++) {
+        int t = tets[i];
+        const double *tf = &s->tf[12 * t];
+        for (int a = 0; a < 4; a++)
+            v3_axpy(1.0, &tf[3 * a], &s->f[3 * s->tet[4 * t + a]]);
+    }
+}
+
+double cf_tet4_strain_energy(const cf_solid *s, const int *tets, int nt, cf_elasticity kind)
+{
+    double e = 0;
+    for (int i = 0; i < nt; i++) {
+        int t = tets[i];
+        double R[9], sig[9], w;
+        double q[4] = {s->rq[4 * t], s->rq[4 * t + 1], s->rq[4 * t + 2], s->rq[4 * t + 3]};
+        element_stress(s, t, kind, q, R, sig, &w);
+        e += w * s->vol[t];
+    }
+    return e;
+}

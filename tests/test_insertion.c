@@ -1,0 +1,177 @@
+/* Extrinsic insertion and node duplication: topology, masses, momentum. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include "check.h"
+
+#include "fixtures.h"
+#include "fragments.h"
+#include "insertion.h"
+#include "linalg.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0};
+
+static void init(cf_solid *s, cf_mesh *m)
+{
+    int *body = calloc((size_t)m->n_tets, sizeof(int));
+    assert_int_equal(cf_solid_init(s, m, &mat, body, NULL), CF_OK);
+    free(body);
+    for (int i = 0; i < s->n_nodes; i++) /* a non-uniform velocity field */
+        for (int k = 0; k < 3; k++)
+            s->v[3 * i + k] = sin(1.0 + 3.7 * i + k) + 0.1 * k;
+}
+
+static void momentum(const cf_solid *s, double P[3], double *M)
+{
+    P[0] = P[1] = P[2] = 0, *M = 0;
+    for (int i = 0; i < s->n_nodes; i++) {
+        *M += s->m[i];
+        v3_axpy(s->m[i], &s->v[3 * i], P);
+    }
+}
+
+static int components(const cf_solid *s)
+{
+    int *all = malloc((size_t)s->n_tets * sizeof(int)), *comp = malloc((size_t)s->n_tets * sizeof(int));
+    for (int t = 0; t < s->n_tets; t++)
+        all[t] = t;
+    int k = cf_label_components(s, all, s->n_tets, comp);
+    free(all), free(comp);
+    return k;
+}
+
+/* Cracking the one shared facet of two tets gives two fragments, three new
+ * nodes, masses rho V/4 per tet, and conserves momentum. */
+static void test_two_tets_split_into_two_fragments(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_two_tets(&m);
+    cf_solid s;
+    init(&s, &m);
+    assert_int_equal(components(&s), 1);
+    double P0[3], M0, P1[3], M1;
+    momentum(&s, P0, &M0);
+    int f = -1;
+    for (int i = 0; i < s.n_facets; i++)
+        if (s.facet[4 * i + 2] >= 0)
+            f = i;
+    assert_true(f >= 0);
+    cf_int_list nodes = {0};
+    assert_int_equal(cf_crack_facet(&s, f, &nodes), 0);
+    assert_int_equal(s.n_nodes, 8);
+    assert_int_equal(nodes.n, 3);
+    assert_int_equal(s.n_coh, 1);
+    assert_int_equal(components(&s), 2);
+    momentum(&s, P1, &M1);
+    assert_near(M1, M0, 1e-15 * M0);
+    for (int k = 0; k < 3; k++)
+        assert_near(P1[k], P0[k], 1e-15 * (fabs(P0[k]) + M0));
+    for (int t = 0; t < 2; t++)
+        for (int j = 0; j < 4; j++)
+            assert_near(s.m[s.tet[4 * t + j]], 2400 * s.vol[t] / 4, 1e-12);
+    /* The cohesive element joins copies of the same original vertex. */
+    for (int i = 0; i < 3; i++) {
+        int a = s.tet[4 * s.coh[0].tet[0] + s.coh[0].slot[0][i]];
+        int b = s.tet[4 * s.coh[0].tet[1] + s.coh[0].slot[1][i]];
+        assert_int_not_equal(a, b);
+        assert_int_equal(s.origin[a], s.origin[b]);
+    }
+    free(nodes.v);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
+/* Crack every facet on the plane x = L/2 of a box: two fragments of equal
+ * mass, momentum to round-off.  A single interior facet alone does not split. */
+static void test_box_split_along_a_plane(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 4, 2, 2, 0.4, 0.2, 0.2);
+    cf_solid s;
+    init(&s, &m);
+    double P0[3], M0, P1[3], M1;
+    momentum(&s, P0, &M0);
+    cf_int_list nodes = {0};
+    int first = -1, cracked = 0;
+    for (int f = 0; f < s.n_facets; f++) {
+        const int *F = &s.facet[4 * f];
+        if (F[2] < 0)
+            continue;
+        int on_plane = 1;
+        for (int i = 0; i < 3; i++)
+            on_plane &= fabs(s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][i]]] - 0.2) < 1e-12;
+        if (!on_plane)
+            continue;
+        assert_int_equal(cf_crack_facet(&s, f, &nodes), 0);
+        if (first < 0) {
+            first = f;
+            assert_int_equal(components(&s), 1);
+        }
+        cracked++;
+    }
+    assert_int_equal(cracked, 2 * 2 * 2); /* 2 triangles per cell face, 2x2 faces */
+    assert_int_equal(components(&s), 2);
+    assert_int_equal(s.n_nodes, 45 + 9); /* the 3x3 plane nodes are duplicated */
+    momentum(&s, P1, &M1);
+    assert_near(M1, M0, 1e-14 * M0);
+    for (int k = 0; k < 3; k++)
+        assert_near(P1[k], P0[k], 1e-14 * (fabs(P0[k]) + M0));
+    free(nodes.v);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
+/* Facet-traction criterion under uniaxial tension sigma_xx: facets normal to x
+ * qualify, facets normal to y and z do not. */
+static void test_criterion_selects_facets_normal_to_tension(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 2, 2, 2, 1, 1, 1);
+    cf_solid s;
+    init(&s, &m);
+    for (int t = 0; t < s.n_tets; t++) {
+        memset(&s.sigma[9 * t], 0, 9 * sizeof(double));
+        s.sigma[9 * t] = 1.5 * mat.sigma_max;
+    }
+    int *all = malloc((size_t)s.n_tets * sizeof(int)), *out = malloc((size_t)s.n_tets * 4 * sizeof(int));
+    for (int t = 0; t < s.n_tets; t++)
+        all[t] = t;
+    int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, out);
+    assert_true(n > 0);
+    int normal_x = 0;
+    for (int i = 0; i < n; i++) {
+        const int *F = &s.facet[4 * out[i]];
+        double xs[3];
+        for (int j = 0; j < 3; j++)
+            xs[j] = s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][j]]];
+        normal_x += fabs(xs[0] - xs[1]) < 1e-12 && fabs(xs[1] - xs[2]) < 1e-12;
+        /* any qualifying facet has sigma_n or tau >= sigma_max: never a facet normal to y or z */
+        double ys[3], zs[3];
+        for (int j = 0; j < 3; j++) {
+            ys[j] = s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][j]] + 1];
+            zs[j] = s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][j]] + 2];
+        }
+        assert_false(fabs(ys[0] - ys[1]) < 1e-12 && fabs(ys[1] - ys[2]) < 1e-12);
+        assert_false(fabs(zs[0] - zs[1]) < 1e-12 && fabs(zs[1] - zs[2]) < 1e-12);
+    }
+    assert_int_equal(normal_x, 2 * 4); /* interior plane x = 0.5: 4 cell faces, 2 triangles each */
+    free(all), free(out);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_two_tets_split_into_two_fragments),
+        cmocka_unit_test(test_box_split_along_a_plane),
+        cmocka_unit_test(test_criterion_selects_facets_normal_to_tension),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,154 @@
+/* Tet4 elasticity: gradients, volume, lumped mass, stress, CFL estimate. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include "check.h"
+
+#include "fixtures.h"
+#include "linalg.h"
+#include "solid.h"
+#include "tet4.h"
+
+#include <math.h>
+#include <string.h>
+
+static cf_material material(double E, double nu, double rho)
+{
+    cf_material m = {E, nu, rho, 22, 22, 1e4, 1e4, 2, 2, 0.5, 0};
+    return m;
+}
+
+static void one_tet(cf_solid *s, const double x[4][3], const cf_material *mat)
+{
+    cf_mesh m = {4, 1, NULL, NULL};
+    double xs[12];
+    int t[4] = {0, 1, 2, 3}, body = 0;
+    memcpy(xs, x, sizeof xs);
+    m.x = xs, m.tets = t;
+    assert_int_equal(cf_solid_init(s, &m, mat, &body, NULL), CF_OK);
+}
+
+static const double skew[4][3] = {{0.1, 0.2, 0.0}, {1.3, 0.1, 0.2}, {0.2, 0.9, 0.1}, {0.3, 0.4, 1.1}};
+
+/* Gradients sum to zero and reproduce linear fields: sum_i x_i (x) grad N_i = I. */
+static void test_gradients_reproduce_linear_fields(void **state)
+{
+    (void)state;
+    cf_material mat = material(1e6, 0.3, 1000);
+    cf_solid s;
+    one_tet(&s, skew, &mat);
+    double g[4][3];
+    cf_tet4_gradients(&s, 0, g);
+    for (int c = 0; c < 3; c++)
+        assert_near(g[0][c] + g[1][c] + g[2][c] + g[3][c], 0.0, 1e-12);
+    for (int p = 0; p < 3; p++)
+        for (int q = 0; q < 3; q++) {
+            double acc = 0;
+            for (int i = 0; i < 4; i++)
+                acc += skew[i][p] * g[i][q];
+            assert_near(acc, p == q ? 1.0 : 0.0, 1e-12);
+        }
+    double V = cf_tet_volume(skew[0], skew[1], skew[2], skew[3]);
+    assert_near(s.vol[0], V, 1e-15);
+    for (int i = 0; i < 4; i++) /* lumped mass rho V / 4 per node */
+        assert_near(s.m[i], 1000 * V / 4, 1e-12);
+    cf_solid_free(&s);
+}
+
+/* The lumped masses of a box add up to rho * volume. */
+static void test_lumped_mass_of_box(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 3, 2, 4, 0.3, 0.2, 0.5);
+    int *body = calloc((size_t)m.n_tets, sizeof(int));
+    cf_material mat = material(1e6, 0.3, 2400);
+    cf_solid s;
+    assert_int_equal(cf_solid_init(&s, &m, &mat, body, NULL), CF_OK);
+    double M = 0;
+    for (int i = 0; i < s.n_nodes; i++)
+        M += s.m[i];
+    assert_near(M, 2400 * 0.3 * 0.2 * 0.5, 1e-12);
+    cf_solid_free(&s), cf_mesh_free(&m), free(body);
+}
+
+/* Uniaxial stretch F = diag(1+e,1,1): sigma_xx = (lambda+2mu) e, sigma_yy = lambda e;
+ * the nodal forces balance (sum zero). */
+static void stretch_case(cf_elasticity kind)
+{
+    cf_material mat = material(2e6, 0.25, 1000);
+    cf_solid s;
+    one_tet(&s, skew, &mat);
+    double e = 1e-4;
+    for (int i = 0; i < 4; i++)
+        s.x[3 * i] = (1 + e) * s.X[3 * i];
+    int t = 0;
+    cf_tet4_forces(&s, &t, 1, kind, 1);
+    double lam = s.lambda, mu = s.mu;
+    assert_near(s.sigma[0], (lam + 2 * mu) * e, 1e-6 * (lam + 2 * mu) * e);
+    assert_near(s.sigma[4], lam * e, 1e-6 * (lam + 2 * mu) * e);
+    assert_near(s.sigma[8], lam * e, 1e-6 * (lam + 2 * mu) * e);
+    for (int c = 0; c < 3; c++)
+        assert_near(s.tf[c] + s.tf[3 + c] + s.tf[6 + c] + s.tf[9 + c], 0.0, 1e-9);
+    /* f_i = -V sigma grad N_i */
+    double g[4][3];
+    cf_tet4_gradients(&s, 0, g);
+    for (int a = 0; a < 4; a++)
+        assert_near(s.tf[3 * a], -s.vol[0] * s.sigma[0] * g[a][0], 1e-6 * fabs(s.sigma[0]));
+    cf_solid_free(&s);
+}
+static void test_uniaxial_stretch_corotational(void **state) { (void)state; stretch_case(CF_ELASTICITY_COROTATIONAL); }
+static void test_uniaxial_stretch_linear(void **state) { (void)state; stretch_case(CF_ELASTICITY_LINEAR); }
+
+/* A rigid rotation makes no corotational stress; small strain sees a spurious one. */
+static void test_rigid_rotation_is_stress_free(void **state)
+{
+    (void)state;
+    cf_material mat = material(1e6, 0.3, 1000);
+    cf_solid s;
+    one_tet(&s, skew, &mat);
+    double q[4] = {cos(0.6), sin(0.6) / sqrt(3), sin(0.6) / sqrt(3), sin(0.6) / sqrt(3)}, R[9];
+    quat_to_mat(q, R);
+    for (int i = 0; i < 4; i++)
+        m3_mulv(R, &s.X[3 * i], &s.x[3 * i]);
+    int t = 0;
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, 1);
+    for (int k = 0; k < 12; k++)
+        assert_near(s.tf[k], 0.0, 1e-9 * s.mu * s.vol[0]);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_LINEAR, 1);
+    double fmax = 0;
+    for (int k = 0; k < 12; k++)
+        fmax = fmax > fabs(s.tf[k]) ? fmax : fabs(s.tf[k]);
+    assert_true(fmax > 1e-3 * s.mu * s.vol[0]);
+    cf_solid_free(&s);
+}
+
+/* dt_cfl = 2 r_in / c_d: for a regular tet of edge a, 2 r_in = a / sqrt(6). */
+static void test_cfl_of_regular_tet(void **state)
+{
+    (void)state;
+    double a = 0.01;
+    const double x[4][3] = {{0, 0, 0}, {a, 0, 0}, {a / 2, a * sqrt(3) / 2, 0},
+                            {a / 2, a * sqrt(3) / 6, a * sqrt(2.0 / 3.0)}};
+    cf_material mat = material(70e9, 0.22, 2500);
+    cf_solid s;
+    one_tet(&s, x, &mat);
+    double cd = sqrt(70e9 * 0.78 / (2500 * 1.22 * 0.56));
+    assert_near(s.dt_cfl, a / sqrt(6.0) / cd, 1e-9 * s.dt_cfl);
+    cf_solid_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_gradients_reproduce_linear_fields),
+        cmocka_unit_test(test_lumped_mass_of_box),
+        cmocka_unit_test(test_uniaxial_stretch_corotational),
+        cmocka_unit_test(test_uniaxial_stretch_linear),
+        cmocka_unit_test(test_rigid_rotation_is_stress_free),
+        cmocka_unit_test(test_cfl_of_regular_tet),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
