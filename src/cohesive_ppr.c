@@ -54,52 +54,86 @@ void cf_ppr_traction(const cf_ppr *p, double dn, double dt, double *dn_max, doub
     *Tt = (dt >= *dt_max) ? et : (*dt_max > 0 ? et * dt / *dt_max : et);
 }
 
-int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, int first, int last, double dt)
+/* The current nodes of pair i of element ce, side A and side B. */
+static void pair_nodes(const cf_solid *s, const cf_cohesive *ce, int i, int *a, int *b)
+{
+    *a = s->tet[4 * ce->tet[0] + ce->slot[0][i]];
+    *b = s->tet[4 * ce->tet[1] + ce->slot[1][i]];
+}
+
+/* Unit normal (A -> B) and area of element ce's mid-surface at positions pos. */
+static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double *pos, int a[3],
+                         int b[3], double n[3])
+{
+    double mid[3][3];
+    for (int i = 0; i < 3; i++) {
+        pair_nodes(s, ce, i, &a[i], &b[i]);
+        for (int k = 0; k < 3; k++)
+            mid[i][k] = 0.5 * (pos[3 * a[i] + k] + pos[3 * b[i] + k]);
+    }
+    double e1[3], e2[3];
+    v3_sub(mid[1], mid[0], e1), v3_sub(mid[2], mid[0], e2), v3_cross(e1, e2, n);
+    double nn = v3_norm(n);
+    for (int k = 0; k < 3 && nn > 0; k++)
+        n[k] /= nn;
+    return 0.5 * nn;
+}
+
+int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n)
 {
     int n_failed = 0;
-    for (int c = first; c < last; c++) {
-        cf_cohesive *ce = &s->coh[c];
+    for (int e = 0; e < n; e++) {
+        cf_cohesive *ce = &s->coh[elems[e]];
         int a[3], b[3];
-        double mid[3][3];
-        for (int i = 0; i < 3; i++) {
-            a[i] = s->tet[4 * ce->tet[0] + ce->slot[0][i]];
-            b[i] = s->tet[4 * ce->tet[1] + ce->slot[1][i]];
-            for (int k = 0; k < 3; k++)
-                mid[i][k] = 0.5 * (s->x[3 * a[i] + k] + s->x[3 * b[i] + k]);
-        }
-        double e1[3], e2[3], n[3];
-        v3_sub(mid[1], mid[0], e1), v3_sub(mid[2], mid[0], e2), v3_cross(e1, e2, n);
-        double nn = v3_norm(n);
-        if (nn == 0)
+        double nrm[3];
+        double area = mid_normal(s, ce, s->x, a, b, nrm);
+        if (area == 0)
             continue;
-        double area = 0.5 * nn;
-        for (int k = 0; k < 3; k++)
-            n[k] /= nn;
         for (int i = 0; i < 3; i++) {
             if (a[i] == b[i]) /* the crack has not opened at this vertex yet */
                 continue;
             double d[3], tv[3];
             v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
-            double dn = v3_dot(d, n);
+            double dn = v3_dot(d, nrm);
             for (int k = 0; k < 3; k++)
-                tv[k] = d[k] - dn * n[k];
+                tv[k] = d[k] - dn * nrm[k];
             double dtl = v3_norm(tv);
             double Tn, Tt;
             cf_ppr_traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
             n_failed += ce->failed[i];
             double fvec[3] = {0, 0, 0};
-            double w = area / 3.0;
-            if (dn < 0) { /* penalty contact, stable with margin for a node in 3 pairs */
-                double mmin = s->m[a[i]] < s->m[b[i]] ? s->m[a[i]] : s->m[b[i]];
-                v3_axpy(0.1 * mmin / (dt * dt) * dn, n, fvec);
-            } else {
-                v3_axpy(w * Tn, n, fvec);
-            }
+            if (dn > 0)
+                v3_axpy(area / 3.0 * Tn, nrm, fvec);
             if (dtl > 0)
-                v3_axpy(w * Tt / dtl, tv, fvec);
-            v3_axpy(1.0, fvec, &s->f[3 * a[i]]);  /* pulls A towards B */
+                v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
+            v3_axpy(1.0, fvec, &s->f[3 * a[i]]); /* pulls A towards B */
             v3_axpy(-1.0, fvec, &s->f[3 * b[i]]);
         }
     }
     return n_failed;
+}
+
+void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
+{
+    for (int e = 0; e < n; e++) {
+        int a[3], b[3];
+        double nrm[3];
+        double area = mid_normal(s, &s->coh[elems[e]], s->p, a, b, nrm);
+        if (area == 0)
+            continue;
+        for (int i = 0; i < 3; i++) {
+            if (a[i] == b[i])
+                continue;
+            double d[3];
+            v3_sub(&s->p[3 * b[i]], &s->p[3 * a[i]], d);
+            double dn = v3_dot(d, nrm);
+            /* Only faces still facing each other: once the sides have moved
+             * apart by more than the facet's size the mid-surface means nothing. */
+            if (dn >= 0 || v3_dot(d, d) > 0.25 * area)
+                continue;
+            double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]], c = dn / (wa + wb);
+            v3_axpy(wa * c, nrm, &s->p[3 * a[i]]);
+            v3_axpy(-wb * c, nrm, &s->p[3 * b[i]]);
+        }
+    }
 }

@@ -30,11 +30,18 @@ void cf_ppr_envelope(const cf_ppr *p, double dn, double dt, double *Tn, double *
 void cf_ppr_traction(const cf_ppr *p, double dn, double dt, double *dn_max, double *dt_max,
                      unsigned char *failed, double *Tn, double *Tt);
 
-/* Add the forces of every cohesive element in [first, last) to s->f.
- * Nodal (Newton-Cotes) integration: each node pair carries traction * A/3.
- * Compression is resisted by a penalty whose per-pair stiffness is
- * 0.1 m_min / dt^2 (a twentieth of the explicit bound 2 m_min / dt^2 of one
- * pair, so a node copy in several pairs stays stable), dt the step size.  Returns the number of node pairs in complete failure. */
-int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, int first, int last, double dt);
+/* Add the forces of the cohesive elements elems[0..n) to s->f.
+ * Nodal (Newton-Cotes) integration: each node pair carries traction * A/3,
+ * A the current mid-surface area, normal from side A to side B.  Returns the
+ * number of node pairs in complete failure. */
+int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n);
+
+/* Compression across a crack: a PBD non-penetration constraint on the
+ * predicted positions s->p, Delta_n >= 0 for every open node pair, the
+ * correction split by inverse masses, for pairs closer than half the facet's
+ * size (sqrt(A)/2).  It lives in the relaxation loop with
+ * the bars and the obstacles, so it is stable at any dt (a penalty force at
+ * the PBD time steps used here is not). */
+void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n);
 
 #endif

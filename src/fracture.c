@@ -59,12 +59,6 @@ static cf_status check_and_insert(cf_sim *sim, cf_fragment *f, int *inserted)
     return CF_OK;
 }
 
-/* Cohesive forces of this fragment's elements (they are few; one call each). */
-static void cohesive_forces(cf_sim *sim, cf_fragment *f, double dt)
-{
-    for (int i = 0; i < f->coh.n; i++)
-        cf_cohesive_forces(&sim->solid, &sim->ppr, f->coh.v[i], f->coh.v[i] + 1, dt);
-}
 
 /* Friction and restitution of nodes in contact, relative to the obstacle. */
 static void contact_velocities(cf_sim *sim, cf_fragment *f, double t)
@@ -133,7 +127,7 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
     }
     if (fracture) {
         cf_tet4_scatter(s, f->tets, f->nt);
-        cohesive_forces(sim, f, dt);
+        cf_cohesive_forces(s, &sim->ppr, f->coh.v, f->coh.n);
     }
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
@@ -144,7 +138,7 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
     double t1 = cf_wall_time();
     sim->prof.forces += t1 - t0;
 
-    /* Prediction, then PBD bars and collision constraints. */
+    /* Prediction, then PBD bars, crack and obstacle collision constraints. */
     double t_next = t + dt;
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
@@ -155,6 +149,8 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
     }
     for (int it = 0; it < set->iterations; it++) {
         cf_bars_project(&f->bars, s, set->k_stiffness);
+        if (fracture)
+            cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
         for (int i = 0; i < nn; i++) {
             int a = nodes[i];
             double n[3];

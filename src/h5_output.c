@@ -1096,6 +1096,17 @@ static cf_status write_connectivity(cf_h5 *h, cf_error *err)
     return ok ? CF_OK : h5_fail(err, h->path, "writing /xdmf/polyvertex");
 }
 
+/* Shortest "%g" text that reads back as exactly `v` (0.03, not
+ * 0.029999999999999999). */
+static void format_double(char *buf, size_t n, double v)
+{
+    for (int prec = 15; prec <= 17; ++prec) {
+        snprintf(buf, n, "%.*g", prec, v);
+        if (strtod(buf, NULL) == v)
+            return;
+    }
+}
+
 /* What every grid of the sidecar refers to. */
 typedef struct xdmf_ctx {
     FILE *fp;
@@ -1150,16 +1161,18 @@ static void put_xdmf(const xdmf_ctx *x, const cf_h5 *h)
         if (r->count == 0)
             continue; /* readers do not accept a grid without points */
         unsigned long long n = (unsigned long long)r->count;
+        char time_text[32];
+        format_double(time_text, sizeof time_text, r->time);
         fprintf(fp,
                 "      <Grid Name=\"frame_%06llu\" GridType=\"Uniform\">\n"
-                "        <Time Value=\"%.17g\"/>\n"
+                "        <Time Value=\"%s\"/>\n"
                 "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%llu\" "
                 "NodesPerElement=\"1\">\n"
                 "          <DataItem Dimensions=\"%llu\" NumberType=\"Int\" Precision=\"4\" "
                 "Format=\"HDF\">%s:/xdmf/polyvertex|%llu:1:%llu:%llu</DataItem>\n"
                 "        </Topology>\n"
                 "        <Geometry GeometryType=\"XYZ\">\n",
-                (unsigned long long)t, r->time, n, n, x->href, (unsigned long long)r->first, n,
+                (unsigned long long)t, time_text, n, n, x->href, (unsigned long long)r->first, n,
                 M);
         put_frame_slab(x, t, r->ncols, FLD_POSITION);
         fputs("        </Geometry>\n", fp);

@@ -269,11 +269,16 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
             g->steps = 0;
         }
     }
-    /* Siblings born in one split do not collide with each other: their single
-     * convex hulls overlap where the crack surface is not convex. */
-    if (sim->bullet && k > 1)
+    /* Fragments of one body do not collide with each other: a single convex
+     * hull per fragment overlaps its neighbours wherever the crack surface is
+     * not convex, and Bullet would push them apart explosively. */
+    if (sim->bullet) {
+        int root = fi;
+        while (sim->frag[root].parent >= 0)
+            root = sim->frag[root].parent;
         for (int a = 0; a < k; a++)
-            cfb_set_family(sim->bullet, sim->frag[first + a].body, fi);
+            cfb_set_family(sim->bullet, sim->frag[first + a].body, root);
+    }
     if (sim->bullet || k > 1)
         cf_bars_free(&sim->frag[fi].bars);
     free(tets), free(comp), free(seen);

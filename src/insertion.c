@@ -65,10 +65,14 @@ static int nodal_principal(const cf_solid *s, const int *tets, int nt, double *o
     for (int i = 0; i < nt; i++)
         for (int j = 0; j < 4; j++) {
             int n = s->tet[4 * tets[i] + j];
+            double *a = &acc[10 * n];
+            if (a[9] == 0) /* done already */
+                continue;
             double sig[9];
             for (int k = 0; k < 9; k++)
-                sig[k] = acc[10 * n + k] / acc[10 * n + 9];
+                sig[k] = a[k] / a[9];
             out[n] = max_principal(sig);
+            a[9] = 0;
         }
     free(acc);
     return 0;

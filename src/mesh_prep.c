@@ -18,8 +18,10 @@
  *     from the measured count, at most 3 times), aiming a little low.
  *   - The remaining gap is closed with a maximum tet volume -a: modelling
  *     N(a) = N0 + C / a, the first guess is C = V (the enclosed volume) and
- *     later guesses fit the last two runs; accepted within ±5 %, at most 6
- *     runs, otherwise the closest run is kept.
+ *     later guesses fit the last two runs; accepted within ±5 %, at most 8
+ *     runs, otherwise the closest run is kept.  If the first -a run barely
+ *     adds tets, the surface is too coarse for -Y (every tet touches it) and
+ *     the search goes on with "-pq2.0a<a>F", letting tetgen split facets.
  * target_tets = 0 runs plain "tetgen -pqF" on the full surface.
  */
 #define _XOPEN_SOURCE 700 /* POSIX 2008 + realpath */
@@ -50,7 +52,7 @@ extern char **environ;
 #define TETS_PER_TRI 2.4 /* tetgen -pYq2.0 tets per surface triangle (bunny: 2.3-2.5) */
 #define BASE_OPTS "pYq2.0"
 #define TOL 0.05
-#define MAX_A_RUNS 6
+#define MAX_A_RUNS 8
 
 static double now_s(void)
 {
@@ -453,11 +455,12 @@ static cf_status fit_size(const cf_surface *s, int target, const char *dir, int 
         return CF_OK;
     /* Fill with a maximum volume: N(a) ~ N0 + C / a. */
     double V = cf_surface_volume(cur);
-    double a_prev = INFINITY, n_prev = n, C = V;
-    double a = C / (target - n);
+    double a_prev = INFINITY, n_prev = n;
+    double a = V / (target - n);
+    const char *base_opts = BASE_OPTS;
     for (int run = 0; run < MAX_A_RUNS; run++) {
         char opts[64];
-        snprintf(opts, sizeof opts, BASE_OPTS "a%.3gF", a);
+        snprintf(opts, sizeof opts, "%sa%.3gF", base_opts, a);
         a = strtod(strchr(opts, 'a') + 1, NULL); /* exactly the value tetgen gets */
         trial u = {{0}, {0}};
         if ((st = tetgen_trial(dir, opts, &u, verbose, err)) != CF_OK) {
@@ -473,11 +476,23 @@ static cf_status fit_size(const cf_surface *s, int target, const char *dir, int 
         }
         if (fabs((double)nu / target - 1) <= TOL)
             break;
+        if (run == 0 && nu - n < 0.1 * (target - n)) {
+            /* -Y blocks the fill: on a coarse surface every tet touches
+             * the boundary and cannot be split without splitting a facet.
+             * Let tetgen add points on the facets (the shape is kept: they
+             * lie in the facets' planes). */
+            base_opts = "pq2.0";
+            if (verbose)
+                fprintf(stderr, "  the surface is too coarse to fill with -Y; letting tetgen "
+                                "refine it\n");
+            continue;
+        }
         /* Fit N = N0 + C / a through this run and the previous one. */
         double inv_p = isinf(a_prev) ? 0.0 : 1.0 / a_prev, inv = 1.0 / a;
         double Cfit = (nu - n_prev) / (inv - inv_p);
         double N0 = nu - Cfit * inv;
-        double next = (Cfit > 0 && target > N0) ? Cfit / (target - N0) : (nu < target ? a / 2 : a * 2);
+        double next = (Cfit > 0 && target > N0) ? Cfit / (target - N0)
+                                                : (nu < target ? a / 2 : a * 2);
         /* keep steps moderate: within a factor of 4 */
         if (next > 4 * a)
             next = 4 * a;
@@ -536,11 +551,13 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
     cf_surface s = {0}, dec = {0};
     const cf_surface *used = &s;
     trial best = {{0}, {0}};
-    char dir[PATH_MAX] = "";
+    char dir[512] = ""; /* short, so every path built from it fits PATH_MAX */
     if ((st = load_clean_surface(o, &s, err)) != CF_OK)
         goto out;
     const char *tmpdir = getenv("TMPDIR");
-    snprintf(dir, sizeof dir, "%s/cohfrac-mesh-XXXXXX", tmpdir && *tmpdir ? tmpdir : "/tmp");
+    if (!tmpdir || !*tmpdir || strlen(tmpdir) > 400)
+        tmpdir = "/tmp";
+    snprintf(dir, sizeof dir, "%s/cohfrac-mesh-XXXXXX", tmpdir);
     if (!mkdtemp(dir)) {
         st = cf_error_set(err, CF_ERR_OUTPUT, "cannot create a temporary directory %s (%s)", dir,
                           strerror(errno));

@@ -265,7 +265,8 @@ static cf_status load_off(const char *path, char *text, dbuf *v, ibuf *t, cf_err
         return cf_error_set(err, CF_ERR_MESH_PARSE, "%s:%d: expected the header 'OFF'", path, line);
     s = skip_ws(s + hl);
     if (!*s && !(s = off_line(&p, &line)))
-        return cf_error_set(err, CF_ERR_MESH_PARSE, "%s:%d: missing '<#vertices> <#faces> <#edges>'",
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s:%d: missing '<#vertices> <#faces> <#edges>'",
                             path, line);
     long nv, nf;
     if (parse_long(&s, &nv) || parse_long(&s, &nf) || nv < 0 || nf < 0 || nv > 0x7fffffffL)
@@ -351,10 +352,33 @@ static int weld_init(weld *w, size_t expect, dbuf *v)
     return 0;
 }
 
-/* Index of point x, adding it if new; -1 on memory error.  The table is
- * sized for all corners up front, so it never needs to grow. */
+/* Double the table when half full (keeps probe chains short and
+ * guarantees a free slot). */
+static int weld_grow(weld *w)
+{
+    size_t cap = 2 * (w->mask + 1);
+    int *slot = malloc(cap * sizeof *slot);
+    if (!slot)
+        return -1;
+    memset(slot, 0xff, cap * sizeof *slot);
+    int n = (int)(w->v->n / 3);
+    for (int k = 0; k < n; k++) {
+        size_t i = (size_t)hash3(&w->v->a[3 * (size_t)k]) & (cap - 1);
+        while (slot[i] >= 0)
+            i = (i + 1) & (cap - 1);
+        slot[i] = k;
+    }
+    free(w->slot);
+    w->slot = slot;
+    w->mask = cap - 1;
+    return 0;
+}
+
+/* Index of point x, adding it if new; -1 on memory error. */
 static int weld_get(weld *w, const double x[3])
 {
+    if (2 * (w->v->n / 3 + 1) > w->mask + 1 && weld_grow(w))
+        return -1;
     size_t i = (size_t)hash3(x) & w->mask;
     for (;;) {
         int k = w->slot[i];
@@ -420,8 +444,8 @@ static cf_status load_stl(const char *path, unsigned char *buf, size_t len, dbuf
                             "%s: neither ASCII STL (starts with 'solid') nor binary STL (84 + 50 "
                             "bytes per triangle; this file has %zu bytes)",
                             path, len);
-    /* Rough upper bound on corners from the file size, for the weld table. */
-    if (weld_init(&w, len / 20 + 16, v))
+    /* a facet takes at least ~80 bytes: size the table from that */
+    if (weld_init(&w, len / 80 + 16, v))
         return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
     cf_status st = CF_OK;
     char *p = (char *)buf;
@@ -667,11 +691,10 @@ int cf_surface_check_closed(const cf_surface *s, char *why, size_t why_len)
         do {
             /* In triangle (v, x, y) the edge y->v is followed by v->y in the
              * neighbour across it, which continues the fan around v. */
-            int t = h[e].tri, x = h[e].to, y = -1;
+            int t = h[e].tri, y = -1;
             for (int k = 0; k < 3; k++)
                 if (s->tri[3 * t + k] == v)
                     y = s->tri[3 * t + (k + 2) % 3];
-            (void)x;
             e = hedge_find(h, nh, v, y);
             steps++;
         } while (e != i && e >= 0 && steps <= deg[v]);
@@ -713,7 +736,10 @@ static void cross3(const double *u, const double *v, double *w)
     w[2] = u[0] * v[1] - u[1] * v[0];
 }
 
-static double dot3(const double *u, const double *v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
+static double dot3(const double *u, const double *v)
+{
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
 
 static void sub3(const double *a, const double *b, double *c)
 {
@@ -1039,7 +1065,8 @@ static long find_pairs(const cf_surface *s, int **out)
     ibuf pairs = {0};
     int oom = 0;
     for (size_t c = 0; c < ncell && !oom; c++) {
-        int cx = (int)(c % dim[0]), cy = (int)(c / dim[0] % dim[1]), cz = (int)(c / dim[0] / dim[1]);
+        int cx = (int)(c % dim[0]), cy = (int)(c / dim[0] % dim[1]);
+        int cz = (int)(c / dim[0] / dim[1]);
         for (size_t i = start[c]; i < start[c + 1] && !oom; i++)
             for (size_t j = i + 1; j < start[c + 1]; j++) {
                 int a = items[i], b = items[j];
@@ -1505,8 +1532,10 @@ static int try_collapse(decim *d, int a, int b)
         }
     if (common != 2)
         return 0;
-    /* Keep every vertex at valence >= 3 (valence = live triangles here). */
-    if (d->vtn[opp[0]] <= 3 || d->vtn[opp[1]] <= 3 || d->vtn[a] + d->vtn[b] - 4 < 3)
+    /* Keep every vertex at valence >= 4 (valence = live triangles here): a
+     * valence-3 vertex makes tetgen use the tet of it and its neighbours,
+     * a sliver where the surface is nearly flat. */
+    if (d->vtn[opp[0]] <= 4 || d->vtn[opp[1]] <= 4 || d->vtn[a] + d->vtn[b] - 4 < 4)
         return 0;
     if (!collapse_ok(d, a, b, p))
         return 0;
@@ -1638,3 +1667,4 @@ done:
     free(d.heap.e);
     return result;
 }
+

@@ -17,13 +17,19 @@ typedef struct cf_surface {
     int *tri;  /* [n_tris][3] 0-based, counter-clockwise seen from outside */
 } cf_surface;
 
-/* Load a surface; the format is taken from the extension (.obj, .off, .stl).
- * OBJ polygons are fan-triangulated; normals/texcoords are ignored; STL
- * vertices are welded exactly.
- * Errors: CF_ERR_FILE_OPEN, CF_ERR_MESH_PARSE (file:line), CF_ERR_MESH_INDEX. */
+/* Load a surface; the format is taken from the extension (.obj, .off, .stl;
+ * any case).  OBJ polygons are fan-triangulated (negative, relative indices
+ * allowed); normals/texcoords are ignored; OFF may be COFF/NOFF... with
+ * extra per-line data; STL may be ASCII or binary (told apart by the binary
+ * size rule 84 + 50 n) and its vertices are welded exactly.  Triangles with
+ * a repeated corner are dropped.  Vertices are kept as given (unused ones
+ * too).  On error `s` is left empty.
+ * Errors: CF_ERR_FILE_OPEN, CF_ERR_MESH_PARSE (file:line), CF_ERR_MESH_INDEX
+ * (file:line), CF_ERR_NOMEM. */
 cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err);
 
-/* Write as OFF (used to hand the surface to tetgen). Error CF_ERR_OUTPUT. */
+/* Write as OFF, 0-based, coordinates with %.17g (used to hand the surface
+ * to tetgen).  Error CF_ERR_OUTPUT. */
 cf_status cf_surface_write_off(const cf_surface *s, const char *path, cf_error *err);
 
 /* Find pairs of triangles that intersect other than at a shared vertex or
@@ -38,9 +44,13 @@ int cf_surface_self_intersections(const cf_surface *s, int *pairs, int max_pairs
 /* Repair the defect class of DESIGN §9: a valence-3 vertex whose three
  * triangles overlap their neighbours.  Such a vertex is removed and its three
  * triangles replaced by the one triangle of its three neighbours.  Only
- * vertices touching an intersecting pair are considered.  Returns the number
- * of vertices removed (>= 0).  The surface is compacted (unused vertices
- * dropped). */
+ * vertices touching an intersecting pair are considered; a vertex is kept
+ * when the cap triangle already exists or a neighbour would drop below
+ * valence 3.  Repeats (intersection search, removal) until no intersection
+ * is left or nothing more can be removed.  Returns the number of vertices
+ * removed (>= 0), -1 when out of memory.  The surface is compacted (dead
+ * triangles and unused vertices dropped, order otherwise kept).  It does
+ * not promise that no intersection remains: check afterwards. */
 int cf_surface_repair_valence3(cf_surface *s);
 
 /* Enclosed volume (divergence theorem), file units cubed; positive when the
@@ -64,9 +74,10 @@ int cf_surface_check_closed(const cf_surface *s, char *why, size_t why_len);
  * (Garland & Heckbert 1997), cheapest collapse first with a fixed
  * tie-break, so the result is reproducible.  A collapse is refused when it
  * breaks the link condition (would pinch the surface), leaves a vertex of
- * valence < 3, flips or turns a triangle by more than 60 degrees or makes a
- * needle; boundary edges are never collapsed.  Stops early when no valid
- * collapse is left.  The vertex positions move (optimal quadric points);
+ * valence < 4 (tetgen turns those into slivers where the surface is flat),
+ * flips or turns a triangle by more than 60 degrees or makes a needle;
+ * boundary edges are never collapsed.  Stops early when no valid collapse
+ * is left.  The vertex positions move (optimal quadric points);
  * unused vertices are dropped.  Returns the new triangle count, -1 when out
  * of memory.  It does not test for self-intersections: check afterwards. */
 int cf_surface_decimate(cf_surface *s, int target_tris);
@@ -81,15 +92,30 @@ typedef struct cf_mesh_prep_opts {
     int verbose;          /* print what is done to stderr */
 } cf_mesh_prep_opts;
 
-/* Load, report self-intersections (face indices) and repair them, coarsen
- * the surface if `target_tets` needs it, run tetgen, check orientation and
- * volume of the result against the surface's enclosed volume, and write
- * <output>.node/.ele.  Skips all work when the outputs exist and are newer
- * than the input and were made with the same options (a stamp file
- * <output>.stamp records them).
- * Errors: as cf_surface_load, CF_ERR_SURFACE_INTERSECT (intersections left
- * after repair: lists face pairs), CF_ERR_EXTERNAL (tetgen missing or
- * failed: its output is quoted), CF_ERR_MESH_INVERTED. */
+/* Load, report self-intersections (face indices) and repair them, check the
+ * surface is a closed manifold, coarsen it if `target_tets` needs it, run
+ * tetgen, orient every tet positively, check the tets' total volume against
+ * the surface's enclosed volume (1e-6 relative), and write
+ * <output>.node/.ele (0-based, %.17g; coordinates in the surface's file
+ * units and axes: no scaling or rotation).  The output directory is created
+ * if missing.  Skips all work (printing "cached" when verbose) when the
+ * outputs exist and are newer than the input and were made with the same
+ * options and input (path, size, mtime; the stamp file <output>.stamp
+ * records them).
+ * Size: target_tets = N > 0 gives N tets within about 5 % (deterministic:
+ * the same input always gives the same mesh): tetgen -pYq2.0 keeps the
+ * surface; a surface too fine for N is decimated first (about 2.4 tets per
+ * surface triangle) and a maximum tet volume -a fills up to N.  N = 0 runs
+ * plain tetgen -pq on the full surface.  The stamp lists the options used.
+ * The program is `tetgen` from PATH, or $COHFRAC_TETGEN; temporary files go
+ * to $TMPDIR (default /tmp) and are removed.
+ * Errors: as cf_surface_load, CF_ERR_USAGE (missing paths, N < 0),
+ * CF_ERR_MESH_PARSE (surface not closed or encloses no volume: names the
+ * edge/vertex), CF_ERR_SURFACE_INTERSECT (intersections left after repair,
+ * or made by decimation: lists face pairs), CF_ERR_EXTERNAL (tetgen missing
+ * or failed: its output is quoted; or its tets do not fill the surface),
+ * CF_ERR_MESH_INVERTED (degenerate tet in tetgen's output), CF_ERR_OUTPUT,
+ * CF_ERR_NOMEM. */
 cf_status cf_mesh_prepare(const cf_mesh_prep_opts *opts, cf_error *err);
 
 #endif
