@@ -34,6 +34,7 @@ return {
     dt_rigid = 1e-3, rigid_substeps = 5,
     dt_fracture = 5e-6, check_interval = 1, quiet_steps = 400,
     elasticity = "corotational", criterion = "source",
+    impact_threshold = 1.0,   -- m/s: the first impact is 3.1 m/s; settling fragments stay rigid
     pbd = { k_stiffness = 0.9, iterations = 3, k_damping = 1.0 },
   },
   output = { file = "out/bunny_drop.h5", frame_interval = 0.005 },

@@ -50,9 +50,12 @@ static double max_principal(const double A[9])
  * (written at the node's index of `out`, which has s->n_nodes entries). */
 static int nodal_principal(const cf_solid *s, const int *tets, int nt, double *out)
 {
-    double *acc = calloc((size_t)s->n_nodes * 10, sizeof(double));
+    double *acc = malloc((size_t)s->n_nodes * 10 * sizeof(double));
     if (!acc)
         return -1;
+    for (int i = 0; i < nt; i++) /* clear only this fragment's nodes */
+        for (int j = 0; j < 4; j++)
+            memset(&acc[10 * s->tet[4 * tets[i] + j]], 0, 10 * sizeof(double));
     for (int i = 0; i < nt; i++) {
         int t = tets[i];
         for (int j = 0; j < 4; j++) {

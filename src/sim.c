@@ -366,6 +366,19 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
     return 1;
 }
 
+/* A fragment with no uncracked interior facet (a single tet, say) cannot
+ * break further: an impact leaves it in rigid mode. */
+static int can_break(const cf_solid *s, const cf_fragment *f)
+{
+    for (int i = 0; i < f->nt; i++)
+        for (int k = 0; k < 4; k++) {
+            int fc = s->tet_facet[4 * f->tets[i] + k];
+            if (s->facet[4 * fc + 2] >= 0 && !s->cracked[fc])
+                return 1;
+        }
+    return 0;
+}
+
 /* Advance the rigid fragments by one rigid step; detect impacts. */
 static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
 {
@@ -387,7 +400,8 @@ static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
             if (f->body < 0 || f->mode != CF_MODE_RIGID)
                 continue;
             double dv = cfb_contact_impulse(sim->bullet, f->body) / f->mass;
-            if (dv > set->impact_threshold) { /* redo this step in fracture mode */
+            if (dv > set->impact_threshold && can_break(&sim->solid, f)) {
+                /* redo this step in fracture mode */
                 double th = cf_wall_time();
                 cf_status st = cf_handoff_to_fracture(sim, fi, &pre[fi], err);
                 sim->prof.handoff += cf_wall_time() - th;
@@ -403,7 +417,7 @@ static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
     for (int fi = 0; fi < n; fi++) {
         if (sim->frag[fi].mode != CF_MODE_RIGID)
             continue;
-        if (cf_pbd_impact(sim, fi, dt)) {
+        if (cf_pbd_impact(sim, fi, dt) && can_break(&sim->solid, &sim->frag[fi])) {
             cf_status st = cf_handoff_to_fracture(sim, fi, NULL, err);
             if (st != CF_OK)
                 return st;
