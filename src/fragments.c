@@ -127,7 +127,7 @@ void cf_nodes_state(const cf_solid *s, const int *nodes, int nn, double q[4], cf
     fro = sqrt(fro);
     for (int k = 0; k < 9 && fro > 0; k++)
         A[k] /= fro;
-    polar_rotation(A, q, 100, st->R);
+    polar_rotation(A, q, 100, 1e-14, st->R);
 }
 
 void cf_nodes_inertia(const cf_solid *s, const int *nodes, int nn, const double *pos,

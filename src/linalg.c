@@ -95,7 +95,7 @@ void mat_to_quat(const double R[9], double q[4])
     quat_normalize(q);
 }
 
-void polar_rotation(const double F[9], double q[4], int max_iter, double R[9])
+void polar_rotation(const double F[9], double q[4], int max_iter, double tol, double R[9])
 {
     quat_normalize(q);
     for (int it = 0; it < max_iter; it++) {
@@ -111,7 +111,7 @@ void polar_rotation(const double F[9], double q[4], int max_iter, double R[9])
         double s = 1.0 / (fabs(dotsum) + 1e-9);
         om[0] *= s, om[1] *= s, om[2] *= s;
         double angle = v3_norm(om);
-        if (angle < 1e-10) /* rotation converged far below any strain of interest */
+        if (angle < tol)
             break;
         double half = 0.5 * angle, sh = sin(half) / angle;
         double dq[4] = {cos(half), om[0] * sh, om[1] * sh, om[2] * sh};

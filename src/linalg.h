@@ -53,8 +53,9 @@ double m3_inv(const double A[9], double out[9]);
 /* Rotation part R of F = R S (polar decomposition), by the quaternion
  * iteration of Müller, Bender, Chentanez, Macklin 2016 ("A robust method to
  * extract the rotational part of deformations"); q is the warm start and is
- * updated (w,x,y,z).  Robust for inverted F (returns a proper rotation). */
-void polar_rotation(const double F[9], double q[4], int max_iter, double R[9]);
+ * updated (w,x,y,z).  Stops when the update angle falls below tol (rad).
+ * Robust for inverted F (returns a proper rotation). */
+void polar_rotation(const double F[9], double q[4], int max_iter, double tol, double R[9]);
 
 /* Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi:
  * A = V diag(w) V^T, V's columns are the eigenvectors, det V = +1. */

@@ -51,7 +51,7 @@ static void element_stress(const cf_solid *s, int t, cf_elasticity kind, double 
     deformation_gradient(s, t, F);
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         double S[9];
-        polar_rotation(F, q, 30, R); /* exits early once converged */
+        polar_rotation(F, q, 30, 1e-10, R); /* 1e-10 rad: far below any strain of interest */
         m3_mul_tn(R, F, S);
         hooke(s, S, sig, w);
     } else {
