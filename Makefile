@@ -22,6 +22,7 @@ meshes: build
 
 run: meshes
 	$(BUILD)/cohfrac run scenes/bunny_drop.lua --mesh-dir $(MESHES)
+	/usr/bin/python3 tools/check_run.py out/bunny_drop.h5
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure

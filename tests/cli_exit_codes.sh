@@ -1,0 +1,43 @@
+#!/bin/sh
+# The documented exit codes of the `cohfrac` program, one case per code:
+# 0 ok, 1 usage, 2 bad input, 3 diverged, 4 output failed, 5 external failure.
+# usage: cli_exit_codes.sh COHFRAC_EXE MESH_DIR
+set -u
+exe=$1
+meshes=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+expect() { # expect CODE WHAT CMD...
+    code=$1; what=$2; shift 2
+    "$@" >"$tmp/log" 2>&1
+    rc=$?
+    if [ "$rc" -eq "$code" ]; then echo "ok    exit $rc: $what"
+    else echo "FAIL  exit $rc (want $code): $what"; sed 's/^/      /' "$tmp/log"; fails=$((fails + 1)); fi
+}
+cat >"$tmp/drop.lua" <<LUA
+return { name = "tiny", duration = 0.002,
+  bodies = { { mesh = "bunny_small", position = {0, 0, 2} } },
+  obstacles = { { type = "plane", point = {0, 0, 0}, normal = {0, 0, 1} } },
+  output = { file = "$tmp/out/tiny.h5" } }
+LUA
+echo 'return { bodies = { { mesh = "bunny_small" } }, solver = { dt_rigid = -1 } }' >"$tmp/bad.lua"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$tmp/open.obj"
+: >"$tmp/file"
+
+expect 0 "--version" "$exe" --version
+expect 0 "a tiny run" "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q
+expect 1 "no command" "$exe"
+expect 1 "unknown option" "$exe" run --bogus "$tmp/drop.lua"
+expect 2 "scene value out of range" "$exe" run "$tmp/bad.lua" --mesh-dir "$meshes"
+expect 2 "missing scene file" "$exe" run "$tmp/none.lua"
+expect 2 "open surface" "$exe" mesh "$tmp/open.obj" -o "$tmp/m"
+expect 3 "divergence (dt far above the CFL step, no PBD iterations to hold it)" \
+    "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q --set bodies[1].position='{0,0,0.78}' --set bodies[1].velocity='{0,0,-3}' \
+    --set material.E=1e9 --set solver.dt_fracture=1e-3 --set solver.dt_rigid=1e-3 \
+    --set solver.pbd.k_stiffness=0 --set duration=0.05
+expect 4 "output under a regular file" "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q \
+    -o "$tmp/file/x.h5"
+expect 5 "tetgen missing" env COHFRAC_TETGEN=/nonexistent/tetgen "$exe" mesh \
+    /usr/share/glmark2/models/bunny.obj -o "$tmp/b" --target-tets 15000
+[ "$fails" -eq 0 ]
