@@ -4,7 +4,25 @@
 
 #include "cohfrac/mesh.h"
 
+#include <stdio.h>
 #include <stdlib.h>
+
+/* The whole file as a NUL-terminated string (malloc'd), or NULL. */
+static inline char *fixture_read_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *b = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    size_t got = b ? fread(b, 1, (size_t)n, f) : 0;
+    if (b)
+        b[got] = '\0';
+    fclose(f);
+    return b;
+}
 
 /* Box [0,lx]x[0,ly]x[0,lz] in nx*ny*nz cells, 6 tets per cell (Kuhn
  * subdivision along the main diagonal), every tet positively oriented. */

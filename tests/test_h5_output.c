@@ -10,6 +10,8 @@
 
 #include <cmocka.h>
 
+#include "fixtures.h"
+
 #include "cohfrac/h5_output.h"
 
 #include <hdf5.h>
@@ -149,21 +151,6 @@ static void check_string(hid_t f, const char *obj, const char *attr, const char 
     free(s);
 }
 
-static char *slurp(const char *path)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return NULL;
-    fseek(fp, 0, SEEK_END);
-    long n = ftell(fp);
-    fseek(fp, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    size_t got = buf ? fread(buf, 1, (size_t)n, fp) : 0;
-    fclose(fp);
-    if (buf)
-        buf[got] = '\0';
-    return buf;
-}
 
 static int count_occurrences(const char *hay, const char *needle)
 {
@@ -429,7 +416,7 @@ static void test_round_trip(void **state)
     assert_memory_equal(conn, want_conn, sizeof conn);
     assert_true(H5Fclose(f) >= 0);
 
-    char *x = slurp(xdmf);
+    char *x = fixture_read_file(xdmf);
     assert_non_null(x);
     assert_non_null(strstr(x, "<Xdmf Version=\"3.0\""));
     assert_non_null(strstr(x, "CollectionType=\"Temporal\""));
@@ -541,7 +528,7 @@ static void test_growth(void **state)
     assert_true(H5Fclose(f) >= 0);
 
     /* a name without .h5 keeps its extension and gets .xdmf appended */
-    char *x = slurp(xdmf);
+    char *x = fixture_read_file(xdmf);
     assert_non_null(x);
     assert_int_equal(count_occurrences(x, "<Grid Name=\"frame_"), T);
     assert_non_null(
@@ -695,7 +682,7 @@ static char *capture_open_stderr(const fixture *fx, const char *path, cf_status 
     fflush(stderr);
     dup2(saved, 2);
     close(saved);
-    char *text = slurp(log);
+    char *text = fixture_read_file(log);
     unlink(log);
     return text;
 }

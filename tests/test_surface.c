@@ -9,6 +9,8 @@
 
 #include <cmocka.h>
 
+#include "fixtures.h"
+
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -615,20 +617,6 @@ static int have_tetgen(void)
     return 0;
 }
 
-static char *read_all(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    size_t got = fread(b, 1, (size_t)n, f);
-    b[got] = '\0';
-    fclose(f);
-    return b;
-}
 
 static void test_prepare_cube(void **state)
 {
@@ -659,7 +647,7 @@ static void test_prepare_cube(void **state)
     snprintf(stamp, sizeof stamp, "%s.stamp", out);
     struct stat s0, s1;
     assert_int_equal(stat(node, &s0), 0);
-    char *stamp_text = read_all(stamp);
+    char *stamp_text = fixture_read_file(stamp);
     assert_non_null(stamp_text);
     assert_non_null(strstr(stamp_text, "target_tets 0\n"));
     assert_non_null(strstr(stamp_text, "pcube.off"));
@@ -686,7 +674,7 @@ static void test_prepare_cube(void **state)
     for (int e = 0; e < 2; e++) {
         snprintf(p2, sizeof p2, "%s%s", out2, e ? ".ele" : ".node");
         snprintf(p3, sizeof p3, "%s%s", out3, e ? ".ele" : ".node");
-        char *a = read_all(p2), *b = read_all(p3);
+        char *a = fixture_read_file(p2), *b = fixture_read_file(p3);
         assert_non_null(a);
         assert_non_null(b);
         assert_string_equal(a, b);
