@@ -51,7 +51,9 @@ static void element_stress(const cf_solid *s, int t, cf_elasticity kind, double 
     deformation_gradient(s, t, F);
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         double S[9];
-        polar_rotation(F, q, 30, 1e-10, R); /* 1e-10 rad: far below any strain of interest */
+        /* A rotation error theta leaves a strain error O(theta^2 + theta eps): 1e-7
+         * rad is far below any cracking strain. */
+        polar_rotation(F, q, 10, 1e-7, R);
         m3_mul_tn(R, F, S);
         hooke(s, S, sig, w);
     } else {
