@@ -4,6 +4,7 @@
 
 #include "linalg.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,6 +98,14 @@ void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[
     cf_nodes_angular_velocity(&sim->solid, f->nodes.v, f->nodes.n, ns.com, ns.L, w);
 }
 
+static int count_dead(const cf_sim *sim)
+{
+    int n = 0;
+    for (int i = 0; i < sim->n_frag; i++)
+        n += sim->frag[i].mode == CF_MODE_DEAD;
+    return n;
+}
+
 static cf_status record_handoff(cf_sim *sim, int fi, int direction, double merr, double loss,
                                 cf_error *err)
 {
@@ -104,6 +113,11 @@ static cf_status record_handoff(cf_sim *sim, int fi, int direction, double merr,
     if (merr > sim->max_momentum_error)
         sim->max_momentum_error = merr;
     sim->total_handoff_loss += loss;
+    if (sim->opt.progress)
+        fprintf(stderr, "hand-off t=%.4f s: fragment %d %s, linear momentum error %.2e, "
+                        "handoff_loss %.4g J, %d fragments alive\n",
+                sim->t, fi, direction ? "fracture -> rigid" : "rigid -> fracture", merr, loss,
+                sim->n_frag - count_dead(sim));
     if (!sim->h5)
         return CF_OK;
     cf_handoff_record r = {sim->t, fi, direction, merr, loss};
