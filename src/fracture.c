@@ -5,7 +5,6 @@
 #include "tet4.h"
 
 #include <stdlib.h>
-#include <string.h>
 #include <time.h>
 
 double cf_wall_time(void)
@@ -70,11 +69,9 @@ static void contact_velocities(cf_sim *sim, cf_fragment *f, double t)
         if (j < 0)
             continue;
         int a = f->nodes.v[i];
-        double n[3], u[3] = {0, 0, 0};
+        double n[3], u[3], vr[3];
         cf_obstacle_distance(&sim->obs.o[j], t, &s->x[3 * a], n);
-        if (sim->obs.o[j].type != CF_OBSTACLE_PLANE)
-            memcpy(u, sim->obs.o[j].velocity, sizeof u);
-        double vr[3];
+        cf_obstacle_velocity(&sim->obs.o[j], u);
         v3_sub(&s->v[3 * a], u, vr);
         double vn = v3_dot(vr, n), vt[3];
         for (int k = 0; k < 3; k++)
@@ -156,9 +153,8 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
             double n[3];
             int hit = cf_obstacles_project(&sim->obs, t_next, &s->p[3 * a], n);
             if (hit >= 0 && f->contact[i] < 0) {
-                double u[3] = {0, 0, 0}, vr[3];
-                if (sim->obs.o[hit].type != CF_OBSTACLE_PLANE)
-                    memcpy(u, sim->obs.o[hit].velocity, sizeof u);
+                double u[3], vr[3];
+                cf_obstacle_velocity(&sim->obs.o[hit], u);
                 v3_sub(&s->v[3 * a], u, vr);
                 f->vn_pre[i] = v3_dot(vr, n);
             }
@@ -196,9 +192,8 @@ int cf_pbd_impact(const cf_sim *sim, int fi, double dt)
             double n[3];
             if (cf_obstacle_distance(&sim->obs.o[j], sim->t + dt, p, n) >= 0)
                 continue;
-            double u[3] = {0, 0, 0}, vr[3];
-            if (sim->obs.o[j].type != CF_OBSTACLE_PLANE)
-                memcpy(u, sim->obs.o[j].velocity, sizeof u);
+            double u[3], vr[3];
+            cf_obstacle_velocity(&sim->obs.o[j], u);
             v3_sub(v, u, vr);
             if (-v3_dot(vr, n) > sim->scene->solver.impact_threshold)
                 return 1;

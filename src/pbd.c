@@ -71,6 +71,12 @@ void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
     }
 }
 
+void cf_obstacle_velocity(const cf_obstacle *o, double u[3])
+{
+    for (int k = 0; k < 3; k++)
+        u[k] = o->type == CF_OBSTACLE_PLANE ? 0.0 : o->velocity[k];
+}
+
 double cf_obstacle_distance(const cf_obstacle *o, double t, const double p[3], double normal[3])
 {
     double c[3] = {o->center[0] + t * o->velocity[0], o->center[1] + t * o->velocity[1],

@@ -32,6 +32,10 @@ typedef struct cf_obstacles {
  * obstacle that was hit, or -1.  `normal` receives its outward normal. */
 int cf_obstacles_project(const cf_obstacles *obs, double t, double p[3], double normal[3]);
 
+/* Velocity of obstacle o (m/s): planes are static, spheres and boxes move
+ * at their constant velocity. */
+void cf_obstacle_velocity(const cf_obstacle *o, double u[3]);
+
 /* Signed distance of point p from obstacle j at time t (negative inside) and
  * the outward normal there. */
 double cf_obstacle_distance(const cf_obstacle *o, double t, const double p[3], double normal[3]);
