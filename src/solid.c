@@ -163,15 +163,9 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets", nt);
     }
-    int *all = malloc((size_t)nt * sizeof(int));
-    if (!all) {
-        cf_solid_free(s);
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-    }
-    for (int t = 0; t < nt; t++)
-        all[t] = t;
-    cf_solid_lump_masses(s, all, nt);
-    free(all);
+    for (int t = 0; t < nt; t++) /* lumped mass: rho V / 4 to each node */
+        for (int j = 0; j < 4; j++)
+            s->m[s->tet[4 * t + j]] += mat->rho * s->vol[t] / 4.0;
     return CF_OK;
 }
 
@@ -215,16 +209,4 @@ int cf_solid_copy_node(cf_solid *s, int n)
     s->m[k] = 0;
     s->origin[k] = s->origin[n];
     return k;
-}
-
-void cf_solid_lump_masses(cf_solid *s, const int *tets, int nt)
-{
-    for (int i = 0; i < nt; i++)
-        for (int j = 0; j < 4; j++)
-            s->m[s->tet[4 * tets[i] + j]] = 0;
-    for (int i = 0; i < nt; i++) {
-        double q = s->mat.rho * s->vol[tets[i]] / 4.0;
-        for (int j = 0; j < 4; j++)
-            s->m[s->tet[4 * tets[i] + j]] += q;
-    }
 }

@@ -68,7 +68,4 @@ void cf_solid_free(cf_solid *s);
  * or -1 when out of memory. */
 int cf_solid_copy_node(cf_solid *s, int n);
 
-/* Recompute the lumped mass of the nodes of `tets` (sum of rho V/4). */
-void cf_solid_lump_masses(cf_solid *s, const int *tets, int nt);
-
 #endif
