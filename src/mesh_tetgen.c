@@ -438,5 +438,8 @@ void cf_mesh_free(cf_mesh *m)
         return;
     free(m->x);
     free(m->tets);
+    for (int g = 0; g < m->n_groups && m->groups; g++)
+        free(m->groups[g].nodes);
+    free(m->groups);
     memset(m, 0, sizeof *m);
 }

@@ -135,7 +135,7 @@ static void test_cube_volume_exact(void **state)
     /* 5 tets: the regular tet (0,3,5,6) in the middle and the four corners
      * 1, 2, 4, 7 cut off, each with its three neighbours. */
     int cut5[5][4] = {{1, 0, 3, 5}, {2, 0, 6, 3}, {4, 0, 5, 6}, {7, 3, 6, 5}, {0, 3, 5, 6}};
-    cf_mesh m = {8, 5, &x[0][0], &cut5[0][0]};
+    cf_mesh m = {.n_nodes = 8, .n_tets = 5, .x = &x[0][0], .tets = &cut5[0][0]};
     double expect_corner = 1.0 / 6.0, expect_centre = 1.0 / 3.0;
     for (int t = 0; t < 5; t++) {
         const int *T = cut5[t];
@@ -161,7 +161,7 @@ static void test_cube_volume_exact(void **state)
             six[t][1] = six[t][2], six[t][2] = s;
         }
     }
-    cf_mesh k = {8, 6, &x[0][0], &six[0][0]};
+    cf_mesh k = {.n_nodes = 8, .n_tets = 6, .x = &x[0][0], .tets = &six[0][0]};
     assert_int_equal(cf_mesh_check(&k, "cube6", &err), CF_OK);
     assert_true(cf_mesh_volume(&k) == 1.0);
     /* with two tets inverted the signed total is 4/6 - 2/6 */
@@ -183,7 +183,7 @@ static void test_write_read_roundtrip(void **state)
     x[4][2] = -1.0 / 3.0;
     int t[2][4];
     memcpy(t, two_t, sizeof t);
-    cf_mesh m = {5, 2, &x[0][0], &t[0][0]}, r;
+    cf_mesh m = {.n_nodes = 5, .n_tets = 2, .x = &x[0][0], .tets = &t[0][0]}, r;
     cf_error err = {0};
     assert_int_equal(cf_mesh_write_tetgen(&m, base("rt"), &err), CF_OK);
     assert_int_equal(cf_mesh_load_tetgen(base("rt"), &r, &err), CF_OK);

@@ -10,10 +10,11 @@
  *   0  success
  *   1  usage error (bad command line)
  *   2  bad input (mesh, surface or scene file)
- *   3  the simulation diverged (NaN / inverted tets); the output file is
- *      closed and readable up to the last frame
+ *   3  the simulation diverged (NaN, inverted tets, or energy growth with
+ *      no work input); the output file is closed and readable up to the
+ *      last frame
  *   4  output could not be written
- *   5  a required external program or resource failed (tetgen, memory)
+ *   5  a required external program or resource failed (tetgen, gmsh, memory)
  */
 #ifndef COHFRAC_ERROR_H
 #define COHFRAC_ERROR_H
@@ -28,6 +29,7 @@
     X(CF_ERR_MESH_PARSE, 2, "malformed mesh or surface file")                  \
     X(CF_ERR_MESH_INDEX, 2, "element refers to a node that does not exist")    \
     X(CF_ERR_MESH_INVERTED, 2, "inverted or degenerate tetrahedron")           \
+    X(CF_ERR_MESH_FORMAT, 2, "mesh file version or content not supported")     \
     X(CF_ERR_SURFACE_INTERSECT, 2, "surface intersects itself and could not be repaired") \
     X(CF_ERR_SCENE_SYNTAX, 2, "scene script does not parse or fails to run")   \
     X(CF_ERR_SCENE_KEY, 2, "unknown or missing key in scene")                  \

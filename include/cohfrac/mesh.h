@@ -1,4 +1,5 @@
-/* cohfrac — Tet4 volume meshes: the TetGen .node/.ele loader and checks.
+/* cohfrac — Tet4 volume meshes: the TetGen .node/.ele and Gmsh .msh
+ * loaders, meshed primitives and the checks.
  *
  * A cf_mesh is a linear tetrahedral mesh in SI units (metres).  Tets are
  * positively oriented: det[x1-x0, x2-x0, x3-x0] > 0 (DESIGN §2).
@@ -8,12 +9,47 @@
 
 #include "cohfrac/error.h"
 
+/* A named node set (a Gmsh physical group, any dimension): the nodes of
+ * every element of the group, 0-based, ascending, no repeats.  A group named
+ * in $PhysicalNames but without elements has n_nodes = 0, nodes = NULL.
+ * Names longer than 63 characters are cut. */
+typedef struct cf_mesh_group {
+    char name[64];
+    int dim;      /* 0 point, 1 curve, 2 surface, 3 volume */
+    int n_nodes;
+    int *nodes;   /* [n_nodes] */
+} cf_mesh_group;
+
 typedef struct cf_mesh {
     int n_nodes;
     int n_tets;
     double *x; /* [n_nodes][3] node positions, m */
     int *tets; /* [n_tets][4] 0-based node indices */
+    int n_groups;
+    cf_mesh_group *groups; /* [n_groups] named node sets (Gmsh files only) */
 } cf_mesh;
+
+/* Meshed primitives (scene bodies with `mesh = {type = ...}`), m. */
+typedef enum {
+    CF_PRIM_NONE = 0,
+    CF_PRIM_BOX,           /* structured, in-engine: size, cells, tets_per_cell */
+    CF_PRIM_SPHERE,        /* gmsh: radius, mesh_size */
+    CF_PRIM_HOLLOW_SPHERE, /* gmsh: radius (outer), thickness, mesh_size */
+    CF_PRIM_PLATE,         /* gmsh: size (x, y, thickness z), mesh_size */
+    CF_PRIM_NOTCHED_BEAM   /* gmsh: size (length x, width y, height z), notch, mesh_size */
+} cf_primitive_type;
+
+typedef struct cf_primitive {
+    cf_primitive_type type;
+    double size[3];     /* box, plate, notched beam: edge lengths along x, y, z, m */
+    int cells[3];       /* box: cells along x, y, z */
+    int tets_per_cell;  /* box: 5 or 6 */
+    double radius;      /* sphere, hollow sphere: outer radius, m */
+    double thickness;   /* hollow sphere: shell thickness, m */
+    double notch[3];    /* notched beam: depth (from the bottom face, z), width (x),
+                           offset of the notch centre from mid-span (x), m */
+    double mesh_size;   /* gmsh characteristic element length, m */
+} cf_primitive;
 
 /* Load TetGen files `<base>.node` and `<base>.ele` (`base` may also be given
  * with either extension).  Accepts 0- or 1-based numbering (taken from the
@@ -49,6 +85,52 @@ int cf_mesh_orient_positive(cf_mesh *m);
  * is written under a temporary name and renamed.  Errors: CF_ERR_OUTPUT,
  * CF_ERR_NOMEM. */
 cf_status cf_mesh_write_tetgen(const cf_mesh *m, const char *base, cf_error *err);
+
+/* Load a Gmsh MSH file: version 4.1 (ASCII or binary) or 2.2 (ASCII).
+ * Only 4-node tetrahedra (element type 4) become tets; every element of a
+ * physical group (any type) adds its nodes to the group; the groups become
+ * named node sets (m->groups, sorted by dimension then tag, named by their
+ * physical name, or "<dim>:<tag>" when unnamed).  Node i is the i-th node of
+ * the file (tags may have gaps or any order); nodes no tet uses are kept.
+ * Tets are re-oriented to positive volume, then checked as cf_mesh_check.
+ * Sections other than $MeshFormat, $PhysicalNames, $Entities, $Nodes and
+ * $Elements are skipped.
+ * Errors: CF_ERR_FILE_OPEN; CF_ERR_MESH_PARSE (file:line, or file: byte N in
+ * binary files; what was expected); CF_ERR_MESH_FORMAT (version 4.0 or
+ * other unsupported version, 2.2 binary, an unknown element type, or no
+ * 4-node tetrahedra: the message says how to re-export, e.g.
+ * `gmsh -3 -format msh41 file.geo`); CF_ERR_MESH_INDEX (an element refers
+ * to a node not in $Nodes); CF_ERR_MESH_INVERTED; CF_ERR_NOMEM.  On error
+ * `m` is left empty. */
+cf_status cf_mesh_load_gmsh(const char *path, cf_mesh *m, cf_error *err);
+
+/* Load a volume mesh by extension: `.msh` (Gmsh), else a TetGen pair. */
+cf_status cf_mesh_load(const char *path, cf_mesh *m, cf_error *err);
+
+/* A structured box centred at the origin: size[k] m along axis k split into
+ * cells[k] cells, each cut into 5 (alternating) or 6 (Kuhn) positive tets;
+ * both meshes are conforming.  Node (i,j,k) of the grid has index
+ * (k*(cells[1]+1) + j)*(cells[0]+1) + i.  No groups.
+ * Errors: CF_ERR_SCENE_VALUE (non-positive size or cells, tets_per_cell not 5
+ * or 6), CF_ERR_NOMEM. */
+cf_status cf_mesh_box(const double size[3], const int cells[3], int tets_per_cell, cf_mesh *m,
+                      cf_error *err);
+
+/* Mesh a primitive: a box in-engine; the others by running
+ * `gmsh -3 -format msh41` ($COHFRAC_GMSH overrides the program) on a
+ * generated .geo script (OpenCASCADE kernel, Mesh.CharacteristicLengthMax =
+ * mesh_size), cached in `cache_dir` (created if missing; NULL or "" means
+ * ".") as <type>_<16 hex digits: FNV-1a hash of the script, which prints
+ * every parameter>.msh, with the .geo beside it.  The mesh is written under
+ * a temporary name, then renamed, so a second call just loads the cache.
+ * Each primitive is centred at the origin (bounding-box centre).  Notched
+ * beam: the slot is cut up from the bottom face z = -size[2]/2, through the
+ * whole width y.
+ * Errors: CF_ERR_SCENE_VALUE (bad parameters), CF_ERR_EXTERNAL (gmsh
+ * missing or failed: its output is quoted), CF_ERR_OUTPUT (cache not
+ * writable), the errors of cf_mesh_load_gmsh, CF_ERR_NOMEM. */
+cf_status cf_mesh_primitive(const cf_primitive *p, const char *cache_dir, cf_mesh *m,
+                            cf_error *err);
 
 /* Release the arrays and zero `m` (NULL or an empty mesh is fine). */
 void cf_mesh_free(cf_mesh *m);
