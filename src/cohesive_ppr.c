@@ -79,7 +79,22 @@ static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double 
     return 0.5 * nn;
 }
 
-int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n)
+/* Work absorbed by one scalar traction-opening component between the last
+ * evaluation (d0, T0) and this one (d, T), trapezoidal in the opening.  The
+ * normal law is discontinuous at zero opening (penalty below, cohesive
+ * above): a step that crosses zero is split there, t0plus being the
+ * cohesive traction at 0+. */
+static double component_work(double d0, double T0, double d, double T, double t0plus)
+{
+    if (d0 <= 0 && d > 0)
+        return -0.5 * T0 * d0 + 0.5 * (t0plus + T) * d;
+    if (d0 > 0 && d <= 0)
+        return -0.5 * (T0 + t0plus) * d0 + 0.5 * T * d;
+    return 0.5 * (T0 + T) * (d - d0);
+}
+
+int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n, double dt,
+                       double kp)
 {
     int n_failed = 0;
     for (int e = 0; e < n; e++) {
@@ -98,12 +113,39 @@ int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n)
             for (int k = 0; k < 3; k++)
                 tv[k] = d[k] - dn * nrm[k];
             double dtl = v3_norm(tv);
-            double Tn, Tt;
+            double Tn, Tt, e0n, e0t;
+            cf_ppr_envelope(p, 0, ce->dt_max[i], &e0n, &e0t);
+            double t0plus = ce->dn_max[i] > 0 ? 0 : e0n; /* secant or envelope at 0+ */
             cf_ppr_traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
             n_failed += ce->failed[i];
+            /* Stability cap of a node pair at step dt: a node pair is shared
+             * by up to ~8 elements, so a sixteenth of the two-mass limit
+             * 4/(dt^2 (wa + wb)) keeps their sum stable. */
+            double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
+            double cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
+            if (dn <= 0) { /* compression: penalty, while the faces still face each other */
+                double facing = v3_dot(d, d) <= 0.25 * area;
+                Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
+            }
+            /* The tangential traction rises from zero with the capped
+             * stiffness: at zero tangential opening its direction is
+             * undefined, and a jump to tau_max there would act in a
+             * direction set by round-off (time continuity, Papoulia et al.
+             * 2003). */
+            Tt = fmin(Tt, cap * dtl);
+            if (!ce->started[i]) {
+                cf_ppr_envelope(p, 0, 0, &e0n, &e0t);
+                ce->last[i][0] = 0, ce->last[i][1] = 0, ce->last[i][2] = e0n;
+                ce->last[i][3] = ce->dt_max[i] > 0 ? 0 : e0t; /* secant or envelope at 0 */
+                ce->started[i] = 1;
+            }
+            double *L = ce->last[i];
+            ce->work[i] += area / 3.0 *
+                           (component_work(L[0], L[2], dn, Tn, t0plus) + 0.5 * (L[3] + Tt) * (dtl - L[1]));
+            ce->stored[i] = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
+            L[0] = dn, L[1] = dtl, L[2] = Tn, L[3] = Tt;
             double fvec[3] = {0, 0, 0};
-            if (dn > 0)
-                v3_axpy(area / 3.0 * Tn, nrm, fvec);
+            v3_axpy(area / 3.0 * Tn, nrm, fvec);
             if (dtl > 0)
                 v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
             v3_axpy(1.0, fvec, &s->f[3 * a[i]]); /* pulls A towards B */
@@ -111,6 +153,35 @@ int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n)
         }
     }
     return n_failed;
+}
+
+void cf_cohesive_energy(const cf_solid *s, const int *elems, int n, double *stored,
+                        double *dissipated)
+{
+    double st = 0, w = 0;
+    int count = elems ? n : s->n_coh;
+    for (int e = 0; e < count; e++) {
+        const cf_cohesive *ce = &s->coh[elems ? elems[e] : e];
+        for (int i = 0; i < 3; i++)
+            st += ce->stored[i], w += ce->work[i];
+    }
+    *stored = st;
+    *dissipated = w - st;
+}
+
+double cf_cohesive_release(cf_solid *s, const int *elems, int n)
+{
+    double dropped = 0;
+    for (int e = 0; e < n; e++) {
+        cf_cohesive *ce = &s->coh[elems[e]];
+        for (int i = 0; i < 3; i++) {
+            dropped += ce->stored[i];
+            ce->work[i] -= ce->stored[i];
+            ce->stored[i] = 0;
+            ce->started[i] = 0;
+        }
+    }
+    return dropped;
 }
 
 void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)

@@ -32,9 +32,26 @@ void cf_ppr_traction(const cf_ppr *p, double dn, double dt, double *dn_max, doub
 
 /* Add the forces of the cohesive elements elems[0..n) to s->f.
  * Nodal (Newton-Cotes) integration: each node pair carries traction * A/3,
- * A the current mid-surface area, normal from side A to side B.  Returns the
- * number of node pairs in complete failure. */
-int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n);
+ * A the current mid-surface area, normal from side A to side B.
+ * Compression (Delta_n < 0, faces still facing each other, failed or not) is
+ * a penalty T_n = K_p Delta_n with K_p = kp Pa/m, capped per node pair so
+ * that the pair is stable at step dt: K_p A/3 <= 1/(dt^2 (1/m_a + 1/m_b)),
+ * a quarter of the two-mass limit (DESIGN §3.5); kp = 0 means the cap.
+ * Each pair's absorbed work and stored energy are updated (cf_cohesive).
+ * Returns the number of node pairs in complete failure. */
+int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n, double dt,
+                       double kp);
+
+/* Energy of cohesive elements elems[0..n) (all of them when elems is NULL),
+ * J: stored (recoverable, on the secant; includes compression penalty) and
+ * dissipated (absorbed work minus stored; G_I A for a facet of area A opened
+ * to complete failure in pure mode I). */
+void cf_cohesive_energy(const cf_solid *s, const int *elems, int n, double *stored,
+                        double *dissipated);
+
+/* Drop the recoverable energy of elems[0..n) (a fragment handed to rigid
+ * mode, whose openings reset): returns the energy dropped, J. */
+double cf_cohesive_release(cf_solid *s, const int *elems, int n);
 
 /* Compression across a crack: a PBD non-penetration constraint on the
  * predicted positions s->p, Delta_n >= 0 for every open node pair, the

@@ -5,6 +5,7 @@
 #include "tet4.h"
 
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 double cf_wall_time(void)
@@ -27,6 +28,10 @@ static int ensure_scratch(cf_fragment *f)
     if (!v)
         return -1;
     f->vn_pre = v;
+    v = realloc(f->v_old, (size_t)cap * 3 * sizeof(double));
+    if (!v)
+        return -1;
+    f->v_old = v;
     f->scratch_cap = cap;
     return 0;
 }
@@ -59,20 +64,21 @@ static cf_status check_and_insert(cf_sim *sim, cf_fragment *f, int *inserted)
 }
 
 
-/* Friction and restitution of nodes in contact, relative to the obstacle. */
-static void contact_velocities(cf_sim *sim, cf_fragment *f, double t)
+/* Friction and restitution of nodes in contact, relative to the obstacle.
+ * Returns the kinetic energy this removes, J. */
+static double contact_velocities(cf_sim *sim, cf_fragment *f, double t)
 {
     cf_solid *s = &sim->solid;
-    double mu = s->mat.friction, e = s->mat.restitution;
+    double mu = s->mat.friction, e = s->mat.restitution, removed = 0;
     for (int i = 0; i < f->nodes.n; i++) {
         int j = f->contact[i];
         if (j < 0)
             continue;
         int a = f->nodes.v[i];
-        double n[3], u[3], vr[3];
+        double n[3], u[3], vr[3], *va = &s->v[3 * a];
         cf_obstacle_distance(&sim->obs.o[j], t, &s->x[3 * a], n);
         cf_obstacle_velocity(&sim->obs.o[j], u);
-        v3_sub(&s->v[3 * a], u, vr);
+        v3_sub(va, u, vr);
         double vn = v3_dot(vr, n), vt[3];
         for (int k = 0; k < 3; k++)
             vt[k] = vr[k] - vn * n[k];
@@ -83,27 +89,44 @@ static void contact_velocities(cf_sim *sim, cf_fragment *f, double t)
         double dvn = fabs(vn_new - (f->vn_pre[i] < 0 ? f->vn_pre[i] : 0));
         double vtl = v3_norm(vt);
         double scale = vtl > 0 ? fmax(0.0, 1.0 - mu * dvn / vtl) : 0;
+        removed += 0.5 * s->m[a] * v3_dot(va, va);
         for (int k = 0; k < 3; k++)
-            s->v[3 * a + k] = u[k] + vn_new * n[k] + scale * vt[k];
+            va[k] = u[k] + vn_new * n[k] + scale * vt[k];
+        removed -= 0.5 * s->m[a] * v3_dot(va, va);
     }
+    return removed;
 }
 
-cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
+/* The prescribed velocity components of boundary node a: into v (m/s), or
+ * into the prediction p = x + dt v when `on_p` is set. */
+static void impose_boundary(cf_sim *sim, int a, double dt, int on_p)
 {
-    cf_fragment *f = &sim->frag[fi];
+    cf_solid *s = &sim->solid;
+    const cf_boundary *bc = &sim->scene->boundaries[s->bc[a]];
+    for (int k = 0; k < 3; k++)
+        if (bc->axes & (1 << k)) {
+            if (on_p)
+                s->p[3 * a + k] = s->x[3 * a + k] + dt * bc->velocity[k];
+            else
+                s->v[3 * a + k] = bc->velocity[k];
+        }
+}
+
+/* f = f_ext - f_int + f_coh at x_n; strain energy and inverted tets. */
+static cf_status forces(cf_sim *sim, cf_fragment *f, double dt, int fracture)
+{
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->scene->solver;
     const double *g = sim->scene->gravity;
     double t0 = cf_wall_time();
-
-    /* Stresses and internal forces (fracture mode only). */
+    f->e_strain = 0;
     if (fracture) {
         int check = (f->steps % set->check_interval) == 0;
-        cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check);
-        double t1 = cf_wall_time();
-        sim->prof.stress += t1 - t0;
+        f->n_inverted = cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check);
+        f->e_strain = cf_tet4_strain_energy(s, f->tets, f->nt);
+        sim->prof.stress += cf_wall_time() - t0;
         int inserted = 0;
-        if (check) {
+        if (check && set->criterion != CF_CRITERION_NONE) {
             cf_status st = check_and_insert(sim, f, &inserted);
             if (st != CF_OK)
                 return st;
@@ -113,30 +136,72 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
     }
     if (ensure_scratch(f))
         return CF_ERR_NOMEM;
-
-    /* f = f_ext - f_int + f_coh ; v <- v + dt M^-1 f */
-    const int *nodes = f->nodes.v;
-    int nn = f->nodes.n;
-    for (int i = 0; i < nn; i++) {
-        int a = nodes[i];
+    for (int i = 0; i < f->nodes.n; i++) {
+        int a = f->nodes.v[i];
         for (int k = 0; k < 3; k++)
             s->f[3 * a + k] = s->m[a] * g[k];
     }
     if (fracture) {
         cf_tet4_scatter(s, f->tets, f->nt);
-        cf_cohesive_forces(s, &sim->ppr, f->coh.v, f->coh.n);
+        cf_cohesive_forces(s, &sim->ppr, f->coh.v, f->coh.n, dt, set->contact_stiffness);
     }
+    sim->prof.forces += cf_wall_time() - t0;
+    return CF_OK;
+}
+
+/* v <- v + dt M^-1 f, prescribed velocities, global damping (pbd rigid
+ * mode); the ledger's kinetic energy and the boundary and damping work. */
+static void update_velocities(cf_sim *sim, cf_fragment *f, double dt, int fracture)
+{
+    cf_solid *s = &sim->solid;
+    const int *nodes = f->nodes.v;
+    int nn = f->nodes.n;
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
+        memcpy(&f->v_old[3 * i], &s->v[3 * a], 3 * sizeof(double));
         v3_axpy(dt / s->m[a], &s->f[3 * a], &s->v[3 * a]);
     }
-    if (!fracture)
-        cf_global_damping(s, nodes, nn, set->k_damping);
-    double t1 = cf_wall_time();
-    sim->prof.forces += t1 - t0;
+    /* Work of the boundary: the reaction R = m (v_bc - v_free)/dt over
+     * dt (v_old + v_new)/2, the leapfrog work of a force. */
+    double w_bc = 0;
+    for (int i = 0; i < nn; i++) {
+        int a = nodes[i];
+        if (s->bc[a] < 0)
+            continue;
+        double vfree[3], *vo = &f->v_old[3 * i];
+        memcpy(vfree, &s->v[3 * a], sizeof vfree);
+        impose_boundary(sim, a, dt, 0);
+        for (int k = 0; k < 3; k++)
+            w_bc += s->m[a] * (s->v[3 * a + k] - vfree[k]) * 0.5 * (vo[k] + s->v[3 * a + k]);
+    }
+    sim->flow.boundary += w_bc;
+    if (!fracture) {
+        double before = 0, after = 0;
+        for (int i = 0; i < nn; i++)
+            before += 0.5 * s->m[nodes[i]] * v3_dot(&s->v[3 * nodes[i]], &s->v[3 * nodes[i]]);
+        cf_global_damping(s, nodes, nn, sim->scene->solver.k_damping);
+        for (int i = 0; i < nn; i++)
+            after += 0.5 * s->m[nodes[i]] * v3_dot(&s->v[3 * nodes[i]], &s->v[3 * nodes[i]]);
+        sim->flow.damping += before - after;
+    }
+    double ke = 0, mx[3] = {0, 0, 0};
+    for (int i = 0; i < nn; i++) {
+        int a = nodes[i];
+        ke += 0.5 * s->m[a] * v3_dot(&f->v_old[3 * i], &s->v[3 * a]);
+        v3_axpy(s->m[a], &s->x[3 * a], mx);
+    }
+    f->e_kin = ke;
+    memcpy(f->mx, mx, sizeof mx);
+}
 
-    /* Prediction, then PBD bars, crack and obstacle collision constraints. */
-    double t_next = t + dt;
+/* Prediction p = x + dt v, then the constraint projection: bars (PBD or
+ * XPBD), crack-face contact, obstacles, prescribed nodes. */
+static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int fracture)
+{
+    cf_solid *s = &sim->solid;
+    const cf_solver_settings *set = &sim->scene->solver;
+    const int *nodes = f->nodes.v;
+    int nn = f->nodes.n;
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         for (int k = 0; k < 3; k++)
@@ -144,9 +209,18 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
         f->contact[i] = -1;
         f->vn_pre[i] = 0;
     }
-    for (int it = 0; it < set->iterations; it++) {
-        cf_bars_project(&f->bars, s, set->k_stiffness);
-        if (fracture)
+    int bars = set->constraints != CF_CONSTRAINTS_NONE || !fracture;
+    int iterations = bars ? set->iterations : 1;
+    double k = cf_pbd_effective_stiffness(set->k_stiffness, set->iterations,
+                                          set->iteration_independent);
+    if (set->constraints == CF_CONSTRAINTS_XPBD)
+        cf_bars_reset_lambda(&f->bars);
+    for (int it = 0; it < iterations; it++) {
+        if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
+            cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
+        else if (bars)
+            cf_bars_project(&f->bars, s, k);
+        if (fracture && bars)
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
         for (int i = 0; i < nn; i++) {
             int a = nodes[i];
@@ -161,21 +235,47 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
             if (hit >= 0)
                 f->contact[i] = hit;
         }
+        for (int i = 0; i < nn; i++)
+            if (s->bc[nodes[i]] >= 0)
+                impose_boundary(sim, nodes[i], dt, 1);
     }
-    /* v <- (p - x)/dt ; x <- p */
+    /* v <- (p - x)/dt ; x <- p.  Energy the projection removed: kinetic
+     * 1/2 m (v_pred^2 - v^2) plus, to first order, the potential f . (p - pred). */
+    double removed = 0;
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
-        for (int k = 0; k < 3; k++) {
-            s->v[3 * a + k] = (s->p[3 * a + k] - s->x[3 * a + k]) / dt;
-            s->x[3 * a + k] = s->p[3 * a + k];
+        double *va = &s->v[3 * a], vnew[3];
+        for (int c = 0; c < 3; c++)
+            vnew[c] = (s->p[3 * a + c] - s->x[3 * a + c]) / dt;
+        removed += 0.5 * s->m[a] * (v3_dot(va, va) - v3_dot(vnew, vnew));
+        for (int c = 0; c < 3; c++) {
+            removed += s->f[3 * a + c] * dt * (vnew[c] - va[c]);
+            va[c] = vnew[c];
+            s->x[3 * a + c] = s->p[3 * a + c];
         }
     }
-    contact_velocities(sim, f, t_next);
+    if (bars)
+        sim->flow.pbd += removed;
+    else
+        sim->flow.contact += removed;
+}
+
+cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
+{
+    cf_fragment *f = &sim->frag[fi];
+    cf_status st = forces(sim, f, dt, fracture);
+    if (st != CF_OK)
+        return st;
+    double t0 = cf_wall_time();
+    update_velocities(sim, f, dt, fracture);
+    double t1 = cf_wall_time();
+    sim->prof.forces += t1 - t0;
+    project(sim, f, t + dt, dt, fracture);
+    sim->flow.contact += contact_velocities(sim, f, t + dt);
     sim->prof.pbd += cf_wall_time() - t1;
     f->steps++;
     return CF_OK;
 }
-
 int cf_pbd_impact(const cf_sim *sim, int fi, double dt)
 {
     const cf_fragment *f = &sim->frag[fi];

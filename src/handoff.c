@@ -98,6 +98,19 @@ void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[
     cf_nodes_angular_velocity(&sim->solid, f->nodes.v, f->nodes.n, ns.com, ns.L, w);
 }
 
+void cf_fragment_ledger_reset(cf_sim *sim, int fi)
+{
+    cf_fragment *f = &sim->frag[fi];
+    const cf_solid *s = &sim->solid;
+    f->e_kin = f->e_strain = 0;
+    f->mx[0] = f->mx[1] = f->mx[2] = 0;
+    for (int i = 0; i < f->nodes.n; i++) {
+        int a = f->nodes.v[i];
+        f->e_kin += 0.5 * s->m[a] * v3_dot(&s->v[3 * a], &s->v[3 * a]);
+        v3_axpy(s->m[a], &s->x[3 * a], f->mx);
+    }
+}
+
 static int count_dead(const cf_sim *sim)
 {
     int n = 0;
@@ -162,6 +175,7 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
     f->mode = CF_MODE_FRACTURE;
     f->steps = f->quiet = 0;
     f->t_enter = sim->t;
+    cf_fragment_ledger_reset(sim, fi);
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
     double merr = 0;
@@ -233,6 +247,9 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
     }
     int k = cf_label_components(s, tets, nt, comp);
+    /* A rigid fragment keeps no strain or cohesive energy. */
+    sim->flow.handoff += f->e_strain + cf_cohesive_release(s, f->coh.v, f->coh.n);
+    f->e_strain = 0;
     cf_node_state before;
     cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &before);
     double P_before[3] = {before.M * before.v[0], before.M * before.v[1], before.M * before.v[2]};
@@ -281,6 +298,7 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
             }
             g->steps = 0;
+            cf_fragment_ledger_reset(sim, ci);
         }
     }
     /* Fragments of one body do not collide with each other: a single convex
@@ -301,5 +319,7 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
     double pn = v3_norm(P_before);
     double merr = pn > 0 ? v3_norm(d) / pn : v3_norm(d);
     double loss = before.ke - ke_after;
+    if (sim->bullet) /* the pbd rigid backend keeps the nodes' velocities: damping removes it */
+        sim->flow.handoff += loss;
     return record_handoff(sim, fi, 1, merr, loss, err);
 }

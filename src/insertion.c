@@ -98,7 +98,7 @@ int cf_insertion_candidates(const cf_solid *s, const int *tets, int nt, cf_crite
         for (int k = 0; k < 4; k++) {
             int f = s->tet_facet[4 * ta + k];
             const int *F = &s->facet[4 * f];
-            if (F[2] < 0 || s->cracked[f] || F[0] != ta)
+            if (F[2] < 0 || s->cracked[f] || F[0] != ta || (s->candidate && !s->candidate[f]))
                 continue;
             if (rule == CF_CRITERION_SOURCE) {
                 int all = 1;

@@ -89,7 +89,7 @@ static int cmd_run(int argc, char **argv)
     const char *mesh_dir = getenv("COHFRAC_MESH_DIR");
     if (!mesh_dir)
         mesh_dir = "build/meshes";
-    cf_run_options opt = {1, 0};
+    cf_run_options opt = {.progress = 1};
     while ((c = getopt_long(argc, argv, "s:m:o:j:q", lo, NULL)) != -1) {
         switch (c) {
         case 's': sets[n_sets++] = optarg; break;
@@ -112,6 +112,7 @@ static int cmd_run(int argc, char **argv)
     cf_error err = {0};
     cf_scene scene;
     cf_sim *sim = NULL;
+    opt.mesh_dir = mesh_dir;
     if (cf_scene_load(argv[optind], sets, n_sets, mesh_dir, &scene, &err) != CF_OK) {
         rc = fail(&err);
     } else {

@@ -5,45 +5,59 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int cmp_pair(const void *a, const void *b)
+typedef struct {
+    int a, b;       /* ascending node pair */
+    double vol;     /* m^3, this tet's share */
+} edge;
+
+static int cmp_edge(const void *x, const void *y)
 {
-    const int *x = a, *y = b;
-    if (x[0] != y[0])
-        return x[0] < y[0] ? -1 : 1;
-    return (x[1] > y[1]) - (x[1] < y[1]);
+    const edge *e = x, *f = y;
+    if (e->a != f->a)
+        return e->a < f->a ? -1 : 1;
+    return (e->b > f->b) - (e->b < f->b);
 }
 
 int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
 {
     static const int E[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-    int *e = malloc((size_t)nt * 12 * sizeof(int));
+    edge *e = malloc((size_t)(nt ? nt : 1) * 6 * sizeof *e);
     if (!e)
         return -1;
     for (int i = 0; i < nt; i++)
         for (int k = 0; k < 6; k++) {
-            int a = s->tet[4 * tets[i] + E[k][0]], c = s->tet[4 * tets[i] + E[k][1]];
-            e[12 * i + 2 * k] = a < c ? a : c;
-            e[12 * i + 2 * k + 1] = a < c ? c : a;
+            int p = s->tet[4 * tets[i] + E[k][0]], q = s->tet[4 * tets[i] + E[k][1]];
+            edge *x = &e[6 * i + k];
+            x->a = p < q ? p : q, x->b = p < q ? q : p;
+            x->vol = s->vol[tets[i]] / 6.0; /* tributary volume: a sixth per edge */
         }
-    qsort(e, (size_t)nt * 6, 2 * sizeof(int), cmp_pair);
+    qsort(e, (size_t)nt * 6, sizeof *e, cmp_edge);
     int n = 0;
-    for (int i = 0; i < 6 * nt; i++)
-        if (n == 0 || e[2 * i] != e[2 * (n - 1)] || e[2 * i + 1] != e[2 * (n - 1) + 1]) {
-            e[2 * n] = e[2 * i], e[2 * n + 1] = e[2 * i + 1];
-            n++;
-        }
-    double *rest = malloc((size_t)(n ? n : 1) * sizeof(double));
-    if (!rest) {
-        free(e);
+    for (int i = 0; i < 6 * nt; i++) {
+        if (n > 0 && e[i].a == e[n - 1].a && e[i].b == e[n - 1].b)
+            e[n - 1].vol += e[i].vol;
+        else
+            e[n++] = e[i];
+    }
+    size_t cap = (size_t)(n ? n : 1);
+    int *ends = malloc(cap * 2 * sizeof(int));
+    double *rest = malloc(cap * sizeof(double)), *compliance = malloc(cap * sizeof(double));
+    double *lambda = calloc(cap, sizeof(double));
+    if (!ends || !rest || !compliance || !lambda) {
+        free(e), free(ends), free(rest), free(compliance), free(lambda);
         return -1;
     }
     for (int i = 0; i < n; i++) {
         double d[3];
-        v3_sub(&s->X[3 * e[2 * i]], &s->X[3 * e[2 * i + 1]], d);
+        ends[2 * i] = e[i].a, ends[2 * i + 1] = e[i].b;
+        v3_sub(&s->X[3 * e[i].a], &s->X[3 * e[i].b], d);
         rest[i] = v3_norm(d);
+        /* A bar of section V/L and length L: stiffness E V / L^2. */
+        compliance[i] = rest[i] * rest[i] / (s->mat.E * e[i].vol);
     }
+    free(e);
     cf_bars_free(b);
-    b->n = n, b->ends = e, b->rest = rest;
+    b->n = n, b->ends = ends, b->rest = rest, b->compliance = compliance, b->lambda = lambda;
     return 0;
 }
 
@@ -51,7 +65,16 @@ void cf_bars_free(cf_bars *b)
 {
     free(b->ends);
     free(b->rest);
+    free(b->compliance);
+    free(b->lambda);
     memset(b, 0, sizeof *b);
+}
+
+double cf_pbd_effective_stiffness(double k, int iterations, int iteration_independent)
+{
+    if (!iteration_independent || iterations < 1)
+        return k;
+    return 1.0 - pow(1.0 - k, 1.0 / iterations);
 }
 
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
@@ -69,6 +92,31 @@ void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
         v3_axpy(-w1 * c, d, p1);
         v3_axpy(w2 * c, d, p2);
     }
+}
+
+void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
+{
+    for (int i = 0; i < b->n; i++) {
+        int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
+        double *p1 = &s->p[3 * i1], *p2 = &s->p[3 * i2];
+        double w1 = 1.0 / s->m[i1], w2 = 1.0 / s->m[i2];
+        double d[3];
+        v3_sub(p1, p2, d);
+        double len = v3_norm(d);
+        if (len == 0)
+            continue;
+        double at = scale * b->compliance[i] / (dt * dt);
+        double dl = (-(len - b->rest[i]) - at * b->lambda[i]) / (w1 + w2 + at);
+        b->lambda[i] += dl;
+        v3_axpy(w1 * dl / len, d, p1);
+        v3_axpy(-w2 * dl / len, d, p2);
+    }
+}
+
+void cf_bars_reset_lambda(cf_bars *b)
+{
+    if (b->n > 0)
+        memset(b->lambda, 0, (size_t)b->n * sizeof(double));
 }
 
 void cf_obstacle_velocity(const cf_obstacle *o, double u[3])

@@ -6,11 +6,16 @@
 #include "cohfrac/scene.h"
 #include "solid.h"
 
-/* One bar per unique edge of the current tets, rest length from s->X. */
+/* One bar per unique edge of the current tets, rest length from s->X.
+ * XPBD compliance of a bar: L^2 / (E V_trib) (m/N), V_trib the sum of a
+ * sixth of the volume of every tet that has the edge, so that a bar is a rod
+ * of section V_trib / L of the bulk material. */
 typedef struct cf_bars {
     int n;
-    int *ends;     /* [n][2] node indices, ascending pairs, sorted */
-    double *rest;  /* [n] m */
+    int *ends;          /* [n][2] node indices, ascending pairs, sorted */
+    double *rest;       /* [n] m */
+    double *compliance; /* [n] m/N */
+    double *lambda;     /* [n] XPBD Lagrange multipliers of this step, N s^2 */
 } cf_bars;
 
 /* (Re)build the bars of `tets`.  Returns 0, or -1 when out of memory. */
@@ -20,6 +25,18 @@ void cf_bars_free(cf_bars *b);
 /* One Gauss-Seidel sweep over the bars on s->p, in bar order:
  * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
+
+/* The stiffness used per iteration: k, or with `iteration_independent`
+ * k' = 1 - (1 - k)^(1/iterations) (Müller et al. 2007, §3.3), so that the
+ * stiffness after all iterations does not depend on their number. */
+double cf_pbd_effective_stiffness(double k, int iterations, int iteration_independent);
+
+/* One XPBD sweep (Macklin, Müller, Chentanez 2016, eq. 18): with
+ * alpha~ = scale compliance / dt^2, dlambda = (-C - alpha~ lambda)/(w1 + w2 +
+ * alpha~), p1 += w1 dlambda n, p2 -= w2 dlambda n.  Reset lambda with
+ * cf_bars_reset_lambda at the start of every step. */
+void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale);
+void cf_bars_reset_lambda(cf_bars *b);
 
 /* Obstacles at time t (moving ones at constant velocity). */
 typedef struct cf_obstacles {

@@ -45,36 +45,67 @@
 
 /* Key lists in schema order: they drive unknown-key checks and the
  * "allowed:" lists in messages; resolved_text() writes keys in this order. */
-static const char *const top_keys[] = {"name",   "duration",  "gravity", "material",
-                                       "bodies", "obstacles", "solver",  "output"};
+static const char *const top_keys[] = {"name",     "duration", "gravity",   "material", "bodies",
+                                       "boundary", "obstacles", "solver",   "output"};
 static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
                                             "sigma_max", "alpha", "G_II", "tau_max",
                                             "beta",  "friction", "restitution"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
-                                        "velocity", "angular_velocity"};
+                                        "velocity", "angular_velocity", "expansion_rate",
+                                        "expansion_center"};
+/* Primitive meshes (bodies[i].mesh = {type = ...}), one key list per type. */
+static const char *const prim_box_keys[] = {"type", "size", "cells", "tets_per_cell"};
+static const char *const prim_sphere_keys[] = {"type", "radius", "mesh_size"};
+static const char *const prim_hollow_keys[] = {"type", "radius", "thickness", "mesh_size"};
+static const char *const prim_plate_keys[] = {"type", "size", "mesh_size"};
+static const char *const prim_beam_keys[] = {"type", "size", "notch", "mesh_size"};
+static const char *const boundary_keys[] = {"region", "velocity", "fixed", "axes", "body"};
+static const char *const region_box_keys[] = {"type", "min", "max"};
+static const char *const region_plane_keys[] = {"type", "point", "normal", "tolerance"};
+static const char *const region_group_keys[] = {"type", "name"};
 static const char *const plane_keys[] = {"type", "point", "normal"};
 static const char *const sphere_keys[] = {"type", "center", "radius", "velocity"};
 static const char *const box_keys[] = {"type", "center", "half_extents", "velocity"};
 static const char *const solver_keys[] = {
-    "rigid_backend",     "dt_rigid",         "rigid_substeps", "dt_fracture",
-    "check_interval",    "quiet_steps",      "max_fracture_time",
-    "impact_threshold",  "elasticity",       "criterion",      "pbd",
-    "threads"};
-static const char *const pbd_keys[] = {"k_stiffness", "iterations", "k_damping"};
+    "mode",              "rigid_backend",    "dt_rigid",       "rigid_substeps",
+    "dt_fracture",       "cfl_fraction",     "check_interval", "quiet_steps",
+    "max_fracture_time",
+    "impact_threshold",  "elasticity",       "criterion",      "crack_plane",
+    "constraints",       "pbd",              "xpbd",           "contact_stiffness",
+    "guard",             "threads"};
+static const char *const crack_plane_keys[] = {"point", "normal", "tolerance"};
+static const char *const pbd_keys[] = {"k_stiffness", "iterations", "k_damping",
+                                       "iteration_independent"};
+static const char *const xpbd_keys[] = {"compliance_scale"};
+static const char *const guard_keys[] = {"max_inverted_fraction", "max_energy_growth"};
 static const char *const output_keys[] = {"file", "frame_interval"};
 
-/* Enum spellings, indexed by the enum values of scene.h. */
+/* Enum spellings, indexed by the enum values of scene.h (primitive_names by
+ * cf_primitive_type - 1: CF_PRIM_NONE has no spelling). */
+static const char *const primitive_names[] = {"box", "sphere", "hollow_sphere", "plate",
+                                              "notched_beam"};
+static const char *const region_names[] = {"box", "plane", "group"};
 static const char *const obstacle_names[] = {"plane", "sphere", "box"};
+static const char *const mode_names[] = {"hybrid", "fracture"};
 static const char *const backend_names[] = {"bullet", "pbd"};
 static const char *const elasticity_names[] = {"corotational", "linear"};
-static const char *const criterion_names[] = {"traction", "source"};
+static const char *const criterion_names[] = {"traction", "source", "none"};
+static const char *const constraints_names[] = {"pbd", "xpbd", "none"};
+_Static_assert(CF_PRIM_NONE == 0 && CF_PRIM_BOX == 1 && CF_PRIM_SPHERE == 2 &&
+                   CF_PRIM_HOLLOW_SPHERE == 3 && CF_PRIM_PLATE == 4 && CF_PRIM_NOTCHED_BEAM == 5,
+               "primitive_names follows cf_primitive_type");
+_Static_assert(CF_REGION_BOX == 0 && CF_REGION_PLANE == 1 && CF_REGION_GROUP == 2,
+               "region_names follows cf_region_type");
 _Static_assert(CF_OBSTACLE_PLANE == 0 && CF_OBSTACLE_SPHERE == 1 && CF_OBSTACLE_BOX == 2,
                "obstacle_names follows cf_obstacle_type");
+_Static_assert(CF_RUN_HYBRID == 0 && CF_RUN_FRACTURE == 1, "mode_names follows cf_run_mode");
 _Static_assert(CF_RIGID_BULLET == 0 && CF_RIGID_PBD == 1, "backend_names follows cf_rigid_backend");
 _Static_assert(CF_ELASTICITY_COROTATIONAL == 0 && CF_ELASTICITY_LINEAR == 1,
                "elasticity_names follows cf_elasticity");
-_Static_assert(CF_CRITERION_TRACTION == 0 && CF_CRITERION_SOURCE == 1,
+_Static_assert(CF_CRITERION_TRACTION == 0 && CF_CRITERION_SOURCE == 1 && CF_CRITERION_NONE == 2,
                "criterion_names follows cf_criterion");
+_Static_assert(CF_CONSTRAINTS_PBD == 0 && CF_CONSTRAINTS_XPBD == 1 && CF_CONSTRAINTS_NONE == 2,
+               "constraints_names follows cf_constraints");
 
 /* An allowed interval for a number; `why` is appended to the message. */
 typedef struct range {
@@ -89,6 +120,7 @@ static const range AT_LEAST_ONE = {1.0, INFINITY, 1, 0, NULL};
 static const range UNIT = {0.0, 1.0, 1, 1, NULL};
 static const range POISSON = {-1.0, 0.5, 0, 0,
                               "(Poisson's ratio of a stable isotropic solid)"};
+static const range ANY = {-INFINITY, INFINITY, 0, 0, NULL};
 static const range PPR_SHAPE = {1.0, INFINITY, 0, 0,
                                 "(the PPR cohesive law needs shape parameters alpha, beta > 1)"};
 
@@ -470,6 +502,54 @@ static cf_status normalise(loader *ld, const char *key, double *v, int n, const 
     return CF_OK;
 }
 
+/* A boolean at t[key]; absent: def. */
+static cf_status get_bool(loader *ld, int t, const char *key, int def, int *out)
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key);
+    if (ty == LUA_TNIL) {
+        *out = def;
+    } else {
+        if (ty != LUA_TBOOLEAN)
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a boolean (true or false), got %s",
+                        kp(ld, key), lua_typename(L, ty));
+        *out = lua_toboolean(L, -1);
+    }
+    lua_pop(L, 1);
+    return CF_OK;
+}
+
+/* A number (the same for x, y and z) or a list of 3 numbers; absent: def. */
+static cf_status get_num_or_vec3(loader *ld, int t, const char *key, const double def[3],
+                                 double out[3])
+{
+    lua_State *L = ld->L;
+    int ty = raw_get(L, t, key);
+    lua_pop(L, 1);
+    if (ty == LUA_TNUMBER) {
+        double v;
+        TRY(get_num(ld, t, key, NULL, &ANY, &v));
+        out[0] = out[1] = out[2] = v;
+        return CF_OK;
+    }
+    if (ty == LUA_TNIL || ty == LUA_TTABLE)
+        return get_vec(ld, t, key, 3, def, out);
+    return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a number or a list of 3 numbers, got %s",
+                kp(ld, key), lua_typename(L, ty));
+}
+
+/* Every component of a 3-vector > 0. */
+static cf_status check_positive3(loader *ld, const char *key, const double v[3])
+{
+    char a[40], b[40], c[40];
+    for (int i = 0; i < 3; i++)
+        if (!(v[i] > 0.0))
+            return fail(ld, CF_ERR_SCENE_VALUE,
+                        "'%s' must have every component > 0, got {%s, %s, %s}", kp(ld, key),
+                        shortest(a, v[0]), shortest(b, v[1]), shortest(c, v[2]));
+    return CF_OK;
+}
+
 /* Pushes the table at t[key]; when absent, an empty one, so that every
  * default inside applies. */
 static cf_status push_table(loader *ld, int t, const char *key)
@@ -547,7 +627,8 @@ static int ends_with(const char *s, const char *suffix)
     return ls >= lx && strcmp(s + ls - lx, suffix) == 0;
 }
 
-/* Turn the `mesh` value into an absolute TetGen base path (no extension).
+/* Turn the `mesh` value into an absolute TetGen base path (no extension),
+ * or, for a name ending in ".msh", the absolute path of that Gmsh file.
  * The directory part goes through realpath so that the resolved scene loads
  * the same mesh from any working directory; the file name is kept as given
  * (not following a symlinked .node), so the .ele beside it still matches. */
@@ -575,13 +656,22 @@ static cf_status resolve_mesh(loader *ld, const char *key, const char *name, cha
     }
     if (w < 0 || (size_t)w >= sizeof base)
         return fail(ld, CF_ERR_SCENE_VALUE, "'%s': mesh path too long", kp(ld, key));
-    if (ends_with(base, ".node"))
-        base[strlen(base) - 5] = '\0';
-    else if (ends_with(base, ".ele"))
-        base[strlen(base) - 4] = '\0';
-    snprintf(node, sizeof node, "%s.node", base);
+    if (!prepared && ends_with(base, ".msh")) {
+        if (!is_file(base))
+            return fail(ld, CF_ERR_FILE_OPEN,
+                        "%s: Gmsh mesh '%s' not found: no file %s (relative paths start at the "
+                        "scene file's directory)",
+                        kp(ld, key), name, base);
+        node[0] = '\0';
+    } else {
+        if (ends_with(base, ".node"))
+            base[strlen(base) - 5] = '\0';
+        else if (ends_with(base, ".ele"))
+            base[strlen(base) - 4] = '\0';
+        snprintf(node, sizeof node, "%s.node", base);
+    }
 
-    if (!is_file(node)) {
+    if (node[0] && !is_file(node)) {
         if (prepared) {
             /* The bunny is the one mesh we know a source surface for. */
             const char *src = strncmp(name, "bunny", 5) == 0
@@ -619,6 +709,19 @@ static cf_status resolve_mesh(loader *ld, const char *key, const char *name, cha
 
 /* ---------------------------------------------------------------- sections */
 
+/* Runs `call` with the sub-table t[key] on top of the stack and the key
+ * path extended by `key`. */
+#define WITH_TABLE(ld, t, key, call)                                                        \
+    do {                                                                                    \
+        size_t old_;                                                                        \
+        TRY(push_table(ld, t, key));                                                        \
+        old_ = path_push_key(ld, key);                                                      \
+        TRY(call);                                                                          \
+        path_pop(ld, old_);                                                                 \
+        lua_pop((ld)->L, 1);                                                                \
+    } while (0)
+
+
 static cf_status read_material(loader *ld, int t, cf_material *m)
 {
     static const double E = 1e6, nu = 0.3, rho = 2400.0, G_I = 22.0, sigma = 1e4, alpha = 2.0,
@@ -640,19 +743,232 @@ static cf_status read_material(loader *ld, int t, cf_material *m)
     return CF_OK;
 }
 
+/* cells: a list of 3 integers >= 1. */
+static cf_status get_cells(loader *ld, int t, const char *key, int out[3])
+{
+    static const double one3[3] = {1.0, 1.0, 1.0};
+    double v[3];
+    char got[40];
+    TRY(get_vec(ld, t, key, 3, one3, v));
+    for (int i = 0; i < 3; i++) {
+        if (v[i] != floor(v[i]))
+            return fail(ld, CF_ERR_SCENE_TYPE, "'%s' must be a list of 3 integers, got %s at [%d]",
+                        kp(ld, key), shortest(got, v[i]), i + 1);
+        if (v[i] < 1.0 || v[i] > INT_MAX)
+            return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must hold integers in [1, %d], got %s at [%d]",
+                        kp(ld, key), INT_MAX, shortest(got, v[i]), i + 1);
+        out[i] = (int)v[i];
+    }
+    return CF_OK;
+}
+
+/* A primitive mesh table (the key path ends in ".mesh"); only records the
+ * parameters: meshing happens when the simulation starts. */
+static cf_status read_primitive(loader *ld, int t, cf_primitive *p)
+{
+    char a[40], b[40];
+    int type = 0;
+    memset(p, 0, sizeof *p);
+    TRY(get_enum(ld, t, "type", primitive_names, COUNT(primitive_names), -1, &type));
+    p->type = (cf_primitive_type)(type + 1);
+    switch (p->type) {
+    case CF_PRIM_BOX: {
+        double tets;
+        TRY(check_keys(ld, t, prim_box_keys, COUNT(prim_box_keys)));
+        TRY(get_vec(ld, t, "size", 3, NULL, p->size));
+        TRY(check_positive3(ld, "size", p->size));
+        TRY(get_cells(ld, t, "cells", p->cells));
+        TRY(get_int(ld, t, "tets_per_cell", 6, &ANY, &p->tets_per_cell));
+        if (p->tets_per_cell != 5 && p->tets_per_cell != 6)
+            return fail(ld, CF_ERR_SCENE_VALUE, "'%s' must be 5 or 6, got %d",
+                        kp(ld, "tets_per_cell"), p->tets_per_cell);
+        tets = (double)p->cells[0] * p->cells[1] * p->cells[2] * p->tets_per_cell;
+        if (tets > INT_MAX)
+            return fail(ld, CF_ERR_SCENE_VALUE,
+                        "'%s' = {%d, %d, %d} gives %.3g tets, more than %d", kp(ld, "cells"),
+                        p->cells[0], p->cells[1], p->cells[2], tets, INT_MAX);
+        break;
+    }
+    case CF_PRIM_SPHERE:
+        TRY(check_keys(ld, t, prim_sphere_keys, COUNT(prim_sphere_keys)));
+        TRY(get_num(ld, t, "radius", NULL, &POSITIVE, &p->radius));
+        TRY(get_num(ld, t, "mesh_size", NULL, &POSITIVE, &p->mesh_size));
+        break;
+    case CF_PRIM_HOLLOW_SPHERE:
+        TRY(check_keys(ld, t, prim_hollow_keys, COUNT(prim_hollow_keys)));
+        TRY(get_num(ld, t, "radius", NULL, &POSITIVE, &p->radius));
+        TRY(get_num(ld, t, "thickness", NULL, &POSITIVE, &p->thickness));
+        if (p->thickness >= p->radius)
+            return fail(ld, CF_ERR_SCENE_VALUE,
+                        "'%s' must be < radius (%s): the shell needs a cavity, got %s",
+                        kp(ld, "thickness"), shortest(a, p->radius), shortest(b, p->thickness));
+        TRY(get_num(ld, t, "mesh_size", NULL, &POSITIVE, &p->mesh_size));
+        break;
+    case CF_PRIM_PLATE:
+        TRY(check_keys(ld, t, prim_plate_keys, COUNT(prim_plate_keys)));
+        TRY(get_vec(ld, t, "size", 3, NULL, p->size));
+        TRY(check_positive3(ld, "size", p->size));
+        TRY(get_num(ld, t, "mesh_size", NULL, &POSITIVE, &p->mesh_size));
+        break;
+    case CF_PRIM_NOTCHED_BEAM: {
+        const double *n = p->notch;
+        char c[40];
+        TRY(check_keys(ld, t, prim_beam_keys, COUNT(prim_beam_keys)));
+        TRY(get_vec(ld, t, "size", 3, NULL, p->size));
+        TRY(check_positive3(ld, "size", p->size));
+        TRY(get_vec(ld, t, "notch", 3, NULL, p->notch));
+        if (!(n[0] > 0.0 && n[0] < p->size[2]))
+            return fail(ld, CF_ERR_SCENE_VALUE,
+                        "'%s' depth (notch[1]) must be in (0, %s), less than the beam height "
+                        "size[3], got %s",
+                        kp(ld, "notch"), shortest(a, p->size[2]), shortest(b, n[0]));
+        if (!(n[1] > 0.0))
+            return fail(ld, CF_ERR_SCENE_VALUE, "'%s' width (notch[2]) must be > 0, got %s",
+                        kp(ld, "notch"), shortest(a, n[1]));
+        if (!(fabs(n[2]) + 0.5 * n[1] < 0.5 * p->size[0]))
+            return fail(ld, CF_ERR_SCENE_VALUE,
+                        "'%s' must lie inside the beam length: |offset| + width/2 (notch[3], "
+                        "notch[2]) must be < size[1]/2 = %s, got %s + %s",
+                        kp(ld, "notch"), shortest(a, 0.5 * p->size[0]), shortest(b, fabs(n[2])),
+                        shortest(c, 0.5 * n[1]));
+        TRY(get_num(ld, t, "mesh_size", NULL, &POSITIVE, &p->mesh_size));
+        break;
+    }
+    case CF_PRIM_NONE:
+        break;
+    }
+    return CF_OK;
+}
+
 static cf_status read_body(loader *ld, int t, cf_body_def *b)
 {
     static const double one = 1.0;
+    lua_State *L = ld->L;
     char mesh[1024];
     TRY(check_keys(ld, t, body_keys, COUNT(body_keys)));
-    TRY(get_str(ld, t, "mesh", NULL, mesh, sizeof mesh));
-    TRY(resolve_mesh(ld, "mesh", mesh, b->mesh, sizeof b->mesh));
+    switch (raw_get(L, t, "mesh")) {
+    case LUA_TTABLE: {
+        size_t old = path_push_key(ld, "mesh");
+        TRY(read_primitive(ld, lua_gettop(L), &b->primitive));
+        path_pop(ld, old);
+        lua_pop(L, 1);
+        b->mesh[0] = '\0';
+        break;
+    }
+    case LUA_TNIL:
+    case LUA_TSTRING:
+        lua_pop(L, 1);
+        TRY(get_str(ld, t, "mesh", NULL, mesh, sizeof mesh));
+        TRY(resolve_mesh(ld, "mesh", mesh, b->mesh, sizeof b->mesh));
+        b->primitive.type = CF_PRIM_NONE;
+        break;
+    default:
+        return fail(ld, CF_ERR_SCENE_TYPE,
+                    "'%s' must be a string (a mesh name or path) or a table (a primitive), got %s",
+                    kp(ld, "mesh"), luaL_typename(L, -1));
+    }
     TRY(get_num(ld, t, "scale", &one, &POSITIVE, &b->scale));
     TRY(get_vec(ld, t, "position", 3, ZERO3, b->position));
     TRY(get_vec(ld, t, "orientation", 4, IDENTITY_QUAT, b->orientation));
     TRY(normalise(ld, "orientation", b->orientation, 4, "quaternion"));
     TRY(get_vec(ld, t, "velocity", 3, ZERO3, b->velocity));
     TRY(get_vec(ld, t, "angular_velocity", 3, ZERO3, b->angular_velocity));
+    TRY(get_num_or_vec3(ld, t, "expansion_rate", ZERO3, b->expansion_rate));
+    if (raw_get(L, t, "expansion_center") != LUA_TNIL) {
+        b->has_expansion_center = 1;
+        TRY(get_vec(ld, t, "expansion_center", 3, NULL, b->expansion_center));
+    }
+    lua_pop(L, 1);
+    return CF_OK;
+}
+
+/* The `region` of a boundary entry (the key path ends in ".region"). */
+static cf_status read_region(loader *ld, int t, cf_boundary *b)
+{
+    static const double tolerance = 1e-6;
+    int type;
+    TRY(get_enum(ld, t, "type", region_names, COUNT(region_names), -1, &type));
+    b->type = (cf_region_type)type;
+    switch (b->type) {
+    case CF_REGION_BOX:
+        TRY(check_keys(ld, t, region_box_keys, COUNT(region_box_keys)));
+        TRY(get_vec(ld, t, "min", 3, NULL, b->min));
+        TRY(get_vec(ld, t, "max", 3, NULL, b->max));
+        for (int i = 0; i < 3; i++)
+            if (!(b->min[i] < b->max[i])) {
+                char x[40], y[40];
+                return fail(ld, CF_ERR_SCENE_VALUE,
+                            "'%s' must exceed min in every component, got max[%d] = %s <= "
+                            "min[%d] = %s",
+                            kp(ld, "max"), i + 1, shortest(x, b->max[i]), i + 1,
+                            shortest(y, b->min[i]));
+            }
+        break;
+    case CF_REGION_PLANE:
+        TRY(check_keys(ld, t, region_plane_keys, COUNT(region_plane_keys)));
+        TRY(get_vec(ld, t, "point", 3, NULL, b->point));
+        TRY(get_vec(ld, t, "normal", 3, NULL, b->normal));
+        TRY(normalise(ld, "normal", b->normal, 3, "vector"));
+        TRY(get_num(ld, t, "tolerance", &tolerance, &POSITIVE, &b->tolerance));
+        break;
+    case CF_REGION_GROUP:
+        TRY(check_keys(ld, t, region_group_keys, COUNT(region_group_keys)));
+        TRY(get_str(ld, t, "name", NULL, b->group, sizeof b->group));
+        break;
+    }
+    return CF_OK;
+}
+
+/* One entry of `boundary`; bodies are read already (n_bodies of them). */
+static cf_status read_boundary(loader *ld, int t, int n_bodies, cf_boundary *b)
+{
+    lua_State *L = ld->L;
+    char axes[64];
+    int has_velocity, fixed = 0;
+    TRY(check_keys(ld, t, boundary_keys, COUNT(boundary_keys)));
+    if (raw_get(L, t, "region") == LUA_TNIL)
+        return fail(ld, CF_ERR_SCENE_KEY,
+                    "missing required key '%s' (a box, plane or group region)", kp(ld, "region"));
+    lua_pop(L, 1);
+    WITH_TABLE(ld, t, "region", read_region(ld, lua_gettop(L), b));
+
+    has_velocity = raw_get(L, t, "velocity") != LUA_TNIL;
+    lua_pop(L, 1);
+    TRY(get_bool(ld, t, "fixed", 0, &fixed));
+    if (has_velocity && fixed)
+        return fail(ld, CF_ERR_SCENE_VALUE,
+                    "'%s' gives both 'velocity' and 'fixed = true'; give one of them (fixed = "
+                    "true means velocity {0, 0, 0})",
+                    ld->path);
+    if (!has_velocity && !fixed)
+        return fail(ld, CF_ERR_SCENE_KEY,
+                    "missing required key '%s' (or 'fixed = true'): a boundary prescribes a "
+                    "velocity",
+                    kp(ld, "velocity"));
+    TRY(get_vec(ld, t, "velocity", 3, ZERO3, b->velocity));
+
+    TRY(get_str(ld, t, "axes", "xyz", axes, sizeof axes));
+    b->axes = 0;
+    for (const char *c = axes; *c; c++) {
+        static const char xyz[] = "xyz";
+        const char *at = strchr(xyz, *c);
+        int bit = at ? 1 << (at - xyz) : 0;
+        if (!bit || (b->axes & bit))
+            return fail(ld, CF_ERR_SCENE_VALUE,
+                        "'%s' is \"%s\"; allowed: distinct letters from \"xyz\" (\"z\", "
+                        "\"xy\", ...)",
+                        kp(ld, "axes"), axes);
+        b->axes |= bit;
+    }
+
+    if (raw_get(L, t, "body") == LUA_TNIL) {
+        b->body = -1;
+    } else {
+        range bodies = {1.0, (double)n_bodies, 1, 1, "(a 1-based index into bodies)"};
+        TRY(get_int(ld, t, "body", 0, &bodies, &b->body));
+        b->body--;
+    }
+    lua_pop(L, 1);
     return CF_OK;
 }
 
@@ -690,13 +1006,55 @@ static cf_status read_obstacle(loader *ld, int t, cf_obstacle *o)
     return CF_OK;
 }
 
+static cf_status read_crack_plane(loader *ld, int t, cf_solver_settings *s)
+{
+    static const double tolerance = 1e-6;
+    TRY(check_keys(ld, t, crack_plane_keys, COUNT(crack_plane_keys)));
+    TRY(get_vec(ld, t, "point", 3, NULL, s->crack_plane_point));
+    TRY(get_vec(ld, t, "normal", 3, NULL, s->crack_plane_normal));
+    TRY(normalise(ld, "normal", s->crack_plane_normal, 3, "vector"));
+    TRY(get_num(ld, t, "tolerance", &tolerance, &POSITIVE, &s->crack_plane_tolerance));
+    s->has_crack_plane = 1;
+    return CF_OK;
+}
+
+static cf_status read_pbd(loader *ld, int t, cf_solver_settings *s)
+{
+    static const double k_stiffness = 0.9, k_damping = 1.0;
+    TRY(check_keys(ld, t, pbd_keys, COUNT(pbd_keys)));
+    TRY(get_num(ld, t, "k_stiffness", &k_stiffness, &UNIT, &s->k_stiffness));
+    TRY(get_int(ld, t, "iterations", 3, &AT_LEAST_ONE, &s->iterations));
+    TRY(get_num(ld, t, "k_damping", &k_damping, &UNIT, &s->k_damping));
+    TRY(get_bool(ld, t, "iteration_independent", 0, &s->iteration_independent));
+    return CF_OK;
+}
+
+static cf_status read_xpbd(loader *ld, int t, cf_solver_settings *s)
+{
+    static const double one = 1.0;
+    TRY(check_keys(ld, t, xpbd_keys, COUNT(xpbd_keys)));
+    TRY(get_num(ld, t, "compliance_scale", &one, &POSITIVE, &s->compliance_scale));
+    return CF_OK;
+}
+
+static cf_status read_guard(loader *ld, int t, cf_solver_settings *s)
+{
+    static const double inverted = 0.01, growth = 0.5;
+    TRY(check_keys(ld, t, guard_keys, COUNT(guard_keys)));
+    TRY(get_num(ld, t, "max_inverted_fraction", &inverted, &UNIT, &s->max_inverted_fraction));
+    TRY(get_num(ld, t, "max_energy_growth", &growth, &POSITIVE, &s->max_energy_growth));
+    return CF_OK;
+}
+
 static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
 {
     static const double dt_rigid = 1e-3, dt_fracture = 5e-6, max_fracture_time = 0.05,
-                        impact_threshold = 0.2, k_stiffness = 0.9, k_damping = 1.0;
-    int backend, elasticity, criterion, top;
-    size_t old;
+                        impact_threshold = 0.2, contact_stiffness = 0.0, cfl_fraction = 0.0;
+    lua_State *L = ld->L;
+    int mode, backend, elasticity, criterion, constraints;
     TRY(check_keys(ld, t, solver_keys, COUNT(solver_keys)));
+    TRY(get_enum(ld, t, "mode", mode_names, COUNT(mode_names), CF_RUN_HYBRID, &mode));
+    s->mode = (cf_run_mode)mode;
     TRY(get_enum(ld, t, "rigid_backend", backend_names, COUNT(backend_names), CF_RIGID_BULLET,
                  &backend));
     s->rigid_backend = (cf_rigid_backend)backend;
@@ -707,6 +1065,7 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
         return fail(ld, CF_ERR_SCENE_VALUE,
                     "'%s' must not exceed solver.dt_rigid (%g), got %g", kp(ld, "dt_fracture"),
                     s->dt_rigid, s->dt_fracture);
+    TRY(get_num(ld, t, "cfl_fraction", &cfl_fraction, &NON_NEGATIVE, &s->cfl_fraction));
     TRY(get_int(ld, t, "check_interval", 1, &AT_LEAST_ONE, &s->check_interval));
     TRY(get_int(ld, t, "quiet_steps", 400, &AT_LEAST_ONE, &s->quiet_steps));
     TRY(get_num(ld, t, "max_fracture_time", &max_fracture_time, &POSITIVE,
@@ -719,17 +1078,21 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     TRY(get_enum(ld, t, "criterion", criterion_names, COUNT(criterion_names),
                  CF_CRITERION_TRACTION, &criterion));
     s->criterion = (cf_criterion)criterion;
-
-    TRY(push_table(ld, t, "pbd"));
-    top = lua_gettop(ld->L);
-    old = path_push_key(ld, "pbd");
-    TRY(check_keys(ld, top, pbd_keys, COUNT(pbd_keys)));
-    TRY(get_num(ld, top, "k_stiffness", &k_stiffness, &UNIT, &s->k_stiffness));
-    TRY(get_int(ld, top, "iterations", 3, &AT_LEAST_ONE, &s->iterations));
-    TRY(get_num(ld, top, "k_damping", &k_damping, &UNIT, &s->k_damping));
-    path_pop(ld, old);
-    lua_pop(ld->L, 1);
-
+    s->has_crack_plane = 0;
+    if (raw_get(L, t, "crack_plane") != LUA_TNIL) {
+        lua_pop(L, 1);
+        WITH_TABLE(ld, t, "crack_plane", read_crack_plane(ld, lua_gettop(L), s));
+    } else {
+        lua_pop(L, 1);
+    }
+    TRY(get_enum(ld, t, "constraints", constraints_names, COUNT(constraints_names),
+                 CF_CONSTRAINTS_PBD, &constraints));
+    s->constraints = (cf_constraints)constraints;
+    WITH_TABLE(ld, t, "pbd", read_pbd(ld, lua_gettop(L), s));
+    WITH_TABLE(ld, t, "xpbd", read_xpbd(ld, lua_gettop(L), s));
+    TRY(get_num(ld, t, "contact_stiffness", &contact_stiffness, &NON_NEGATIVE,
+                &s->contact_stiffness));
+    WITH_TABLE(ld, t, "guard", read_guard(ld, lua_gettop(L), s));
     TRY(get_int(ld, t, "threads", 0, &NON_NEGATIVE, &s->threads));
     return CF_OK;
 }
@@ -737,25 +1100,21 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
 static cf_status read_output(loader *ld, int t, const char *name, cf_output_settings *o)
 {
     static const double frame_interval = 0.01;
+    lua_State *L = ld->L;
     char def[sizeof o->file];
     TRY(check_keys(ld, t, output_keys, COUNT(output_keys)));
     snprintf(def, sizeof def, "out/%s.h5", name); /* name < 128 bytes: fits */
-    TRY(get_str(ld, t, "file", def, o->file, sizeof o->file));
+    /* "" means no output file. */
+    if (raw_get(L, t, "file") == LUA_TSTRING && lua_rawlen(L, -1) == 0) {
+        lua_pop(L, 1);
+        o->file[0] = '\0';
+    } else {
+        lua_pop(L, 1);
+        TRY(get_str(ld, t, "file", def, o->file, sizeof o->file));
+    }
     TRY(get_num(ld, t, "frame_interval", &frame_interval, &POSITIVE, &o->frame_interval));
     return CF_OK;
 }
-
-/* Runs `call` with the sub-table t[key] on top of the stack and the key
- * path extended by `key`. */
-#define WITH_TABLE(ld, t, key, call)                                                        \
-    do {                                                                                    \
-        size_t old_;                                                                        \
-        TRY(push_table(ld, t, key));                                                        \
-        old_ = path_push_key(ld, key);                                                      \
-        TRY(call);                                                                          \
-        path_pop(ld, old_);                                                                 \
-        lua_pop((ld)->L, 1);                                                                \
-    } while (0)
 
 static cf_status read_scene(loader *ld, int t)
 {
@@ -791,6 +1150,24 @@ static cf_status read_scene(loader *ld, int t)
     }
     lua_pop(L, 1);
 
+    TRY(push_list(ld, t, "boundary", &n));
+    li = lua_gettop(L);
+    if (n > 0) {
+        s->boundaries = calloc((size_t)n, sizeof s->boundaries[0]);
+        if (!s->boundaries)
+            return fail(ld, CF_ERR_NOMEM, "out of memory for %d boundary entries", n);
+    }
+    for (int i = 0; i < n; i++) {
+        size_t old = path_push_key(ld, "boundary");
+        path_push_index(ld, i + 1);
+        lua_rawgeti(L, li, i + 1);
+        TRY(read_boundary(ld, lua_gettop(L), s->n_bodies, &s->boundaries[i]));
+        lua_pop(L, 1);
+        path_pop(ld, old);
+        s->n_boundaries = i + 1;
+    }
+    lua_pop(L, 1);
+
     TRY(push_list(ld, t, "obstacles", &n));
     li = lua_gettop(L);
     if (n > 0) {
@@ -810,6 +1187,12 @@ static cf_status read_scene(loader *ld, int t)
     lua_pop(L, 1);
 
     WITH_TABLE(ld, t, "solver", read_solver(ld, lua_gettop(L), &s->solver));
+    if (s->n_boundaries > 0 && s->solver.mode != CF_RUN_FRACTURE)
+        return fail(ld, CF_ERR_SCENE_VALUE,
+                    "'boundary' has %d entr%s but solver.mode is \"%s\": boundary conditions "
+                    "need solver.mode = \"fracture\"",
+                    s->n_boundaries, s->n_boundaries == 1 ? "y" : "ies",
+                    mode_names[s->solver.mode]);
     WITH_TABLE(ld, t, "output", read_output(ld, lua_gettop(L), s->name, &s->output));
     return CF_OK;
 }
@@ -1092,6 +1475,80 @@ static void put_str(text *b, int ind, const char *key, const char *s)
     put(b, "\",\n");
 }
 
+static void put_primitive(text *b, int ind, const cf_primitive *p)
+{
+    put(b, "%*smesh = {\n", ind, "");
+    put_str(b, ind + 2, "type", primitive_names[p->type - 1]);
+    switch (p->type) {
+    case CF_PRIM_BOX:
+        put_vec(b, ind + 2, "size", p->size, 3);
+        put(b, "%*scells = {%d, %d, %d},\n", ind + 2, "", p->cells[0], p->cells[1], p->cells[2]);
+        put(b, "%*stets_per_cell = %d,\n", ind + 2, "", p->tets_per_cell);
+        break;
+    case CF_PRIM_SPHERE:
+        put_num(b, ind + 2, "radius", p->radius);
+        put_num(b, ind + 2, "mesh_size", p->mesh_size);
+        break;
+    case CF_PRIM_HOLLOW_SPHERE:
+        put_num(b, ind + 2, "radius", p->radius);
+        put_num(b, ind + 2, "thickness", p->thickness);
+        put_num(b, ind + 2, "mesh_size", p->mesh_size);
+        break;
+    case CF_PRIM_PLATE:
+        put_vec(b, ind + 2, "size", p->size, 3);
+        put_num(b, ind + 2, "mesh_size", p->mesh_size);
+        break;
+    case CF_PRIM_NOTCHED_BEAM:
+        put_vec(b, ind + 2, "size", p->size, 3);
+        put_vec(b, ind + 2, "notch", p->notch, 3);
+        put_num(b, ind + 2, "mesh_size", p->mesh_size);
+        break;
+    case CF_PRIM_NONE:
+        break;
+    }
+    put(b, "%*s},\n", ind, "");
+}
+
+static void put_boundary(text *b, const cf_boundary *d)
+{
+    static const char xyz[] = "xyz";
+    char axes[4];
+    int n = 0;
+    put(b, "    {\n      region = {\n");
+    put_str(b, 8, "type", region_names[d->type]);
+    switch (d->type) {
+    case CF_REGION_BOX:
+        put_vec(b, 8, "min", d->min, 3);
+        put_vec(b, 8, "max", d->max, 3);
+        break;
+    case CF_REGION_PLANE:
+        put_vec(b, 8, "point", d->point, 3);
+        put_vec(b, 8, "normal", d->normal, 3);
+        put_num(b, 8, "tolerance", d->tolerance);
+        break;
+    case CF_REGION_GROUP:
+        put_str(b, 8, "name", d->group);
+        break;
+    }
+    put(b, "      },\n");
+    /* fixed = true reads back as velocity +0.0 exactly; anything else,
+     * -0.0 included, is written as it is. */
+    if (memcmp(d->velocity, ZERO3, sizeof ZERO3) == 0)
+        put(b, "      fixed = true,\n");
+    else
+        put_vec(b, 6, "velocity", d->velocity, 3);
+    for (int k = 0; k < 3; k++)
+        if (d->axes & (1 << k))
+            axes[n++] = xyz[k];
+    axes[n] = '\0';
+    put_str(b, 6, "axes", axes);
+    if (d->body >= 0)
+        put(b, "      body = %d,\n", d->body + 1);
+    else
+        put(b, "      -- body: every body\n");
+    put(b, "    },\n");
+}
+
 /* The whole scene as Lua text in schema order; NULL when out of memory. */
 static char *resolved_text(const cf_scene *s)
 {
@@ -1118,14 +1575,25 @@ static char *resolved_text(const cf_scene *s)
     for (int i = 0; i < s->n_bodies; i++) {
         const cf_body_def *d = &s->bodies[i];
         put(&b, "    {\n");
-        put_str(&b, 6, "mesh", d->mesh);
+        if (d->primitive.type != CF_PRIM_NONE)
+            put_primitive(&b, 6, &d->primitive);
+        else
+            put_str(&b, 6, "mesh", d->mesh);
         put_num(&b, 6, "scale", d->scale);
         put_vec(&b, 6, "position", d->position, 3);
         put_vec(&b, 6, "orientation", d->orientation, 4);
         put_vec(&b, 6, "velocity", d->velocity, 3);
         put_vec(&b, 6, "angular_velocity", d->angular_velocity, 3);
+        put_vec(&b, 6, "expansion_rate", d->expansion_rate, 3);
+        if (d->has_expansion_center)
+            put_vec(&b, 6, "expansion_center", d->expansion_center, 3);
+        else
+            put(&b, "      -- expansion_center: the body's centre of mass\n");
         put(&b, "    },\n");
     }
+    put(&b, "  },\n  boundary = {\n");
+    for (int i = 0; i < s->n_boundaries; i++)
+        put_boundary(&b, &s->boundaries[i]);
     put(&b, "  },\n  obstacles = {\n");
     for (int i = 0; i < s->n_obstacles; i++) {
         const cf_obstacle *o = &s->obstacles[i];
@@ -1145,20 +1613,40 @@ static char *resolved_text(const cf_scene *s)
         put(&b, "    },\n");
     }
     put(&b, "  },\n  solver = {\n");
+    put_str(&b, 4, "mode", mode_names[v->mode]);
     put_str(&b, 4, "rigid_backend", backend_names[v->rigid_backend]);
     put_num(&b, 4, "dt_rigid", v->dt_rigid);
     put(&b, "    rigid_substeps = %d,\n", v->rigid_substeps);
     put_num(&b, 4, "dt_fracture", v->dt_fracture);
+    put_num(&b, 4, "cfl_fraction", v->cfl_fraction);
     put(&b, "    check_interval = %d,\n", v->check_interval);
     put(&b, "    quiet_steps = %d,\n", v->quiet_steps);
     put_num(&b, 4, "max_fracture_time", v->max_fracture_time);
     put_num(&b, 4, "impact_threshold", v->impact_threshold);
     put_str(&b, 4, "elasticity", elasticity_names[v->elasticity]);
     put_str(&b, 4, "criterion", criterion_names[v->criterion]);
+    if (v->has_crack_plane) {
+        put(&b, "    crack_plane = {\n");
+        put_vec(&b, 6, "point", v->crack_plane_point, 3);
+        put_vec(&b, 6, "normal", v->crack_plane_normal, 3);
+        put_num(&b, 6, "tolerance", v->crack_plane_tolerance);
+        put(&b, "    },\n");
+    } else {
+        put(&b, "    -- crack_plane: none\n");
+    }
+    put_str(&b, 4, "constraints", constraints_names[v->constraints]);
     put(&b, "    pbd = {\n");
     put_num(&b, 6, "k_stiffness", v->k_stiffness);
     put(&b, "      iterations = %d,\n", v->iterations);
     put_num(&b, 6, "k_damping", v->k_damping);
+    put(&b, "      iteration_independent = %s,\n", v->iteration_independent ? "true" : "false");
+    put(&b, "    },\n    xpbd = {\n");
+    put_num(&b, 6, "compliance_scale", v->compliance_scale);
+    put(&b, "    },\n");
+    put_num(&b, 4, "contact_stiffness", v->contact_stiffness);
+    put(&b, "    guard = {\n");
+    put_num(&b, 6, "max_inverted_fraction", v->max_inverted_fraction);
+    put_num(&b, 6, "max_energy_growth", v->max_energy_growth);
     put(&b, "    },\n");
     put(&b, "    threads = %d,\n", v->threads);
     put(&b, "  },\n  output = {\n");
@@ -1272,6 +1760,7 @@ void cf_scene_free(cf_scene *s)
         return;
     free(s->bodies);
     free(s->obstacles);
+    free(s->boundaries);
     free(s->resolved);
     memset(s, 0, sizeof *s);
 }

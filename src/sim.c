@@ -34,35 +34,96 @@ static void place_mesh(cf_mesh *m, const cf_body_def *b)
     }
 }
 
-/* All bodies' meshes, placed and concatenated; body[t] is each tet's body. */
-static cf_status load_bodies(const cf_scene *sc, cf_mesh *all, int **body, cf_error *err)
+/* Whether the placed node x of body b lies in the region of boundary c
+ * (group regions are matched by the caller). */
+static int in_region(const cf_boundary *c, const double x[3])
+{
+    if (c->type == CF_REGION_BOX) {
+        for (int k = 0; k < 3; k++)
+            if (x[k] < c->min[k] || x[k] > c->max[k])
+                return 0;
+        return 1;
+    }
+    double d[3];
+    v3_sub(x, c->point, d);
+    return fabs(v3_dot(d, c->normal)) <= c->tolerance;
+}
+
+/* The boundary condition of each node of body b (mesh m, placed): the last
+ * matching entry of the scene's list wins.  Counts the nodes per entry. */
+static cf_status body_boundary(const cf_scene *sc, int b, const cf_mesh *m, int *bc, int *count,
+                               cf_error *err)
+{
+    for (int c = 0; c < sc->n_boundaries; c++) {
+        const cf_boundary *bd = &sc->boundaries[c];
+        if (bd->body >= 0 && bd->body != b)
+            continue;
+        if (bd->type != CF_REGION_GROUP) {
+            for (int i = 0; i < m->n_nodes; i++)
+                if (in_region(bd, &m->x[3 * i]))
+                    bc[i] = c, count[c]++;
+            continue;
+        }
+        int g = 0;
+        while (g < m->n_groups && strcmp(m->groups[g].name, bd->group) != 0)
+            g++;
+        if (g == m->n_groups) {
+            if (bd->body < 0)
+                continue; /* another body may have it */
+            return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                                "boundary[%d].region.name: body %d's mesh has no physical group "
+                                "'%s' (%d groups): name a Gmsh physical group of that mesh",
+                                c + 1, b + 1, bd->group, m->n_groups);
+        }
+        for (int i = 0; i < m->groups[g].n_nodes; i++)
+            bc[m->groups[g].nodes[i]] = c, count[c]++;
+    }
+    return CF_OK;
+}
+
+static cf_status load_mesh(const cf_body_def *bd, const char *mesh_dir, cf_mesh *m, cf_error *err)
+{
+    if (bd->primitive.type != CF_PRIM_NONE)
+        return cf_mesh_primitive(&bd->primitive, mesh_dir ? mesh_dir : "build/meshes", m, err);
+    return cf_mesh_load(bd->mesh, m, err);
+}
+
+/* All bodies' meshes, placed and concatenated; body[t] is each tet's body,
+ * bc[n] each node's boundary condition (-1 none). */
+static cf_status load_bodies(const cf_scene *sc, const char *mesh_dir, cf_mesh *all, int **body,
+                             int **bc, cf_error *err)
 {
     memset(all, 0, sizeof *all);
-    *body = NULL;
-    for (int b = 0; b < sc->n_bodies; b++) {
+    *body = NULL, *bc = NULL;
+    int *count = calloc((size_t)sc->n_boundaries + 1, sizeof(int));
+    cf_status st = count ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int b = 0; b < sc->n_bodies && st == CF_OK; b++) {
         cf_mesh m;
-        cf_status st = cf_mesh_load_tetgen(sc->bodies[b].mesh, &m, err);
-        if (st != CF_OK) {
-            cf_mesh_free(all);
-            free(*body);
-            return st;
-        }
+        st = load_mesh(&sc->bodies[b], mesh_dir, &m, err);
+        if (st != CF_OK)
+            break;
         place_mesh(&m, &sc->bodies[b]);
-        double *x = realloc(all->x, (size_t)(all->n_nodes + m.n_nodes) * 3 * sizeof(double));
-        int *t = realloc(all->tets, (size_t)(all->n_tets + m.n_tets) * 4 * sizeof(int));
-        int *bt = realloc(*body, (size_t)(all->n_tets + m.n_tets) * sizeof(int));
+        size_t nn = (size_t)(all->n_nodes + m.n_nodes), nt = (size_t)(all->n_tets + m.n_tets);
+        double *x = realloc(all->x, nn * 3 * sizeof(double));
         if (x)
             all->x = x;
+        int *t = realloc(all->tets, nt * 4 * sizeof(int));
         if (t)
             all->tets = t;
+        int *bt = realloc(*body, nt * sizeof(int));
         if (bt)
             *body = bt;
-        if (!x || !t || !bt) {
+        int *nb = realloc(*bc, nn * sizeof(int));
+        if (nb)
+            *bc = nb;
+        if (!x || !t || !bt || !nb) {
             cf_mesh_free(&m);
-            cf_mesh_free(all);
-            free(*body);
-            return cf_error_set(err, CF_ERR_NOMEM, "out of memory loading %s", sc->bodies[b].mesh);
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory loading body %d", b + 1);
+            break;
         }
+        for (int i = 0; i < m.n_nodes; i++)
+            (*bc)[all->n_nodes + i] = -1;
+        st = body_boundary(sc, b, &m, &(*bc)[all->n_nodes], count, err);
         memcpy(&all->x[3 * all->n_nodes], m.x, (size_t)m.n_nodes * 3 * sizeof(double));
         for (int i = 0; i < 4 * m.n_tets; i++)
             all->tets[4 * all->n_tets + i] = m.tets[i] + all->n_nodes;
@@ -72,13 +133,56 @@ static cf_status load_bodies(const cf_scene *sc, cf_mesh *all, int **body, cf_er
         all->n_tets += m.n_tets;
         cf_mesh_free(&m);
     }
-    return CF_OK;
+    for (int c = 0; c < sc->n_boundaries && st == CF_OK; c++)
+        if (count[c] == 0)
+            st = cf_error_set(err, CF_ERR_SCENE_VALUE,
+                              "boundary[%d] selects no node: check its region against the placed "
+                              "mesh (positions are after scale, orientation and position)",
+                              c + 1);
+    free(count);
+    if (st != CF_OK) {
+        cf_mesh_free(all);
+        free(*body), free(*bc);
+        *body = *bc = NULL;
+    }
+    return st;
 }
 
 /* Body of an input node (-1 for a node no tet uses). */
 static int node_body(const cf_solid *s, const int *body, int a)
 {
     return s->vt_start[a] < s->vt_start[a + 1] ? body[s->vt_list[s->vt_start[a]]] : -1;
+}
+
+/* With a crack plane, only the interior facets on it may crack: mark the
+ * others as not candidates. */
+static cf_status select_crack_plane(cf_sim *sim, cf_error *err)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
+    cf_solid *s = &sim->solid;
+    if (!set->has_crack_plane)
+        return CF_OK;
+    s->candidate = malloc((size_t)s->n_facets);
+    if (!s->candidate)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    int n = 0;
+    for (int fc = 0; fc < s->n_facets; fc++) {
+        const int *F = &s->facet[4 * fc];
+        int on = F[2] >= 0;
+        for (int i = 0; i < 3 && on; i++) {
+            double d[3];
+            v3_sub(&s->X[3 * s->tet0[4 * F[0] + CF_TET_FACE[F[1]][i]]], set->crack_plane_point, d);
+            on = fabs(v3_dot(d, set->crack_plane_normal)) <= set->crack_plane_tolerance;
+        }
+        s->candidate[fc] = (unsigned char)on;
+        n += on;
+    }
+    if (n == 0)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "solver.crack_plane: no interior facet lies within %g m of the plane: "
+                            "move the plane onto a layer of mesh faces or raise its tolerance",
+                            set->crack_plane_tolerance);
+    return CF_OK;
 }
 
 /* Initial fragments: the connected components of each body. */
@@ -113,10 +217,10 @@ static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *
     }
     free(all), free(comp), free(seen);
 
-    /* Initial velocities: v = v_b + w_b x (x - com of the body). */
+    /* Initial velocity field: v = v_b + w_b x (x - x_com) + rate (.) (x - x_e). */
     for (int b = 0; b < sim->scene->n_bodies; b++) {
         const cf_body_def *bd = &sim->scene->bodies[b];
-        double M = 0, com[3] = {0, 0, 0};
+        double M = 0, com[3] = {0, 0, 0}, xe[3];
         for (int a = 0; a < s->n_nodes; a++)
             if (node_body(s, body, a) == b) {
                 M += s->m[a];
@@ -124,21 +228,29 @@ static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *
             }
         for (int k2 = 0; k2 < 3; k2++)
             com[k2] /= M;
+        memcpy(xe, bd->has_expansion_center ? bd->expansion_center : com, sizeof xe);
         for (int a = 0; a < s->n_nodes; a++)
             if (node_body(s, body, a) == b) {
                 double r[3], wr[3];
                 v3_sub(&s->x[3 * a], com, r);
                 v3_cross(bd->angular_velocity, r, wr);
                 for (int k2 = 0; k2 < 3; k2++)
-                    s->v[3 * a + k2] = bd->velocity[k2] + wr[k2];
+                    s->v[3 * a + k2] = bd->velocity[k2] + wr[k2] +
+                                       bd->expansion_rate[k2] * (s->x[3 * a + k2] - xe[k2]);
             }
     }
+    int fracture = sim->scene->solver.mode == CF_RUN_FRACTURE;
     for (int fi = 0; fi < sim->n_frag; fi++) {
         cf_fragment *f = &sim->frag[fi];
         int *tt = realloc(f->tets, (size_t)f->nt * sizeof(int));
         if (tt)
             f->tets = tt;
         cf_fragment_rest_props(sim, fi);
+        cf_fragment_ledger_reset(sim, fi);
+        if (fracture) {
+            f->mode = CF_MODE_FRACTURE;
+            f->t_enter = 0;
+        }
         if (sim->bullet) {
             const cf_body_def *bd = &sim->scene->bodies[body[f->tets[0]]];
             cf_node_state ns;
@@ -161,7 +273,9 @@ static cf_status add_obstacles(cf_sim *sim, cf_error *err)
     for (int j = 0; j < sc->n_obstacles; j++) {
         const cf_obstacle *o = &sc->obstacles[j];
         int id = -1;
-        double mu = sc->material.friction, e = sc->material.restitution;
+        /* Bullet multiplies the two bodies' coefficients: obstacles carry 1 so
+         * that the contact uses the material's values. */
+        double mu = 1.0, e = 1.0;
         if (o->type == CF_OBSTACLE_PLANE)
             id = cfb_add_plane(sim->bullet, o->point, o->normal, mu, e);
         else if (o->type == CF_OBSTACLE_SPHERE)
@@ -215,20 +329,42 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
     cf_ppr_init(&sim->ppr, &scene->material);
 
     cf_mesh all;
-    int *body = NULL;
-    cf_status st = load_bodies(scene, &all, &body, err);
+    int *body = NULL, *bc = NULL;
+    cf_status st = load_bodies(scene, opt->mesh_dir, &all, &body, &bc, err);
     if (st == CF_OK) {
         st = cf_solid_init(&sim->solid, &all, &scene->material, body, err);
+        if (st == CF_OK)
+            memcpy(sim->solid.bc, bc, (size_t)all.n_nodes * sizeof(int));
         cf_mesh_free(&all);
     }
-    if (st == CF_OK && scene->solver.rigid_backend == CF_RIGID_BULLET) {
+    free(bc);
+    sim->dt_fracture = scene->solver.cfl_fraction > 0
+                           ? scene->solver.cfl_fraction * sim->solid.dt_cfl
+                           : scene->solver.dt_fracture;
+    /* With no rigid mode the outer step only paces output and checks: a
+     * whole number of fracture steps, so that every step is dt_fracture. */
+    sim->dt_outer = scene->solver.dt_rigid;
+    if (scene->solver.mode == CF_RUN_FRACTURE)
+        sim->dt_outer = fmax(1.0, floor(scene->solver.dt_rigid / sim->dt_fracture + 1e-9)) *
+                        sim->dt_fracture;
+    sim->n_steps = lround(ceil(scene->duration / sim->dt_outer - 1e-9));
+    if (st == CF_OK && scene->solver.rigid_backend == CF_RIGID_BULLET &&
+        scene->solver.mode == CF_RUN_HYBRID) {
         sim->bullet = cfb_world_create(scene->gravity);
         st = sim->bullet ? add_obstacles(sim, err)
                          : cf_error_set(err, CF_ERR_EXTERNAL, "Bullet world: %s", cfb_last_error());
     }
     if (st == CF_OK)
+        st = select_crack_plane(sim, err);
+    if (st == CF_OK)
         st = make_initial_fragments(sim, body, err);
     free(body);
+    if (st == CF_OK) { /* the ledger's reference state */
+        cf_ledger l;
+        cf_sim_ledger(sim, &l);
+        sim->e0 = l.kinetic + l.strain;
+        memcpy(sim->mx0, l.mass_moment, sizeof sim->mx0);
+    }
     if (st == CF_OK && scene->output.file[0]) {
         st = cf_h5_open(scene->output.file, scene->name, scene->resolved, &sim->h5, err);
         if (st == CF_OK)
@@ -251,6 +387,7 @@ void cf_sim_destroy(cf_sim *sim)
     for (int i = 0; i < sim->n_frag; i++) {
         cf_fragment *f = &sim->frag[i];
         free(f->tets), free(f->nodes.v), free(f->coh.v), free(f->contact), free(f->vn_pre);
+        free(f->v_old);
         cf_bars_free(&f->bars);
     }
     free(sim->frag);
@@ -260,24 +397,72 @@ void cf_sim_destroy(cf_sim *sim)
     free(sim);
 }
 
-/* Kinetic energy of fragment fi (J). */
-static double fragment_kinetic_energy(cf_sim *sim, int fi)
+/* Kinetic energy (J) of rigid fragment f in Bullet state st. */
+static double body_kinetic_energy(const cf_fragment *f, const cfb_state *st)
 {
-    cf_fragment *f = &sim->frag[fi];
-    if (f->body < 0) {
-        cf_node_state ns;
-        cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
-        return ns.ke;
-    }
-    cfb_state st;
-    cfb_get_state(sim->bullet, f->body, &st);
     double Rb[9], wb[3];
-    quat_to_mat(st.quat, Rb);
-    m3_tmulv(Rb, st.w, wb); /* body-frame angular velocity */
-    double e = 0.5 * f->mass * v3_dot(st.v, st.v);
+    quat_to_mat(st->quat, Rb);
+    m3_tmulv(Rb, st->w, wb); /* body-frame angular velocity */
+    double e = 0.5 * f->mass * v3_dot(st->v, st->v);
     for (int k = 0; k < 3; k++)
         e += 0.5 * f->principal[k] * wb[k] * wb[k];
     return e;
+}
+
+/* Kinetic energy minus gravity's potential work: what a Bullet body keeps
+ * in free flight, J. */
+static double body_energy(const cf_sim *sim, const cf_fragment *f, const cfb_state *st)
+{
+    return body_kinetic_energy(f, st) - f->mass * v3_dot(sim->scene->gravity, st->pos);
+}
+
+void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
+{
+    const cf_solid *s = &sim->solid;
+    memset(l, 0, sizeof *l);
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        const cf_fragment *f = &sim->frag[fi];
+        if (f->mode == CF_MODE_DEAD)
+            continue;
+        if (f->body >= 0) {
+            cfb_state st;
+            double Rb[9], D[9] = {0}, T[9], I[9], Iw[3], c[3];
+            cfb_get_state(sim->bullet, f->body, &st);
+            l->kinetic += body_kinetic_energy(f, &st);
+            v3_axpy(f->mass, st.pos, l->mass_moment);
+            v3_axpy(f->mass, st.v, l->momentum);
+            quat_to_mat(st.quat, Rb); /* body frame = principal axes: I = Rb D Rb^T */
+            D[0] = f->principal[0], D[4] = f->principal[1], D[8] = f->principal[2];
+            m3_mul(Rb, D, T);
+            m3_mul_nt(T, Rb, I);
+            m3_mulv(I, st.w, Iw);
+            v3_cross(st.pos, st.v, c);
+            v3_axpy(f->mass, c, l->angular_momentum);
+            v3_axpy(1.0, Iw, l->angular_momentum);
+            continue;
+        }
+        l->kinetic += f->e_kin;
+        l->strain += f->e_strain;
+        v3_axpy(1.0, f->mx, l->mass_moment);
+        for (int i = 0; i < f->nodes.n; i++) {
+            int a = f->nodes.v[i];
+            double c[3];
+            v3_axpy(s->m[a], &s->v[3 * a], l->momentum);
+            v3_cross(&s->x[3 * a], &s->v[3 * a], c);
+            v3_axpy(s->m[a], c, l->angular_momentum);
+        }
+    }
+    cf_cohesive_energy(s, NULL, 0, &l->cohesive_stored, &l->cohesive_dissipated);
+    double dmx[3];
+    v3_sub(l->mass_moment, sim->mx0, dmx);
+    l->work_gravity = v3_dot(sim->scene->gravity, dmx);
+    l->work_boundary = sim->flow.boundary;
+    l->contact = sim->flow.contact, l->pbd = sim->flow.pbd;
+    l->damping = sim->flow.damping, l->handoff = sim->flow.handoff;
+    l->initial = sim->e0;
+    l->residual = l->kinetic + l->strain + l->cohesive_stored + l->cohesive_dissipated +
+                  l->contact + l->pbd + l->damping + l->handoff -
+                  (l->initial + l->work_gravity + l->work_boundary);
 }
 
 static cf_status write_frame(cf_sim *sim, cf_error *err)
@@ -289,7 +474,6 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     if (!fr)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     int n = 0, n_fracture = 0;
-    double ke = 0;
     for (int fi = 0; fi < sim->n_frag; fi++) {
         cf_fragment *f = &sim->frag[fi];
         if (f->mode == CF_MODE_DEAD)
@@ -300,16 +484,40 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
         o->mode = f->mode;
         cf_fragment_pose(sim, fi, o->com, R, o->v, o->w);
         mat_to_quat(R, o->quat);
-        ke += fragment_kinetic_energy(sim, fi);
         n_fracture += f->mode == CF_MODE_FRACTURE;
     }
     cf_status st = cf_h5_write_frame(sim->h5, sim->step, sim->t, fr, n, err);
     free(fr);
-    const char *names[] = {"kinetic_energy", "fragment_count", "cohesive_elements",
-                           "fragments_in_fracture_mode", "handoff_momentum_error_max"};
-    double values[] = {ke, n, sim->solid.n_coh, n_fracture, sim->max_momentum_error};
-    for (int i = 0; i < 5 && st == CF_OK; i++)
-        st = cf_h5_write_observable(sim->h5, names[i], sim->step, sim->t, values[i], err);
+    cf_ledger l;
+    cf_sim_ledger(sim, &l);
+    const struct {
+        const char *name;
+        double value;
+    } obs[] = {
+        {"energy_kinetic", l.kinetic},
+        {"energy_strain", l.strain},
+        {"energy_cohesive_stored", l.cohesive_stored},
+        {"energy_cohesive_dissipated", l.cohesive_dissipated},
+        {"work_gravity", l.work_gravity},
+        {"work_boundary", l.work_boundary},
+        {"energy_contact_removed", l.contact},
+        {"energy_pbd_removed", l.pbd},
+        {"energy_damping_removed", l.damping},
+        {"energy_handoff_loss", l.handoff},
+        {"energy_residual", l.residual},
+        {"momentum_x", l.momentum[0]},
+        {"momentum_y", l.momentum[1]},
+        {"momentum_z", l.momentum[2]},
+        {"angular_momentum_x", l.angular_momentum[0]},
+        {"angular_momentum_y", l.angular_momentum[1]},
+        {"angular_momentum_z", l.angular_momentum[2]},
+        {"fragment_count", n},
+        {"cohesive_elements", sim->solid.n_coh},
+        {"fragments_in_fracture_mode", n_fracture},
+        {"handoff_momentum_error_max", sim->max_momentum_error},
+    };
+    for (size_t i = 0; i < sizeof obs / sizeof obs[0] && st == CF_OK; i++)
+        st = cf_h5_write_observable(sim->h5, obs[i].name, sim->step, sim->t, obs[i].value, err);
     sim->prof.output += cf_wall_time() - t0;
     return st;
 }
@@ -368,8 +576,11 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 
 /* A fragment with no uncracked interior facet (a single tet, say) cannot
  * break further: an impact leaves it in rigid mode. */
-static int can_break(const cf_solid *s, const cf_fragment *f)
+static int can_break(const cf_sim *sim, const cf_fragment *f)
 {
+    const cf_solid *s = &sim->solid;
+    if (sim->scene->solver.criterion == CF_CRITERION_NONE)
+        return 0;
     for (int i = 0; i < f->nt; i++)
         for (int k = 0; k < 4; k++) {
             int fc = s->tet_facet[4 * f->tets[i] + k];
@@ -399,8 +610,11 @@ static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
             cf_fragment *f = &sim->frag[fi];
             if (f->body < 0 || f->mode != CF_MODE_RIGID)
                 continue;
+            cfb_state now;
+            cfb_get_state(sim->bullet, f->body, &now);
+            double de = body_energy(sim, f, &pre[fi]) - body_energy(sim, f, &now);
             double dv = cfb_contact_impulse(sim->bullet, f->body) / f->mass;
-            if (dv > set->impact_threshold && can_break(&sim->solid, f)) {
+            if (dv > set->impact_threshold && can_break(sim, f)) {
                 /* redo this step in fracture mode */
                 double th = cf_wall_time();
                 cf_status st = cf_handoff_to_fracture(sim, fi, &pre[fi], err);
@@ -409,7 +623,9 @@ static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
                     free(pre);
                     return st;
                 }
+                continue; /* the step is redone in fracture mode */
             }
+            sim->flow.contact += de;
         }
         free(pre);
         return CF_OK;
@@ -417,7 +633,7 @@ static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
     for (int fi = 0; fi < n; fi++) {
         if (sim->frag[fi].mode != CF_MODE_RIGID)
             continue;
-        if (cf_pbd_impact(sim, fi, dt) && can_break(&sim->solid, &sim->frag[fi])) {
+        if (cf_pbd_impact(sim, fi, dt) && can_break(sim, &sim->frag[fi])) {
             cf_status st = cf_handoff_to_fracture(sim, fi, NULL, err);
             if (st != CF_OK)
                 return st;
@@ -431,11 +647,24 @@ static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
     return CF_OK;
 }
 
+static cf_status diverged(const cf_sim *sim, cf_error *err, const char *what)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
+    const char *fix = set->constraints == CF_CONSTRAINTS_NONE
+                          ? "lower solver.dt_fracture below dt_cfl, or use solver.constraints = "
+                            "\"pbd\""
+                          : "lower solver.dt_fracture, or raise solver.pbd.iterations / "
+                            "solver.pbd.k_stiffness";
+    return cf_error_set(err, CF_ERR_DIVERGED,
+                        "%s at t = %.6g s with dt_fracture/dt_cfl = %.3g (dt_cfl %.3g s): %s",
+                        what, sim->t, sim->dt_fracture / sim->solid.dt_cfl, sim->solid.dt_cfl, fix);
+}
+
 /* Sub-cycle every fracture-mode fragment through the rigid step. */
 static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
 {
     const cf_solver_settings *set = &sim->scene->solver;
-    long n_sub = lround(dt / set->dt_fracture);
+    long n_sub = lround(ceil(dt / sim->dt_fracture - 1e-9)); /* h <= dt_fracture */
     if (n_sub < 1)
         n_sub = 1;
     double h = dt / (double)n_sub;
@@ -448,15 +677,44 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
             sim->steps_fracture++;
         }
-        if (!nodes_sane(&sim->solid, &sim->frag[fi]))
-            return cf_error_set(err, CF_ERR_DIVERGED,
-                                "fragment %d diverged (node position not finite or speed above "
-                                "1e5 m/s) at t = %.6g s "
-                                "with dt_fracture/dt_cfl = %.3g: lower solver.dt_fracture or "
-                                "raise solver.pbd.iterations",
-                                fi, sim->t, set->dt_fracture / sim->solid.dt_cfl);
+        const cf_fragment *f = &sim->frag[fi];
+        char what[160];
+        if (!nodes_sane(&sim->solid, f)) {
+            snprintf(what, sizeof what,
+                     "fragment %d diverged: a node position is not finite or a node is faster "
+                     "than 1e5 m/s",
+                     fi);
+            return diverged(sim, err, what);
+        }
+        if (f->n_inverted > set->max_inverted_fraction * f->nt) {
+            snprintf(what, sizeof what,
+                     "fragment %d diverged: %d of its %d tets are inverted (more than "
+                     "solver.guard.max_inverted_fraction = %g)",
+                     fi, f->n_inverted, f->nt, set->max_inverted_fraction);
+            return diverged(sim, err, what);
+        }
     }
     return CF_OK;
+}
+
+/* Energy growth with no work input: kinetic + strain + cohesive energy
+ * above (1 + max_energy_growth) times what was put in. */
+static cf_status check_energy(cf_sim *sim, cf_error *err)
+{
+    cf_ledger l;
+    cf_sim_ledger(sim, &l);
+    double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated;
+    double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary);
+    if (have > sim->e_peak)
+        sim->e_peak = have;
+    if (have <= (1 + sim->scene->solver.max_energy_growth) * input + 1e-12)
+        return CF_OK;
+    char what[200];
+    snprintf(what, sizeof what,
+             "energy grew with no work input: %.4g J against %.4g J put in (more than "
+             "solver.guard.max_energy_growth = %g)",
+             have, input, sim->scene->solver.max_energy_growth);
+    return diverged(sim, err, what);
 }
 
 /* Fracture-mode fragments that have been quiet long enough go back to rigid mode. */
@@ -482,33 +740,44 @@ static cf_status return_to_rigid(cf_sim *sim, cf_error *err)
     return CF_OK;
 }
 
+int cf_sim_done(const cf_sim *sim) { return sim->step >= sim->n_steps; }
+
+double cf_sim_time(const cf_sim *sim) { return sim->t; }
+
+cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
+{
+    const cf_scene *sc = sim->scene;
+    double dt = sim->dt_outer;
+    cf_status st = rigid_step(sim, dt, err);
+    if (st == CF_OK)
+        st = fracture_steps(sim, dt, err);
+    sim->step++;
+    sim->t = (double)sim->step * dt;
+    if (st == CF_OK && sc->solver.mode == CF_RUN_HYBRID)
+        st = return_to_rigid(sim, err);
+    if (st == CF_OK)
+        st = check_energy(sim, err);
+    if (st == CF_OK && (sim->t >= sim->next_frame - 1e-9 * dt || cf_sim_done(sim))) {
+        st = write_frame(sim, err);
+        while (sim->next_frame <= sim->t + 1e-9 * dt)
+            sim->next_frame += sc->output.frame_interval;
+    }
+    progress(sim, 0);
+    return st;
+}
+
 cf_status cf_sim_run(cf_sim *sim, cf_error *err)
 {
     const cf_scene *sc = sim->scene;
-    double dt = sc->solver.dt_rigid;
-    long n_steps = lround(ceil(sc->duration / dt - 1e-9));
     if (sim->opt.progress)
         fprintf(stderr, "cohfrac: %d nodes, %d tets, %d fragment(s); dt_cfl = %.4g s, "
                         "dt_fracture/dt_cfl = %.4g, dt_rigid/dt_cfl = %.4g\n",
                 sim->solid.n_nodes, sim->solid.n_tets, sim->n_frag, sim->solid.dt_cfl,
-                sc->solver.dt_fracture / sim->solid.dt_cfl, dt / sim->solid.dt_cfl);
+                sim->dt_fracture / sim->solid.dt_cfl, sim->dt_outer / sim->solid.dt_cfl);
     cf_status st = write_frame(sim, err);
     sim->next_frame = sc->output.frame_interval;
-    while (st == CF_OK && sim->step < n_steps) {
-        st = rigid_step(sim, dt, err);
-        if (st == CF_OK)
-            st = fracture_steps(sim, dt, err);
-        sim->step++;
-        sim->t = (double)sim->step * dt;
-        if (st == CF_OK)
-            st = return_to_rigid(sim, err);
-        if (st == CF_OK && (sim->t >= sim->next_frame - 1e-9 * dt || sim->step == n_steps)) {
-            st = write_frame(sim, err);
-            while (sim->next_frame <= sim->t + 1e-9 * dt)
-                sim->next_frame += sc->output.frame_interval;
-        }
-        progress(sim, 0);
-    }
+    while (st == CF_OK && !cf_sim_done(sim))
+        st = cf_sim_advance(sim, err);
     progress(sim, 1);
     cf_error cerr;
     if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK && st == CF_OK) {
@@ -526,13 +795,16 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
     int nf, n = alive_fragments(sim, &nf);
     double wall = cf_wall_time() - sim->wall_start;
     fprintf(out, "\n== cohfrac summary: %s ==\n", sc->name);
+    static const char *constraints[] = {"pbd", "xpbd", "none"};
     fprintf(out, "simulated time     %.4g s in %ld rigid steps (dt_rigid %.3g s, backend %s)\n",
-            sim->t, sim->step, sc->solver.dt_rigid,
-            sc->solver.rigid_backend == CF_RIGID_BULLET ? "bullet" : "pbd");
+            sim->t, sim->step, sim->dt_outer,
+            sc->solver.mode == CF_RUN_FRACTURE ? "none: fracture mode only"
+            : sc->solver.rigid_backend == CF_RIGID_BULLET ? "bullet" : "pbd");
+    fprintf(out, "constraints        %s\n", constraints[sc->solver.constraints]);
     fprintf(out, "mesh               %d tets, %d nodes (%d after duplication)\n",
             sim->solid.n_tets, sim->solid.n_verts0, sim->solid.n_nodes);
     fprintf(out, "time step          dt_fracture %.3g s = %.4g dt_cfl (dt_cfl %.4g s)\n",
-            sc->solver.dt_fracture, sc->solver.dt_fracture / sim->solid.dt_cfl, sim->solid.dt_cfl);
+            sim->dt_fracture, sim->dt_fracture / sim->solid.dt_cfl, sim->solid.dt_cfl);
     fprintf(out, "steps per mode     rigid %ld, fracture %ld (threads %d)\n", sim->steps_rigid,
             sim->steps_fracture, omp_get_max_threads());
     fprintf(out, "fragments          %d alive (%d in fracture mode), %d ever\n", n, nf,
@@ -542,6 +814,21 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
                  "handoff_loss %.4g J\n",
             sim->n_handoffs, sim->max_momentum_error, sim->total_handoff_loss);
     double staged = p->rigid + p->stress + p->insertion + p->forces + p->pbd + p->handoff + p->output;
+    cf_ledger l;
+    cf_sim_ledger(sim, &l);
+    double scale = fmax(fabs(l.initial) + fabs(l.work_gravity) + fabs(l.work_boundary), 1e-300);
+    fprintf(out, "energy ledger (J)  kinetic %.6g | strain %.6g | cohesive stored %.6g | "
+                 "cohesive dissipated %.6g\n",
+            l.kinetic, l.strain, l.cohesive_stored, l.cohesive_dissipated);
+    fprintf(out, "                   initial %.6g | work: gravity %.6g, boundary %.6g\n",
+            l.initial, l.work_gravity, l.work_boundary);
+    fprintf(out, "                   removed: contact %.6g, PBD %.6g, damping %.6g, hand-off %.6g\n",
+            l.contact, l.pbd, l.damping, l.handoff);
+    fprintf(out, "                   residual %.4g J = %.3g of initial + work\n", l.residual,
+            l.residual / scale);
+    fprintf(out, "momentum           P = (%.6g, %.6g, %.6g) kg m/s, L = (%.6g, %.6g, %.6g) kg m^2/s\n",
+            l.momentum[0], l.momentum[1], l.momentum[2], l.angular_momentum[0],
+            l.angular_momentum[1], l.angular_momentum[2]);
     fprintf(out, "wall time          %.2f s\n", wall);
     fprintf(out, "  rigid step %.2f s | stress %.2f s | insertion %.2f s | forces %.2f s | "
                  "PBD %.2f s | hand-off %.2f s | output %.2f s | other %.2f s\n",

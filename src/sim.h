@@ -31,8 +31,26 @@ typedef struct cf_fragment {
     double t_enter;          /* s, when fracture mode began */
     int *contact;            /* [nodes.n] obstacle in contact after the last projection, -1 */
     double *vn_pre;          /* [nodes.n] normal velocity before projection, m/s */
+    double *v_old;           /* [nodes.n][3] velocity at the start of the step, m/s */
     int scratch_cap;
+    /* Energy ledger state at the last force evaluation (in-house solver). */
+    double e_kin;            /* J, 1/2 sum m v(n-1/2).v(n+1/2) (leapfrog estimate) */
+    double e_strain;         /* J */
+    double mx[3];            /* kg m, sum m x */
+    int n_inverted;          /* tets with det F <= 0 */
 } cf_fragment;
+
+/* Energy removed or put in by each mechanism since t = 0, J (DESIGN §3-§6;
+ * the ledger balance is in cf_sim_ledger). */
+typedef struct cf_energy_flows {
+    double boundary;   /* work of prescribed velocities */
+    double contact;    /* removed by obstacle contact: restitution, friction, and
+                          the Bullet bodies' energy change beyond gravity's work */
+    double pbd;        /* removed by the PBD/XPBD projection */
+    double damping;    /* removed by global damping */
+    double handoff;    /* non-rigid kinetic + strain + cohesive stored energy
+                          dropped at fracture -> rigid hand-offs */
+} cf_energy_flows;
 
 typedef struct cf_profile {
     double rigid, stress, insertion, forces, pbd, handoff, output; /* s of wall time */
@@ -50,9 +68,17 @@ struct cf_sim {
     cf_h5 *h5;               /* NULL when no output is asked for */
     double t;                /* s */
     long step;               /* rigid steps done */
+    long n_steps;            /* rigid steps in the scene's duration */
+    double dt_fracture;      /* s: solver.dt_fracture, or cfl_fraction dt_cfl */
+    double dt_outer;         /* s: dt_rigid (fracture-only runs: a whole number of
+                                fracture steps) */
     double next_frame;       /* s */
     cf_profile prof;
     long steps_rigid, steps_fracture;
+    cf_energy_flows flow;
+    double e0;               /* J, initial kinetic + strain energy */
+    double mx0[3];           /* kg m, initial sum m x */
+    double e_peak;           /* J, largest kinetic + strain + cohesive stored so far */
     int n_handoffs;
     double max_momentum_error, total_handoff_loss;
     double wall_start;
@@ -94,6 +120,10 @@ cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const d
 
 /* Centre of mass, rotation, velocities of fragment fi, whatever its mode. */
 void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[3], double w[3]);
+
+/* The ledger state of fragment fi from its nodes now: exact kinetic energy,
+ * zero strain energy, sum m x. */
+void cf_fragment_ledger_reset(cf_sim *sim, int fi);
 
 /* Append a new fragment; returns its index or -1 (out of memory). */
 int cf_fragment_new(cf_sim *sim, int parent, double birth_time);

@@ -120,9 +120,11 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->rq = malloc((size_t)nt * 4 * sizeof(double));
     s->sigma = calloc((size_t)nt * 9, sizeof(double));
     s->tf = calloc((size_t)nt * 12, sizeof(double));
+    s->tw = calloc((size_t)nt, sizeof(double));
+    s->bc = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet_frag = malloc((size_t)nt * sizeof(int));
     if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->origin || !s->tet ||
-        !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->sigma || !s->tf || !s->tet_frag) {
+        !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->sigma || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
     }
@@ -130,7 +132,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     memcpy(s->x, mesh->x, (size_t)nn * 3 * sizeof(double));
     memcpy(s->p, mesh->x, (size_t)nn * 3 * sizeof(double));
     for (int i = 0; i < nn; i++)
-        s->origin[i] = i;
+        s->origin[i] = i, s->bc[i] = -1;
     memcpy(s->tet, mesh->tets, (size_t)nt * 4 * sizeof(int));
     memcpy(s->tet0, mesh->tets, (size_t)nt * 4 * sizeof(int));
     memcpy(s->tet_frag, tet_body, (size_t)nt * sizeof(int));
@@ -172,8 +174,8 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 void cf_solid_free(cf_solid *s)
 {
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->origin, s->tet, s->tet0,
-                    s->Dm_inv, s->vol, s->rq, s->sigma, s->tf, s->tet_frag, s->facet,
-                    s->tet_facet, s->cracked, s->vt_start, s->vt_list, s->coh};
+                    s->Dm_inv, s->vol, s->rq, s->sigma, s->tf, s->tw, s->bc, s->tet_frag, s->facet,
+                    s->tet_facet, s->cracked, s->candidate, s->vt_start, s->vt_list, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
     memset(s, 0, sizeof *s);
@@ -196,7 +198,7 @@ int cf_solid_copy_node(cf_solid *s, int n)
         if (grow((void **)&s->X, v3, cap) || grow((void **)&s->x, v3, cap) ||
             grow((void **)&s->v, v3, cap) || grow((void **)&s->p, v3, cap) ||
             grow((void **)&s->f, v3, cap) || grow((void **)&s->m, sizeof(double), cap) ||
-            grow((void **)&s->origin, sizeof(int), cap))
+            grow((void **)&s->origin, sizeof(int), cap) || grow((void **)&s->bc, sizeof(int), cap))
             return -1;
         s->cap_nodes = cap;
     }
@@ -208,5 +210,6 @@ int cf_solid_copy_node(cf_solid *s, int n)
     s->f[3 * k] = s->f[3 * k + 1] = s->f[3 * k + 2] = 0;
     s->m[k] = 0;
     s->origin[k] = s->origin[n];
+    s->bc[k] = s->bc[n];
     return k;
 }

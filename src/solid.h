@@ -22,6 +22,12 @@ typedef struct cf_cohesive {
     int slot[2][3];
     double dn_max[3], dt_max[3]; /* PPR history: largest openings, m */
     unsigned char failed[3];     /* complete failure per node pair */
+    /* Energy of each node pair (J): work absorbed so far (trapezoidal rule
+     * in the openings), and the recoverable part at the last evaluation
+     * (1/2 T Delta A/3 on the secant); dissipated = work - stored. */
+    double work[3], stored[3];
+    double last[3][4];           /* dn, dt, Tn, Tt at the last evaluation */
+    unsigned char started[3];    /* `last` holds an evaluation */
 } cf_cohesive;
 
 typedef struct cf_solid {
@@ -33,6 +39,7 @@ typedef struct cf_solid {
     double *x, *v, *p, *f;    /* [n][3] position m, velocity m/s, PBD prediction m, force N */
     double *m;                /* [n] lumped mass, kg */
     int *origin;              /* [n] original vertex of each copy */
+    int *bc;                  /* [n] boundary condition of the node (scene index), -1 none */
 
     int n_verts0;             /* vertices of the input meshes */
     int n_tets;
@@ -43,12 +50,14 @@ typedef struct cf_solid {
     double *rq;               /* [nt][4] corotational rotation (warm start) */
     double *sigma;            /* [nt][9] Cauchy stress at the last check, Pa */
     double *tf;               /* [nt][12] internal force on each slot, N */
+    double *tw;               /* [nt] strain energy at the last force pass, J */
     int *tet_frag;            /* [nt] fragment id */
 
     int n_facets;
     int *facet;               /* [nf][4] tetA, faceA, tetB, faceB (tetB = -1 on the boundary) */
     int *tet_facet;           /* [nt][4] facet of face k */
     unsigned char *cracked;   /* [nf] */
+    unsigned char *candidate; /* [nf] may crack (NULL: every interior facet) */
     int *vt_start, *vt_list;  /* original vertex -> tets (CSR, ascending) */
 
     int n_coh, cap_coh;

@@ -14,15 +14,17 @@
 void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3]);
 
 /* For each tet of the list: internal nodal forces into s->tf ([4][3] per
- * tet, N) and, when `want_stress`, the world-frame Cauchy stress into
- * s->sigma (Pa).  Parallel over tets (OpenMP); each tet writes only its own
- * slots, so the result does not depend on the thread count. */
-void cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int want_stress);
+ * tet, N), strain energy V (1/2 sigma : eps) into s->tw (J) and, when
+ * `want_stress`, the world-frame Cauchy stress into s->sigma (Pa).  Parallel
+ * over tets (OpenMP); each tet writes only its own slots, so the result does
+ * not depend on the thread count.  Returns the number of inverted tets
+ * (det F <= 0). */
+int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int want_stress);
 
 /* Add the per-tet forces to the nodes: f[node] += tf[slot], in list order. */
 void cf_tet4_scatter(cf_solid *s, const int *tets, int nt);
 
-/* Elastic strain energy of the listed tets (J), from the last stress pass. */
-double cf_tet4_strain_energy(const cf_solid *s, const int *tets, int nt, cf_elasticity kind);
+/* Elastic strain energy of the listed tets (J), from the last force pass. */
+double cf_tet4_strain_energy(const cf_solid *s, const int *tets, int nt);
 
 #endif

@@ -6,6 +6,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* The whole file as a NUL-terminated string (malloc'd), or NULL. */
 static inline char *fixture_read_file(const char *path)
@@ -28,6 +29,7 @@ static inline char *fixture_read_file(const char *path)
  * subdivision along the main diagonal), every tet positively oriented. */
 static inline void fixture_box(cf_mesh *m, int nx, int ny, int nz, double lx, double ly, double lz)
 {
+    memset(m, 0, sizeof *m);
     m->n_nodes = (nx + 1) * (ny + 1) * (nz + 1);
     m->n_tets = 6 * nx * ny * nz;
     m->x = malloc((size_t)m->n_nodes * 3 * sizeof(double));
@@ -66,6 +68,7 @@ static inline void fixture_two_tets(cf_mesh *m)
 {
     static const double x[5][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.2, 0.2, 1}, {0.3, 0.3, -1}};
     static const int t[2][4] = {{0, 1, 2, 3}, {0, 2, 1, 4}};
+    memset(m, 0, sizeof *m);
     m->n_nodes = 5, m->n_tets = 2;
     m->x = malloc(sizeof x), m->tets = malloc(sizeof t);
     for (int i = 0; i < 15; i++)

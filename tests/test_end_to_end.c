@@ -26,7 +26,7 @@ static void test_small_bunny_drop_breaks(void **state)
                                  COHFRAC_MESH_DIR, &sc, &err);
     if (st != CF_OK)
         fail_msg("%s", err.msg);
-    cf_run_options opt = {1, 0};
+    cf_run_options opt = {.progress = 1, .mesh_dir = COHFRAC_MESH_DIR};
     cf_sim *sim = NULL;
     st = cf_sim_create(&sc, &opt, &sim, &err);
     if (st == CF_OK)

@@ -21,7 +21,7 @@
 #include <sys/stat.h>
 
 /* The temporary tree: <tmp>/cube.{node,ele}, <tmp>/sub/part.{node,ele},
- * <tmp>/meshes/bunny.{node,ele} (a prepared-mesh directory). */
+ * <tmp>/meshes/bunny.{node,ele} (a prepared-mesh directory), <tmp>/beam.msh. */
 static char tmp[256];      /* as created */
 static char tmp_real[512]; /* realpath(tmp): what resolved mesh paths start with */
 static char mesh_dir[300];
@@ -85,6 +85,7 @@ static int setup(void **state)
     make_dir("meshes");
     write_file("meshes/bunny.node", "4 3 0 0\n");
     write_file("meshes/bunny.ele", "1 4 0\n");
+    write_file("beam.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
     snprintf(mesh_dir, sizeof mesh_dir, "%s/meshes", tmp);
     return 0;
 }
@@ -188,6 +189,11 @@ static void test_defaults_minimal(void **state)
     assert_vec(s.bodies[0].orientation, (const double[]){1, 0, 0, 0}, 4);
     assert_vec(s.bodies[0].velocity, (const double[]){0, 0, 0}, 3);
     assert_vec(s.bodies[0].angular_velocity, (const double[]){0, 0, 0}, 3);
+    assert_int_equal(s.bodies[0].primitive.type, CF_PRIM_NONE);
+    assert_vec(s.bodies[0].expansion_rate, (const double[]){0, 0, 0}, 3);
+    assert_int_equal(s.bodies[0].has_expansion_center, 0);
+    assert_int_equal(s.n_boundaries, 0);
+    assert_null(s.boundaries);
     assert_int_equal(s.n_obstacles, 0);
     assert_null(s.obstacles);
 
@@ -204,6 +210,15 @@ static void test_defaults_minimal(void **state)
     assert_int_equal(s.solver.iterations, 3);
     assert_double_equal(s.solver.k_damping, 1.0, 0);
     assert_int_equal(s.solver.threads, 0);
+    assert_int_equal(s.solver.mode, CF_RUN_HYBRID);
+    assert_int_equal(s.solver.criterion, CF_CRITERION_TRACTION);
+    assert_int_equal(s.solver.has_crack_plane, 0);
+    assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_PBD);
+    assert_int_equal(s.solver.iteration_independent, 0);
+    assert_double_equal(s.solver.compliance_scale, 1.0, 0);
+    assert_double_equal(s.solver.contact_stiffness, 0.0, 0);
+    assert_double_equal(s.solver.max_inverted_fraction, 0.01, 0);
+    assert_double_equal(s.solver.max_energy_growth, 0.5, 0);
 
     assert_string_equal(s.output.file, "out/scene.h5");
     assert_double_equal(s.output.frame_interval, 0.01, 0);
@@ -355,6 +370,172 @@ static void test_prepared_mesh(void **state)
     cf_scene_free(&s);
 }
 
+/* Every key added with primitives, expansion, boundaries and the fracture
+ * solver options. */
+static const char NEW_KEYS_SCENE[] =
+    "return {\n"
+    "  bodies = {\n"
+    "    { mesh = { type = 'box', size = {1, 2, 3}, cells = {2, 3, 4}, tets_per_cell = 5 },\n"
+    "      expansion_rate = 0.5, expansion_center = {1, 0, 0} },\n"
+    "    { mesh = { type = 'sphere', radius = 0.5, mesh_size = 0.1 },\n"
+    "      expansion_rate = {1, 2, 3} },\n"
+    "    { mesh = { type = 'hollow_sphere', radius = 0.5, thickness = 0.1, mesh_size = 0.05 } },\n"
+    "    { mesh = { type = 'plate', size = {1, 1, 0.01}, mesh_size = 0.02 } },\n"
+    "    { mesh = { type = 'notched_beam', size = {2, 0.1, 0.2}, notch = {0.1, 0.02, 0.3},\n"
+    "               mesh_size = 0.01 } },\n"
+    "    { mesh = 'sub/../beam.msh' },\n"
+    "  },\n"
+    "  boundary = {\n"
+    "    { region = { type = 'box', min = {-1, -1, -1}, max = {1, 1, -0.9} }, fixed = true },\n"
+    "    { region = { type = 'plane', point = {0, 0, 1}, normal = {0, 0, 2}, tolerance = 1e-3 },\n"
+    "      velocity = {0, 0, -0.1}, axes = 'zx', body = 2 },\n"
+    "    { region = { type = 'group', name = 'top' }, velocity = {-0.0, 1, 0}, axes = 'y',\n"
+    "      fixed = false },\n"
+    "  },\n"
+    "  solver = { mode = 'fracture', criterion = 'none',\n"
+    "             crack_plane = { point = {0, 0, 0.5}, normal = {3, 0, 4}, tolerance = 1e-4 },\n"
+    "             constraints = 'xpbd', pbd = { iteration_independent = true },\n"
+    "             xpbd = { compliance_scale = 2 }, contact_stiffness = 1e9,\n"
+    "             guard = { max_inverted_fraction = 0.1, max_energy_growth = 2 } },\n"
+    "  output = { file = '' },\n"
+    "}\n";
+
+static void test_new_keys(void **state)
+{
+    cf_scene s;
+    const cf_primitive *p;
+    const cf_boundary *b;
+    (void)state;
+    load_ok(NEW_KEYS_SCENE, NULL, 0, &s);
+
+    assert_int_equal(s.n_bodies, 6);
+    p = &s.bodies[0].primitive;
+    assert_string_equal(s.bodies[0].mesh, "");
+    assert_int_equal(p->type, CF_PRIM_BOX);
+    assert_vec(p->size, (const double[]){1, 2, 3}, 3);
+    assert_int_equal(p->cells[0], 2);
+    assert_int_equal(p->cells[1], 3);
+    assert_int_equal(p->cells[2], 4);
+    assert_int_equal(p->tets_per_cell, 5);
+    assert_vec(s.bodies[0].expansion_rate, (const double[]){0.5, 0.5, 0.5}, 3);
+    assert_int_equal(s.bodies[0].has_expansion_center, 1);
+    assert_vec(s.bodies[0].expansion_center, (const double[]){1, 0, 0}, 3);
+
+    p = &s.bodies[1].primitive;
+    assert_string_equal(s.bodies[1].mesh, "");
+    assert_int_equal(p->type, CF_PRIM_SPHERE);
+    assert_double_equal(p->radius, 0.5, 0);
+    assert_double_equal(p->mesh_size, 0.1, 0);
+    assert_vec(s.bodies[1].expansion_rate, (const double[]){1, 2, 3}, 3);
+    assert_int_equal(s.bodies[1].has_expansion_center, 0);
+
+    p = &s.bodies[2].primitive;
+    assert_int_equal(p->type, CF_PRIM_HOLLOW_SPHERE);
+    assert_double_equal(p->radius, 0.5, 0);
+    assert_double_equal(p->thickness, 0.1, 0);
+    assert_double_equal(p->mesh_size, 0.05, 0);
+
+    p = &s.bodies[3].primitive;
+    assert_int_equal(p->type, CF_PRIM_PLATE);
+    assert_vec(p->size, (const double[]){1, 1, 0.01}, 3);
+    assert_double_equal(p->mesh_size, 0.02, 0);
+
+    p = &s.bodies[4].primitive;
+    assert_int_equal(p->type, CF_PRIM_NOTCHED_BEAM);
+    assert_vec(p->size, (const double[]){2, 0.1, 0.2}, 3);
+    assert_vec(p->notch, (const double[]){0.1, 0.02, 0.3}, 3);
+    assert_double_equal(p->mesh_size, 0.01, 0);
+
+    /* A Gmsh file keeps its extension and becomes absolute. */
+    assert_int_equal(s.bodies[5].primitive.type, CF_PRIM_NONE);
+    assert_mesh(s.bodies[5].mesh, "beam.msh");
+
+    assert_int_equal(s.n_boundaries, 3);
+    b = &s.boundaries[0];
+    assert_int_equal(b->type, CF_REGION_BOX);
+    assert_vec(b->min, (const double[]){-1, -1, -1}, 3);
+    assert_vec(b->max, (const double[]){1, 1, -0.9}, 3);
+    assert_vec(b->velocity, (const double[]){0, 0, 0}, 3);
+    assert_int_equal(b->axes, 7);
+    assert_int_equal(b->body, -1);
+    b = &s.boundaries[1];
+    assert_int_equal(b->type, CF_REGION_PLANE);
+    assert_vec(b->point, (const double[]){0, 0, 1}, 3);
+    assert_vec(b->normal, (const double[]){0, 0, 1}, 3);
+    assert_double_equal(b->tolerance, 1e-3, 0);
+    assert_vec(b->velocity, (const double[]){0, 0, -0.1}, 3);
+    assert_int_equal(b->axes, 1 | 4);
+    assert_int_equal(b->body, 1);
+    b = &s.boundaries[2];
+    assert_int_equal(b->type, CF_REGION_GROUP);
+    assert_string_equal(b->group, "top");
+    assert_vec(b->velocity, (const double[]){0, 1, 0}, 3);
+    assert_int_equal(b->axes, 2);
+    assert_int_equal(b->body, -1);
+
+    assert_int_equal(s.solver.mode, CF_RUN_FRACTURE);
+    assert_int_equal(s.solver.criterion, CF_CRITERION_NONE);
+    assert_int_equal(s.solver.has_crack_plane, 1);
+    assert_vec(s.solver.crack_plane_point, (const double[]){0, 0, 0.5}, 3);
+    assert_vec(s.solver.crack_plane_normal, (const double[]){0.6, 0, 0.8}, 3);
+    assert_double_equal(s.solver.crack_plane_tolerance, 1e-4, 0);
+    assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_XPBD);
+    assert_int_equal(s.solver.iteration_independent, 1);
+    assert_double_equal(s.solver.k_stiffness, 0.9, 0);
+    assert_double_equal(s.solver.compliance_scale, 2, 0);
+    assert_double_equal(s.solver.contact_stiffness, 1e9, 0);
+    assert_double_equal(s.solver.max_inverted_fraction, 0.1, 0);
+    assert_double_equal(s.solver.max_energy_growth, 2, 0);
+    assert_string_equal(s.output.file, "");
+    assert_non_null(strstr(s.resolved, "file = \"\","));
+    cf_scene_free(&s);
+    assert_true(is_empty(&s));
+}
+
+/* Defaults inside the new tables: box cells and tets_per_cell, plane
+ * tolerances, boundary axes and body, and the other constraint modes. */
+static void test_new_defaults(void **state)
+{
+    cf_scene s;
+    (void)state;
+    load_ok("return { bodies = { { mesh = { type = 'box', size = {1, 1, 1} } } },\n"
+            "  boundary = { { region = { type = 'plane', point = {0,0,0}, normal = {0,1,0} },\n"
+            "                 velocity = {1, 2, 3} } },\n"
+            "  solver = { mode = 'fracture', crack_plane = { point = {0,0,0}, normal = {0,0,1} },\n"
+            "             constraints = 'none', criterion = 'source', xpbd = {}, guard = {} } }",
+            NULL, 0, &s);
+    assert_int_equal(s.bodies[0].primitive.type, CF_PRIM_BOX);
+    assert_int_equal(s.bodies[0].primitive.cells[0], 1);
+    assert_int_equal(s.bodies[0].primitive.cells[1], 1);
+    assert_int_equal(s.bodies[0].primitive.cells[2], 1);
+    assert_int_equal(s.bodies[0].primitive.tets_per_cell, 6);
+    assert_int_equal(s.n_boundaries, 1);
+    assert_double_equal(s.boundaries[0].tolerance, 1e-6, 0);
+    assert_int_equal(s.boundaries[0].axes, 7);
+    assert_int_equal(s.boundaries[0].body, -1);
+    assert_vec(s.boundaries[0].velocity, (const double[]){1, 2, 3}, 3);
+    assert_int_equal(s.solver.has_crack_plane, 1);
+    assert_double_equal(s.solver.crack_plane_tolerance, 1e-6, 0);
+    assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_NONE);
+    assert_int_equal(s.solver.criterion, CF_CRITERION_SOURCE);
+    assert_double_equal(s.solver.compliance_scale, 1, 0);
+    assert_double_equal(s.solver.max_inverted_fraction, 0.01, 0);
+    assert_double_equal(s.solver.max_energy_growth, 0.5, 0);
+    cf_scene_free(&s);
+
+    /* The new keys also take overrides, primitives included. */
+    {
+        static const char *const ov[] = {"bodies[1].mesh.radius=0.25", "solver.constraints='xpbd'",
+                                         "bodies[1].expansion_rate={1, 0, 0}"};
+        load_ok("return { bodies = { { mesh = { type = 'sphere', radius = 1, mesh_size = 0.1 } } } }",
+                ov, 3, &s);
+        assert_double_equal(s.bodies[0].primitive.radius, 0.25, 0);
+        assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_XPBD);
+        assert_vec(s.bodies[0].expansion_rate, (const double[]){1, 0, 0}, 3);
+        cf_scene_free(&s);
+    }
+}
+
 /* ---------------------------------------------------------------- overrides */
 
 static void test_overrides(void **state)
@@ -411,6 +592,32 @@ static void assert_same_scene(const cf_scene *a, const cf_scene *b)
         assert_memory_equal(x->orientation, y->orientation, sizeof x->orientation);
         assert_memory_equal(x->velocity, y->velocity, sizeof x->velocity);
         assert_memory_equal(x->angular_velocity, y->angular_velocity, sizeof x->angular_velocity);
+        assert_int_equal(x->primitive.type, y->primitive.type);
+        assert_memory_equal(x->primitive.size, y->primitive.size, sizeof x->primitive.size);
+        assert_memory_equal(x->primitive.cells, y->primitive.cells, sizeof x->primitive.cells);
+        assert_int_equal(x->primitive.tets_per_cell, y->primitive.tets_per_cell);
+        assert_memory_equal(&x->primitive.radius, &y->primitive.radius, sizeof(double));
+        assert_memory_equal(&x->primitive.thickness, &y->primitive.thickness, sizeof(double));
+        assert_memory_equal(x->primitive.notch, y->primitive.notch, sizeof x->primitive.notch);
+        assert_memory_equal(&x->primitive.mesh_size, &y->primitive.mesh_size, sizeof(double));
+        assert_memory_equal(x->expansion_rate, y->expansion_rate, sizeof x->expansion_rate);
+        assert_int_equal(x->has_expansion_center, y->has_expansion_center);
+        assert_memory_equal(x->expansion_center, y->expansion_center,
+                            sizeof x->expansion_center);
+    }
+    assert_int_equal(a->n_boundaries, b->n_boundaries);
+    for (int i = 0; i < a->n_boundaries; i++) {
+        const cf_boundary *x = &a->boundaries[i], *y = &b->boundaries[i];
+        assert_int_equal(x->type, y->type);
+        assert_memory_equal(x->min, y->min, sizeof x->min);
+        assert_memory_equal(x->max, y->max, sizeof x->max);
+        assert_memory_equal(x->point, y->point, sizeof x->point);
+        assert_memory_equal(x->normal, y->normal, sizeof x->normal);
+        assert_memory_equal(&x->tolerance, &y->tolerance, sizeof x->tolerance);
+        assert_string_equal(x->group, y->group);
+        assert_int_equal(x->body, y->body);
+        assert_int_equal(x->axes, y->axes);
+        assert_memory_equal(x->velocity, y->velocity, sizeof x->velocity);
     }
     assert_int_equal(a->n_obstacles, b->n_obstacles);
     for (int i = 0; i < a->n_obstacles; i++) {
@@ -438,6 +645,23 @@ static void assert_same_scene(const cf_scene *a, const cf_scene *b)
     assert_int_equal(a->solver.iterations, b->solver.iterations);
     assert_memory_equal(&a->solver.k_damping, &b->solver.k_damping, sizeof(double));
     assert_int_equal(a->solver.threads, b->solver.threads);
+    assert_int_equal(a->solver.mode, b->solver.mode);
+    assert_int_equal(a->solver.criterion, b->solver.criterion);
+    assert_int_equal(a->solver.has_crack_plane, b->solver.has_crack_plane);
+    assert_memory_equal(a->solver.crack_plane_point, b->solver.crack_plane_point, 3 * sizeof(double));
+    assert_memory_equal(a->solver.crack_plane_normal, b->solver.crack_plane_normal, 3 * sizeof(double));
+    assert_memory_equal(&a->solver.crack_plane_tolerance, &b->solver.crack_plane_tolerance,
+                        sizeof(double));
+    assert_int_equal(a->solver.constraints, b->solver.constraints);
+    assert_int_equal(a->solver.iteration_independent, b->solver.iteration_independent);
+    assert_memory_equal(&a->solver.compliance_scale, &b->solver.compliance_scale,
+                        sizeof(double));
+    assert_memory_equal(&a->solver.contact_stiffness, &b->solver.contact_stiffness,
+                        sizeof(double));
+    assert_memory_equal(&a->solver.max_inverted_fraction, &b->solver.max_inverted_fraction,
+                        sizeof(double));
+    assert_memory_equal(&a->solver.max_energy_growth, &b->solver.max_energy_growth,
+                        sizeof(double));
     assert_string_equal(a->output.file, b->output.file);
     assert_memory_equal(&a->output.frame_interval, &b->output.frame_interval, sizeof(double));
     assert_string_equal(a->resolved, b->resolved);
@@ -473,6 +697,15 @@ static void test_round_trip(void **state)
                " { type = 'plane', normal = {1e-300, 3e-300, 0} } } }",
                NULL, 0);
     round_trip("return { bodies = { { mesh = 'cube.node', orientation = {1, 0, 1, 13} } } }",
+               NULL, 0);
+    /* Every new key: primitives, a .msh path, expansion, boundaries (fixed,
+     * -0.0 velocity), crack_plane, constraints, xpbd, guard, no output file. */
+    round_trip(NEW_KEYS_SCENE, NULL, 0);
+    round_trip("return { bodies = { { mesh = { type = 'box', size = {0.1, 0.2, 0.3} } } },\n"
+               "  boundary = { { region = { type = 'plane', point = {0,0,0},\n"
+               "                            normal = {1, 1, 13} }, fixed = true, axes = 'zy' } },\n"
+               "  solver = { mode = 'fracture',\n"
+               "             crack_plane = { point = {0,0,0}, normal = {1e-300, 3e-300, 0} } } }",
                NULL, 0);
 }
 
@@ -571,10 +804,10 @@ static void test_error_key(void **state)
     expect_error("return { " MIN_BODY ", solver = { pbd = { k_stiffnes = 1 } } }", NULL, 0,
                  CF_ERR_SCENE_KEY,
                  "scene.lua: unknown key 'solver.pbd.k_stiffnes'; allowed: k_stiffness, "
-                 "iterations, k_damping (did you mean 'k_stiffness'?)");
+                 "iterations, k_damping, iteration_independent (did you mean 'k_stiffness'?)");
     expect_error("return { " MIN_BODY ", gravty = {0,0,0} }", NULL, 0, CF_ERR_SCENE_KEY,
                  "unknown key 'gravty'; allowed: name, duration, gravity, material, bodies, "
-                 "obstacles, solver, output");
+                 "boundary, obstacles, solver, output");
     expect_error("return { bodies = { { mesh = 'cube.node' }, { mesh = 'cube.node', pos = {} } } }",
                  NULL, 0, CF_ERR_SCENE_KEY, "unknown key 'bodies[2].pos'");
     expect_error("return { " MIN_BODY ", material = { 1e6 } }", NULL, 0, CF_ERR_SCENE_KEY,
@@ -605,7 +838,8 @@ static void test_error_type(void **state)
                                        "string at [2]"},
         {"orientation = {1, 0, 0}", "", "'bodies[1].orientation' must be a list of 4 numbers"},
         {"scale = '2'", "", "'bodies[1].scale' must be a number, got string"},
-        {"mesh = 5", "", "'bodies[1].mesh' must be a string, got number"},
+        {"mesh = 5", "", "'bodies[1].mesh' must be a string (a mesh name or path) or a table "
+                         "(a primitive), got number"},
         {"", "duration = true", "'duration' must be a number, got boolean"},
         {"", "material = 5", "'material' must be a table, got number"},
         {"", "solver = { iterations = 3, pbd = 3 }", "unknown key"},
@@ -679,7 +913,6 @@ static void test_error_value(void **state)
         {"", "solver = { elasticity = 'neo' }",
          "'solver.elasticity' is \"neo\"; allowed: corotational, linear"},
         {"", "output = { frame_interval = 0 }", "'output.frame_interval' must be > 0"},
-        {"", "output = { file = '' }", "'output.file' must not be empty"},
         {"", "name = ''", "'name' must not be empty"},
         {"", "name = string.rep('n', 200)", "'name' is too long"},
         {"", "name = 'a\\0b'", "'name' must not contain NUL bytes"},
@@ -710,6 +943,169 @@ static void test_error_value(void **state)
         expect_error(text, NULL, 0, CF_ERR_SCENE_VALUE, cases[i].needle);
     }
     expect_error("return { bodies = {} }", NULL, 0, CF_ERR_SCENE_VALUE, "'bodies' is empty");
+}
+
+/* One case per new kind of error; `text` is the whole scene and every
+ * needle names the key path. */
+#define FRACTURE "solver = { mode = 'fracture' }"
+#define PRIM(m) "return { bodies = { { mesh = " m " } } }"
+#define BOUNDARY(b) "return { " MIN_BODY ", boundary = { " b " }, " FRACTURE " }"
+#define ZBOX "region = { type = 'box', min = {0,0,0}, max = {1,1,1} }"
+
+static void test_error_new_keys(void **state)
+{
+    static const struct {
+        const char *text;
+        cf_status code;
+        const char *needle;
+    } cases[] = {
+        /* primitives */
+        {PRIM("{ type = 'cone' }"), CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.type' is \"cone\"; allowed: box, sphere, hollow_sphere, plate, "
+         "notched_beam"},
+        {PRIM("{ radius = 1 }"), CF_ERR_SCENE_KEY, "missing required key 'bodies[1].mesh.type'"},
+        {PRIM("{ type = 'sphere', radiuss = 1, mesh_size = 0.1 }"), CF_ERR_SCENE_KEY,
+         "unknown key 'bodies[1].mesh.radiuss'; allowed: type, radius, mesh_size (did you mean "
+         "'radius'?)"},
+        {PRIM("{ type = 'box', size = {1,1,1}, radius = 1 }"), CF_ERR_SCENE_KEY,
+         "unknown key 'bodies[1].mesh.radius'; allowed: type, size, cells, tets_per_cell"},
+        {PRIM("{ type = 'sphere', radius = 1 }"), CF_ERR_SCENE_KEY,
+         "missing required key 'bodies[1].mesh.mesh_size'"},
+        {PRIM("{ type = 'box' }"), CF_ERR_SCENE_KEY, "missing required key 'bodies[1].mesh.size'"},
+        {PRIM("{ type = 'notched_beam', size = {2, 0.1, 0.2}, mesh_size = 0.01 }"),
+         CF_ERR_SCENE_KEY, "missing required key 'bodies[1].mesh.notch'"},
+        {PRIM("{ type = 'box', size = {1,1,1}, tets_per_cell = 4 }"), CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.tets_per_cell' must be 5 or 6, got 4"},
+        {PRIM("{ type = 'box', size = {1,1,1}, tets_per_cell = 5.5 }"), CF_ERR_SCENE_TYPE,
+         "'bodies[1].mesh.tets_per_cell' must be an integer, got 5.5"},
+        {PRIM("{ type = 'box', size = {1,0,1} }"), CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.size' must have every component > 0, got {1, 0, 1}"},
+        {PRIM("{ type = 'box', size = {1,1,1}, cells = {1, 0, 1} }"), CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.cells' must hold integers in [1, "},
+        {PRIM("{ type = 'box', size = {1,1,1}, cells = {1, 2.5, 1} }"), CF_ERR_SCENE_TYPE,
+         "'bodies[1].mesh.cells' must be a list of 3 integers, got 2.5 at [2]"},
+        {PRIM("{ type = 'box', size = {1,1,1}, cells = {2000, 2000, 2000} }"), CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.cells' = {2000, 2000, 2000} gives"},
+        {PRIM("{ type = 'sphere', radius = 0, mesh_size = 0.1 }"), CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.radius' must be > 0, got 0"},
+        {PRIM("{ type = 'hollow_sphere', radius = 0.5, thickness = 0.5, mesh_size = 0.1 }"),
+         CF_ERR_SCENE_VALUE, "'bodies[1].mesh.thickness' must be < radius (0.5)"},
+        {PRIM("{ type = 'hollow_sphere', radius = 0.5, thickness = 0.7, mesh_size = 0.1 }"),
+         CF_ERR_SCENE_VALUE, "got 0.7"},
+        {PRIM("{ type = 'plate', size = {1,1,0.1}, mesh_size = -1 }"), CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.mesh_size' must be > 0"},
+        {PRIM("{ type = 'notched_beam', size = {2, 0.1, 0.2}, notch = {0.2, 0.02, 0},"
+              " mesh_size = 0.01 }"),
+         CF_ERR_SCENE_VALUE,
+         "'bodies[1].mesh.notch' depth (notch[1]) must be in (0, 0.2), less than the beam "
+         "height size[3], got 0.2"},
+        {PRIM("{ type = 'notched_beam', size = {2, 0.1, 0.2}, notch = {0.1, 0, 0},"
+              " mesh_size = 0.01 }"),
+         CF_ERR_SCENE_VALUE, "'bodies[1].mesh.notch' width (notch[2]) must be > 0"},
+        {PRIM("{ type = 'notched_beam', size = {2, 0.1, 0.2}, notch = {0.1, 0.2, -0.95},"
+              " mesh_size = 0.01 }"),
+         CF_ERR_SCENE_VALUE, "'bodies[1].mesh.notch' must lie inside the beam length"},
+        {PRIM("true"), CF_ERR_SCENE_TYPE,
+         "'bodies[1].mesh' must be a string (a mesh name or path) or a table"},
+        {PRIM("'nosuch.msh'"), CF_ERR_FILE_OPEN,
+         "bodies[1].mesh: Gmsh mesh 'nosuch.msh' not found: no file "},
+        /* expansion */
+        {"return { bodies = { { mesh = 'cube.node', expansion_rate = 'fast' } } }",
+         CF_ERR_SCENE_TYPE,
+         "'bodies[1].expansion_rate' must be a number or a list of 3 numbers, got string"},
+        {"return { bodies = { { mesh = 'cube.node', expansion_rate = {1, 2} } } }",
+         CF_ERR_SCENE_TYPE, "'bodies[1].expansion_rate' must be a list of 3 numbers"},
+        {"return { bodies = { { mesh = 'cube.node', expansion_rate = 1/0 } } }",
+         CF_ERR_SCENE_VALUE, "'bodies[1].expansion_rate' must be a finite number"},
+        {"return { bodies = { { mesh = 'cube.node', expansion_center = 0 } } }",
+         CF_ERR_SCENE_TYPE, "'bodies[1].expansion_center' must be a list of 3 numbers"},
+        /* boundary */
+        {BOUNDARY("{ " ZBOX ", velocity = {0,0,1}, fixed = true }"), CF_ERR_SCENE_VALUE,
+         "'boundary[1]' gives both 'velocity' and 'fixed = true'; give one of them"},
+        {BOUNDARY("{ " ZBOX " }"), CF_ERR_SCENE_KEY,
+         "missing required key 'boundary[1].velocity' (or 'fixed = true')"},
+        {BOUNDARY("{ " ZBOX ", fixed = false }"), CF_ERR_SCENE_KEY,
+         "missing required key 'boundary[1].velocity'"},
+        {BOUNDARY("{ " ZBOX ", fixed = 1 }"), CF_ERR_SCENE_TYPE,
+         "'boundary[1].fixed' must be a boolean (true or false), got number"},
+        {BOUNDARY("{ " ZBOX ", fixed = true, axes = 'xx' }"), CF_ERR_SCENE_VALUE,
+         "'boundary[1].axes' is \"xx\"; allowed: distinct letters from \"xyz\""},
+        {BOUNDARY("{ " ZBOX ", fixed = true, axes = 'w' }"), CF_ERR_SCENE_VALUE,
+         "'boundary[1].axes' is \"w\""},
+        {BOUNDARY("{ " ZBOX ", fixed = true, axes = '' }"), CF_ERR_SCENE_VALUE,
+         "'boundary[1].axes' must not be empty"},
+        {BOUNDARY("{ " ZBOX ", fixed = true, body = 2 }"), CF_ERR_SCENE_VALUE,
+         "'boundary[1].body' must be in [1, 1] (a 1-based index into bodies), got 2"},
+        {BOUNDARY("{ " ZBOX ", fixed = true, body = 0 }"), CF_ERR_SCENE_VALUE,
+         "'boundary[1].body' must be in [1, 1]"},
+        {BOUNDARY("{ " ZBOX ", fixed = true }, { " ZBOX ", fixed = true, body = 1.5 }"),
+         CF_ERR_SCENE_TYPE, "'boundary[2].body' must be an integer, got 1.5"},
+        {"return { " MIN_BODY ", boundary = { { " ZBOX ", fixed = true } } }", CF_ERR_SCENE_VALUE,
+         "'boundary' has 1 entry but solver.mode is \"hybrid\": boundary conditions need "
+         "solver.mode = \"fracture\""},
+        {BOUNDARY("{ fixed = true }"), CF_ERR_SCENE_KEY,
+         "missing required key 'boundary[1].region'"},
+        {BOUNDARY("{ region = 'top', fixed = true }"), CF_ERR_SCENE_TYPE,
+         "'boundary[1].region' must be a table, got string"},
+        {BOUNDARY("{ region = { type = 'cylinder' }, fixed = true }"), CF_ERR_SCENE_VALUE,
+         "'boundary[1].region.type' is \"cylinder\"; allowed: box, plane, group"},
+        {BOUNDARY("{ " ZBOX ", fixed = true, vel = {0,0,0} }"), CF_ERR_SCENE_KEY,
+         "unknown key 'boundary[1].vel'; allowed: region, velocity, fixed, axes, body"},
+        {BOUNDARY("{ region = { type = 'group', name = 'g', normal = {0,0,1} }, fixed = true }"),
+         CF_ERR_SCENE_KEY, "unknown key 'boundary[1].region.normal'; allowed: type, name"},
+        {BOUNDARY("{ region = { type = 'box', min = {0,0,0}, max = {1,0,1} }, fixed = true }"),
+         CF_ERR_SCENE_VALUE,
+         "'boundary[1].region.max' must exceed min in every component, got max[2] = 0 <= "
+         "min[2] = 0"},
+        {BOUNDARY("{ region = { type = 'box', min = {0,0,0} }, fixed = true }"), CF_ERR_SCENE_KEY,
+         "missing required key 'boundary[1].region.max'"},
+        {BOUNDARY("{ region = { type = 'plane', point = {0,0,0}, normal = {0,0,0} },"
+                  " fixed = true }"),
+         CF_ERR_SCENE_VALUE, "'boundary[1].region.normal' must be a non-zero vector"},
+        {BOUNDARY("{ region = { type = 'plane', point = {0,0,0}, normal = {0,0,1},"
+                  " tolerance = 0 }, fixed = true }"),
+         CF_ERR_SCENE_VALUE, "'boundary[1].region.tolerance' must be > 0"},
+        {BOUNDARY("{ region = { type = 'group', name = string.rep('g', 64) }, fixed = true }"),
+         CF_ERR_SCENE_VALUE, "'boundary[1].region.name' is too long (64 bytes, at most 63)"},
+        {BOUNDARY("{ region = { type = 'group' }, fixed = true }"), CF_ERR_SCENE_KEY,
+         "missing required key 'boundary[1].region.name'"},
+        /* solver */
+        {"return { " MIN_BODY ", solver = { mode = 'rigid' } }", CF_ERR_SCENE_VALUE,
+         "'solver.mode' is \"rigid\"; allowed: hybrid, fracture"},
+        {"return { " MIN_BODY ", solver = { criterion = 'stress' } }", CF_ERR_SCENE_VALUE,
+         "'solver.criterion' is \"stress\"; allowed: traction, source, none"},
+        {"return { " MIN_BODY ", solver = { constraints = 'pdb' } }", CF_ERR_SCENE_VALUE,
+         "'solver.constraints' is \"pdb\"; allowed: pbd, xpbd, none (did you mean 'pbd'?)"},
+        {"return { " MIN_BODY ", solver = { crack_plane = { point = {0,0,0}, normal = {0,0,0} } } }",
+         CF_ERR_SCENE_VALUE, "'solver.crack_plane.normal' must be a non-zero vector, got all zeros"},
+        {"return { " MIN_BODY ", solver = { crack_plane = { point = {0,0,0} } } }", CF_ERR_SCENE_KEY,
+         "missing required key 'solver.crack_plane.normal'"},
+        {"return { " MIN_BODY ", solver = { crack_plane = { point = {0,0,0}, normal = {0,0,1},"
+         " tol = 1 } } }",
+         CF_ERR_SCENE_KEY, "unknown key 'solver.crack_plane.tol'; allowed: point, normal, tolerance"},
+        {"return { " MIN_BODY ", solver = { crack_plane = true } }", CF_ERR_SCENE_TYPE,
+         "'solver.crack_plane' must be a table, got boolean"},
+        {"return { " MIN_BODY ", solver = { pbd = { iteration_independent = 1 } } }",
+         CF_ERR_SCENE_TYPE, "'solver.pbd.iteration_independent' must be a boolean"},
+        {"return { " MIN_BODY ", solver = { xpbd = { compliance_scale = 0 } } }",
+         CF_ERR_SCENE_VALUE, "'solver.xpbd.compliance_scale' must be > 0, got 0"},
+        {"return { " MIN_BODY ", solver = { xpbd = { compliance = 1 } } }", CF_ERR_SCENE_KEY,
+         "unknown key 'solver.xpbd.compliance'"},
+        {"return { " MIN_BODY ", solver = { contact_stiffness = -1 } }", CF_ERR_SCENE_VALUE,
+         "'solver.contact_stiffness' must be >= 0, got -1"},
+        {"return { " MIN_BODY ", solver = { guard = { max_inverted_fraction = 1.5 } } }",
+         CF_ERR_SCENE_VALUE, "'solver.guard.max_inverted_fraction' must be in [0, 1], got 1.5"},
+        {"return { " MIN_BODY ", solver = { guard = { max_energy_growth = 0 } } }",
+         CF_ERR_SCENE_VALUE, "'solver.guard.max_energy_growth' must be > 0, got 0"},
+        {"return { " MIN_BODY ", solver = { guard = { max_inverted = 0.1 } } }", CF_ERR_SCENE_KEY,
+         "unknown key 'solver.guard.max_inverted'; allowed: max_inverted_fraction, "
+         "max_energy_growth"},
+        {"return { " MIN_BODY ", output = { file = 5 } }", CF_ERR_SCENE_TYPE,
+         "'output.file' must be a string, got number"},
+    };
+    (void)state;
+    for (int i = 0; i < (int)(sizeof cases / sizeof cases[0]); i++)
+        expect_error(cases[i].text, NULL, 0, cases[i].code, cases[i].needle);
 }
 
 static void test_error_override(void **state)
@@ -773,7 +1169,8 @@ int main(void)
         cmocka_unit_test(test_error_file_open),   cmocka_unit_test(test_error_syntax),
         cmocka_unit_test(test_error_key),         cmocka_unit_test(test_error_type),
         cmocka_unit_test(test_error_value),       cmocka_unit_test(test_error_override),
-        cmocka_unit_test(test_error_without_record),
+        cmocka_unit_test(test_error_without_record), cmocka_unit_test(test_new_keys),
+        cmocka_unit_test(test_new_defaults),      cmocka_unit_test(test_error_new_keys),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

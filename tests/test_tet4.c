@@ -22,7 +22,7 @@ static cf_material material(double E, double nu, double rho)
 
 static void one_tet(cf_solid *s, const double x[4][3], const cf_material *mat)
 {
-    cf_mesh m = {4, 1, NULL, NULL};
+    cf_mesh m = {.n_nodes = 4, .n_tets = 1};
     double xs[12];
     int t[4] = {0, 1, 2, 3}, body = 0;
     memcpy(xs, x, sizeof xs);

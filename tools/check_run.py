@@ -7,7 +7,7 @@ usage: check_run.py FILE.h5 [--min-fragments N] [--max-momentum-error E]
 Prints and checks:
   * the layout: /parameters/scene, /particles/fragments/{id,position,
     orientation,velocity,angular_velocity,mode}, /fragments/{parent,
-    birth_time}, /observables/{kinetic_energy,fragment_count,
+    birth_time}, /observables/{energy_kinetic,fragment_count,
     cohesive_elements}, /handoffs;
   * free fall before the first impact: the centre of mass of fragment 0
     against z0 - g t^2/2 (g from the scene's gravity), error relative to the
@@ -44,7 +44,7 @@ def main():
         need += [f"particles/fragments/{n}/value" for n in
                  ("id", "position", "orientation", "velocity", "angular_velocity", "mode")]
         need += [f"observables/{n}/value" for n in
-                 ("kinetic_energy", "fragment_count", "cohesive_elements")]
+                 ("energy_kinetic", "energy_residual", "fragment_count", "cohesive_elements")]
         missing = [n for n in need if n not in f]
         check(not missing, "datasets present" + (f" (missing {missing})" if missing else ""))
         if missing:

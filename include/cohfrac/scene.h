@@ -18,21 +18,50 @@
  *     friction [0.5], restitution [0.0] }
  *   bodies = { {                          one entry per solid
  *     mesh        string: a prepared mesh name ("bunny", "bunny_small")
- *                 looked up in the mesh directory, or a path to a TetGen
- *                 .node/.ele pair (with or without extension)   [required]
+ *                 looked up in the mesh directory, a path to a TetGen
+ *                 .node/.ele pair (with or without extension), or a path
+ *                 to a Gmsh .msh file;                          [required]
+ *                 or a primitive table (meshed in the mesh directory):
+ *                 {type="box", size={x,y,z} m, cells={nx,ny,nz} [{1,1,1}],
+ *                  tets_per_cell [6] (5 or 6)}
+ *                 {type="sphere", radius m, mesh_size m}
+ *                 {type="hollow_sphere", radius m, thickness m, mesh_size m}
+ *                 {type="plate", size={x,y,z} m, mesh_size m}
+ *                 {type="notched_beam", size={length,width,height} m,
+ *                  notch={depth,width,offset} m, mesh_size m}
  *     scale [1], position [{0,0,0}] m (of the mesh's bounding-box centre),
  *     orientation [{1,0,0,0}] quaternion (w,x,y,z) applied before scale,
- *     velocity [{0,0,0}] m/s, angular_velocity [{0,0,0}] rad/s (about the COM)
+ *     initial velocity field v = velocity + angular_velocity x (x - x_com)
+ *       + expansion_rate (.) (x - expansion_center):
+ *     velocity [{0,0,0}] m/s, angular_velocity [{0,0,0}] rad/s (about the COM),
+ *     expansion_rate [0] 1/s: a number (radial) or {x,y,z} (per axis),
+ *     expansion_center [the body's centre of mass] m
  *   }, ... }
+ *   boundary = { {                        prescribed nodes (fracture mode)
+ *     region = {type="box", min={..}, max={..}}            nodes inside, m
+ *            | {type="plane", point={..}, normal={..}, tolerance [1e-6]}
+ *                                          nodes within tolerance m of it
+ *            | {type="group", name="..."}  a Gmsh physical group
+ *     velocity = {vx,vy,vz} m/s   (prescribed) or fixed = true (velocity 0)
+ *     axes ["xyz"]: the prescribed components ("z", "xy", ...)
+ *     body [all]: 1-based body index the region applies to
+ *   }, ... }  [{}]; needs solver.mode = "fracture"
  *   obstacles = { {type="plane", point={0,0,0}, normal={0,0,1}},
  *                 {type="sphere", center=..., radius=..., velocity={0,0,0}},
  *                 {type="box", center=..., half_extents=..., velocity={0,0,0}} }
  *                 [{}]; `type` is required, as are a sphere's center and radius
  *                 and a box's center and half_extents (no sensible default)
  *   solver = {
+ *     mode ["hybrid"]: rigid mode with fracture mode on impact
+ *          | "fracture": every body stays in fracture mode (no rigid mode,
+ *            no Bullet world) for the whole run
  *     rigid_backend ["bullet"] | "pbd"
- *     dt_rigid [1e-3] s, rigid_substeps [5] (Bullet sub-steps per dt_rigid)
+ *     dt_rigid [1e-3] s, rigid_substeps [5] (Bullet sub-steps per dt_rigid);
+ *       with mode = "fracture" it only paces output and checks, rounded down
+ *       to a whole number of fracture steps
  *     dt_fracture [5e-6] s, check_interval [1] steps, quiet_steps [400]
+ *     cfl_fraction [0]: when > 0, dt_fracture = cfl_fraction x dt_cfl of the
+ *       mesh (DESIGN §3.2) instead of the dt_fracture value
  *     max_fracture_time [0.05] s (a fragment returns to rigid mode after this
  *       long in fracture mode even if still cracking)
  *     impact_threshold [0.2] m/s: normal contact impulse per unit mass in one
@@ -41,16 +70,32 @@
  *     criterion ["traction"] | "source": cohesive insertion rule, DESIGN §3.3
  *       (facet traction sigma_n >= sigma_max or tau >= tau_max; or the
  *       source's nodal-averaged max principal stress >= 0.9 sigma_max at all
- *       three facet nodes)
- *     pbd = { k_stiffness [0.9], iterations [3], k_damping [1.0] }
+ *       three facet nodes) | "none" (no insertion: elastic only)
+ *     crack_plane = {point={..}, normal={..}, tolerance [1e-6] m}: a
+ *       pre-selected crack path: only interior facets whose three vertices
+ *       lie within tolerance of the plane are candidates for insertion
+ *       (still by `criterion`)  [every interior facet]
+ *     constraints ["pbd"]: the source's PBD bars | "xpbd": bars with
+ *       compliance from E and each bar's tributary volume (Macklin 2016)
+ *       | "none": pure explicit elasticity + CZM (needs dt <= dt_cfl)
+ *     pbd = { k_stiffness [0.9], iterations [3], k_damping [1.0],
+ *             iteration_independent [false]: use k' = 1 - (1-k)^(1/iterations) }
+ *     xpbd = { compliance_scale [1] }: bar compliance = scale L^2/(E V_trib)
+ *     contact_stiffness [0] Pa/m: crack-face penalty K_p; 0 = the stability
+ *       cap 2 m/(A dt^2)/4 of each node pair
+ *     guard = { max_inverted_fraction [0.01], max_energy_growth [0.5] }:
+ *       stop (exit 3) when more than this fraction of a fragment's tets are
+ *       inverted, or when the total energy exceeds the initial energy plus
+ *       all work input by this fraction of their sum
  *     threads [0] (0: all cores)
  *   }
- *   output = { file ["out/<name>.h5"], frame_interval [0.01] s }
+ *   output = { file ["out/<name>.h5"] ("" for none), frame_interval [0.01] s }
  */
 #ifndef COHFRAC_SCENE_H
 #define COHFRAC_SCENE_H
 
 #include "cohfrac/error.h"
+#include "cohfrac/mesh.h"
 
 typedef struct cf_material {
     double E, nu, rho;             /* Pa, -, kg/m^3 */
@@ -61,13 +106,31 @@ typedef struct cf_material {
 } cf_material;
 
 typedef struct cf_body_def {
-    char mesh[1024];           /* resolved TetGen base path (no extension) */
+    char mesh[1024];           /* resolved path: TetGen base (no extension) or a
+                                  .msh file; "" for a primitive */
+    cf_primitive primitive;    /* type CF_PRIM_NONE when `mesh` is a file */
     double scale;
     double position[3];        /* m, where the bounding-box centre goes */
     double orientation[4];     /* w,x,y,z, normalised */
     double velocity[3];        /* m/s */
     double angular_velocity[3];/* rad/s */
+    double expansion_rate[3];  /* 1/s, per axis */
+    int has_expansion_center;  /* 0: the body's centre of mass */
+    double expansion_center[3];/* m */
 } cf_body_def;
+
+typedef enum { CF_REGION_BOX, CF_REGION_PLANE, CF_REGION_GROUP } cf_region_type;
+
+typedef struct cf_boundary {
+    cf_region_type type;
+    double min[3], max[3];       /* box, m */
+    double point[3], normal[3];  /* plane (normal normalised) */
+    double tolerance;            /* plane, m */
+    char group[64];              /* Gmsh physical group name */
+    int body;                    /* 0-based body index, -1 for every body */
+    int axes;                    /* prescribed components: bit 0 x, 1 y, 2 z */
+    double velocity[3];          /* m/s (zero when fixed) */
+} cf_boundary;
 
 typedef enum { CF_OBSTACLE_PLANE, CF_OBSTACLE_SPHERE, CF_OBSTACLE_BOX } cf_obstacle_type;
 
@@ -80,24 +143,37 @@ typedef struct cf_obstacle {
     double velocity[3];          /* sphere, box: constant, m/s */
 } cf_obstacle;
 
+typedef enum { CF_RUN_HYBRID, CF_RUN_FRACTURE } cf_run_mode;
 typedef enum { CF_RIGID_BULLET, CF_RIGID_PBD } cf_rigid_backend;
 typedef enum { CF_ELASTICITY_COROTATIONAL, CF_ELASTICITY_LINEAR } cf_elasticity;
-typedef enum { CF_CRITERION_TRACTION, CF_CRITERION_SOURCE } cf_criterion;
+typedef enum { CF_CRITERION_TRACTION, CF_CRITERION_SOURCE, CF_CRITERION_NONE } cf_criterion;
+typedef enum { CF_CONSTRAINTS_PBD, CF_CONSTRAINTS_XPBD, CF_CONSTRAINTS_NONE } cf_constraints;
 
 typedef struct cf_solver_settings {
+    cf_run_mode mode;
     cf_rigid_backend rigid_backend;
     double dt_rigid;
     int rigid_substeps;
     double dt_fracture;
+    double cfl_fraction;          /* > 0: dt_fracture = cfl_fraction dt_cfl */
     int check_interval;
     int quiet_steps;
     double max_fracture_time;
     double impact_threshold;
     cf_elasticity elasticity;
     cf_criterion criterion;
+    int has_crack_plane;
+    double crack_plane_point[3], crack_plane_normal[3]; /* normal normalised */
+    double crack_plane_tolerance;                    /* m */
+    cf_constraints constraints;
     double k_stiffness;
     int iterations;
     double k_damping;
+    int iteration_independent;
+    double compliance_scale;
+    double contact_stiffness;     /* Pa/m, 0 = stability cap */
+    double max_inverted_fraction;
+    double max_energy_growth;
     int threads;
 } cf_solver_settings;
 
@@ -115,6 +191,8 @@ typedef struct cf_scene {
     cf_body_def *bodies;
     int n_obstacles;
     cf_obstacle *obstacles;
+    int n_boundaries;
+    cf_boundary *boundaries;
     cf_solver_settings solver;
     cf_output_settings output;
     char *resolved; /* the resolved scene as Lua text (every key, defaults filled,

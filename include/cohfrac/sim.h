@@ -19,16 +19,52 @@ typedef struct cf_sim cf_sim;
 typedef struct cf_run_options {
     int progress;      /* 1: progress display on stderr (bar on a TTY, lines otherwise) */
     int threads;       /* OpenMP threads for element loops; 0: scene's setting */
+    const char *mesh_dir; /* where primitives are meshed and cached (NULL: "build/meshes") */
 } cf_run_options;
+
+/* The energy ledger (J) and momenta of the whole scene at the current
+ * state.  Balance: residual = kinetic + strain + cohesive_stored +
+ * cohesive_dissipated + contact + pbd + damping + handoff
+ * - (initial + work_gravity + work_boundary); zero for an exact integrator.
+ * Kinetic energy of the in-house solver is the leapfrog estimate
+ * 1/2 sum m v(n-1/2).v(n+1/2) at the last force evaluation; Bullet bodies'
+ * is 1/2 M v^2 + 1/2 w.I w.  `contact`, `pbd`, `damping`, `handoff` are
+ * energies removed since t = 0 (see DESIGN §3-§6 and docs/physics.md). */
+typedef struct cf_ledger {
+    double kinetic, strain, cohesive_stored, cohesive_dissipated;
+    double work_gravity, work_boundary;
+    double contact, pbd, damping, handoff;
+    double initial;            /* kinetic + strain at t = 0 */
+    double residual;
+    double momentum[3];        /* kg m/s */
+    double angular_momentum[3];/* kg m^2/s, about the origin */
+    double mass_moment[3];     /* kg m, sum m x (gravity's work is g . its change) */
+} cf_ledger;
 
 /* Errors: those of cf_mesh_load_tetgen for each body, CF_ERR_OUTPUT,
  * CF_ERR_EXTERNAL (Bullet world), CF_ERR_NOMEM. */
 cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim **out,
                         cf_error *err);
 
-/* Errors: CF_ERR_DIVERGED (NaN positions; the file is closed and readable),
- * CF_ERR_OUTPUT, CF_ERR_NOMEM. */
+/* Advance to the scene's duration.  Errors: CF_ERR_DIVERGED (a
+ * non-finite or faster than 1e5 m/s node, more inverted tets than
+ * solver.guard.max_inverted_fraction, or kinetic + strain + cohesive energy
+ * above (1 + solver.guard.max_energy_growth) times the initial energy plus
+ * all work input; the message names dt/dt_cfl and what to change; the output
+ * file is closed and readable), CF_ERR_OUTPUT, CF_ERR_NOMEM. */
 cf_status cf_sim_run(cf_sim *sim, cf_error *err);
+
+/* One rigid step (dt_rigid, sub-cycled in fracture mode), with hand-offs,
+ * the divergence guard, and a frame when one is due.  Returns CF_OK; the
+ * errors of cf_sim_run.  cf_sim_done tells when the duration is reached. */
+cf_status cf_sim_advance(cf_sim *sim, cf_error *err);
+int cf_sim_done(const cf_sim *sim);
+
+/* Simulated time, s. */
+double cf_sim_time(const cf_sim *sim);
+
+/* The energy ledger and momenta now. */
+void cf_sim_ledger(const cf_sim *sim, cf_ledger *out);
 
 void cf_sim_print_summary(const cf_sim *sim, FILE *out);
 void cf_sim_destroy(cf_sim *sim);
