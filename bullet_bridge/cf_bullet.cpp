@@ -327,6 +327,13 @@ cfb_world *cfb_world_create(const double gravity[3])
     // Motion states show the state at the end of the last sub-step, not one
     // sub-step behind.
     w->dyn->setLatencyMotionStateInterpolation(false);
+    // Restitution needs a contact point to appear when the bodies touch:
+    // Bullet creates one up to gContactBreakingThreshold x the shape's
+    // size ahead (2% by default), and the solver's speculative treatment of
+    // that gap eats the restitution over the sub-steps of the approach.
+    // 0.1% keeps the gap below one sub-step's travel at impact speeds.
+    gContactBreakingThreshold = 1e-3;
+    w->dyn->getSolverInfo().m_restingContactRestitutionThreshold = 1 << 30;
     w->dyn->setInternalTickCallback(pre_tick, w, true);
     w->dyn->setInternalTickCallback(post_tick, w, false);
     w->n_dynamic = 0;

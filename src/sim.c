@@ -651,7 +651,8 @@ static cf_status diverged(const cf_sim *sim, cf_error *err, const char *what)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     const char *fix = set->constraints == CF_CONSTRAINTS_NONE
-                          ? "lower solver.dt_fracture below dt_cfl, or use solver.constraints = "
+                          ? "lower solver.dt_fracture (or solver.cfl_fraction) below dt_cfl, or use "
+                            "solver.constraints = "
                             "\"pbd\""
                           : "lower solver.dt_fracture, or raise solver.pbd.iterations / "
                             "solver.pbd.k_stiffness";
