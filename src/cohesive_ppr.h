@@ -35,8 +35,10 @@ void cf_ppr_traction(const cf_ppr *p, double dn, double dt, double *dn_max, doub
  * A the current mid-surface area, normal from side A to side B.
  * Compression (Delta_n < 0, faces still facing each other, failed or not) is
  * a penalty T_n = K_p Delta_n with K_p = kp Pa/m, capped per node pair so
- * that the pair is stable at step dt: K_p A/3 <= 1/(dt^2 (1/m_a + 1/m_b)),
- * a quarter of the two-mass limit (DESIGN §3.5); kp = 0 means the cap.
+ * that the pair is stable at step dt: K_p A/3 <= 1/(4 dt^2 (1/m_a + 1/m_b)),
+ * a sixteenth of the two-mass limit, as a node pair may sit in ~8 elements
+ * (DESIGN §3.5); kp = 0 means the cap.  The tangential traction rises from
+ * zero with the same capped stiffness (time continuity).
  * Each pair's absorbed work and stored energy are updated (cf_cohesive).
  * Returns the number of node pairs in complete failure. */
 int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n, double dt,

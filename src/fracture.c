@@ -98,18 +98,25 @@ static double contact_velocities(cf_sim *sim, cf_fragment *f, double t)
 }
 
 /* The prescribed velocity components of boundary node a: into v (m/s), or
- * into the prediction p = x + dt v when `on_p` is set. */
-static void impose_boundary(cf_sim *sim, int a, double dt, int on_p)
+ * into the prediction p = x + dt v when `on_p` is set.  Returns the work of
+ * the reaction that restores p (J): the impulse m dp/dt times the node's
+ * prescribed velocity. */
+static double impose_boundary(cf_sim *sim, int a, double dt, int on_p)
 {
     cf_solid *s = &sim->solid;
     const cf_boundary *bc = &sim->scene->boundaries[s->bc[a]];
+    double work = 0;
     for (int k = 0; k < 3; k++)
         if (bc->axes & (1 << k)) {
-            if (on_p)
-                s->p[3 * a + k] = s->x[3 * a + k] + dt * bc->velocity[k];
-            else
+            if (on_p) {
+                double target = s->x[3 * a + k] + dt * bc->velocity[k];
+                work += s->m[a] * (target - s->p[3 * a + k]) / dt * bc->velocity[k];
+                s->p[3 * a + k] = target;
+            } else {
                 s->v[3 * a + k] = bc->velocity[k];
+            }
         }
+    return work;
 }
 
 /* f = f_ext - f_int + f_coh at x_n; strain energy and inverted tets. */
@@ -237,10 +244,11 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
         }
         for (int i = 0; i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
-                impose_boundary(sim, nodes[i], dt, 1);
+                sim->flow.boundary += impose_boundary(sim, nodes[i], dt, 1);
     }
-    /* v <- (p - x)/dt ; x <- p.  Energy the projection removed: kinetic
-     * 1/2 m (v_pred^2 - v^2) plus, to first order, the potential f . (p - pred). */
+    /* v <- (p - x)/dt ; x <- p.  The projection's energy is measured as the
+     * kinetic energy it removes, 1/2 m (v_pred^2 - v^2); the strain energy it
+     * changes shows in the ledger's residual. */
     double removed = 0;
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
@@ -249,7 +257,6 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
             vnew[c] = (s->p[3 * a + c] - s->x[3 * a + c]) / dt;
         removed += 0.5 * s->m[a] * (v3_dot(va, va) - v3_dot(vnew, vnew));
         for (int c = 0; c < 3; c++) {
-            removed += s->f[3 * a + c] * dt * (vnew[c] - va[c]);
             va[c] = vnew[c];
             s->x[3 * a + c] = s->p[3 * a + c];
         }

@@ -82,7 +82,7 @@
  *             iteration_independent [false]: use k' = 1 - (1-k)^(1/iterations) }
  *     xpbd = { compliance_scale [1] }: bar compliance = scale L^2/(E V_trib)
  *     contact_stiffness [0] Pa/m: crack-face penalty K_p; 0 = the stability
- *       cap 2 m/(A dt^2)/4 of each node pair
+ *       cap of each node pair, K_p A/3 = 1/(4 dt^2 (1/m_a + 1/m_b))
  *     guard = { max_inverted_fraction [0.01], max_energy_growth [0.5] }:
  *       stop (exit 3) when more than this fraction of a fragment's tets are
  *       inverted, or when the total energy exceeds the initial energy plus
