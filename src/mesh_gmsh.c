@@ -12,6 +12,7 @@
  * Error positions are "file:line" in ASCII files and "file: byte N" in
  * binary ones (where a line number means nothing).
  */
+#include "file_text.h"
 #include "cohfrac/mesh.h"
 
 #include <ctype.h>
@@ -795,48 +796,12 @@ static void msh_free(msh *f)
     free(f->names);
 }
 
-/* Whole file into memory, NUL-terminated.  NULL on failure (errno set). */
-static char *read_all(const char *path, size_t *len)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return NULL;
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        if (n + 1 >= cap) {
-            char *nb = cap <= SIZE_MAX / 2 ? realloc(buf, cap * 2) : NULL;
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                errno = ENOMEM;
-                break;
-            }
-            buf = nb, cap *= 2;
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, fp);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    if (buf && ferror(fp)) {
-        free(buf);
-        buf = NULL;
-        errno = EIO;
-    }
-    fclose(fp);
-    if (buf) {
-        buf[n] = '\0';
-        *len = n;
-    }
-    return buf;
-}
 
 cf_status cf_mesh_load_gmsh(const char *path, cf_mesh *m, cf_error *err)
 {
     memset(m, 0, sizeof *m);
     size_t len = 0;
-    char *buf = read_all(path, &len);
+    char *buf = cf_file_read(path, &len);
     if (!buf)
         return cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
                             "%s: cannot read (%s); give the path of a Gmsh .msh file", path,

@@ -26,6 +26,7 @@
  */
 #define _XOPEN_SOURCE 700 /* POSIX 2008 + realpath */
 
+#include "file_text.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/surface.h"
 
@@ -168,21 +169,6 @@ static int cache_valid(const cf_mesh_prep_opts *o, const char *key)
 
 /* ---- running tetgen ---------------------------------------------------- */
 
-/* Last `max` bytes of a log file, for error messages. */
-static void log_tail(const char *path, char *out, size_t max)
-{
-    out[0] = '\0';
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    long from = n > (long)max - 1 ? n - (long)max + 1 : 0;
-    fseek(f, from, SEEK_SET);
-    size_t got = fread(out, 1, max - 1, f);
-    out[got] = '\0';
-    fclose(f);
-}
 
 /* Run `tetgen -<opts> <dir>/surf.off`, output to <dir>/surf.1.*; load it. */
 static cf_status run_tetgen(const char *dir, const char *opts, cf_mesh *m, double *secs,
@@ -219,7 +205,7 @@ static cf_status run_tetgen(const char *dir, const char *opts, cf_mesh *m, doubl
     *secs = now_s() - t0;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         char tail[600];
-        log_tail(logp, tail, sizeof tail);
+        cf_file_log_tail(logp, tail, sizeof tail);
         if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
             return cf_error_set(err, CF_ERR_EXTERNAL,
                                 "'%s' not found: install TetGen (apt install tetgen) or set "

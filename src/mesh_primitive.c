@@ -18,6 +18,7 @@
  * hash of the script (which prints every parameter), so any change of a
  * parameter or of the script gives a new file.  The .geo is kept beside it.
  */
+#include "file_text.h"
 #include "cohfrac/mesh.h"
 
 #include <errno.h>
@@ -255,24 +256,6 @@ static cf_status write_text(const char *path, const char *text, cf_error *err)
     return CF_OK;
 }
 
-/* The last lines of a log (at most max-1 bytes, from a line start). */
-static void log_tail(const char *path, char *out, size_t max)
-{
-    out[0] = '\0';
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    long from = n > (long)max - 1 ? n - (long)max + 1 : 0;
-    fseek(f, from, SEEK_SET);
-    size_t got = fread(out, 1, max - 1, f);
-    out[got] = '\0';
-    fclose(f);
-    char *nl = from > 0 ? strchr(out, '\n') : NULL;
-    if (nl)
-        memmove(out, nl + 1, strlen(nl + 1) + 1);
-}
 
 /* Run `<gmsh> -3 -format msh41 -o <msh> <geo>`, output into `logp`. */
 static cf_status run_gmsh(const char *geo, const char *msh, const char *logp, cf_error *err)
@@ -309,7 +292,7 @@ static cf_status run_gmsh(const char *geo, const char *msh, const char *logp, cf
     struct stat st;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || stat(msh, &st) != 0) {
         char tail[500];
-        log_tail(logp, tail, sizeof tail);
+        cf_file_log_tail(logp, tail, sizeof tail);
         return cf_error_set(err, CF_ERR_EXTERNAL, "'%s' failed (%s %d); its output ends:\n%s",
                             cmd, WIFEXITED(status) ? "exit status" : "signal",
                             WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), tail);

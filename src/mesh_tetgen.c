@@ -1,4 +1,5 @@
 /* cohfrac — TetGen .node/.ele reader and writer, Tet4 volume checks. */
+#include "file_text.h"
 #include "cohfrac/mesh.h"
 
 #include <ctype.h>
@@ -11,43 +12,6 @@
 
 /* ---- small text helpers ------------------------------------------------ */
 
-/* Whole file into a NUL-terminated buffer.  NULL on failure (errno set). */
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        if (n + 1 >= cap) {
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                errno = ENOMEM;
-                break;
-            }
-            buf = nb, cap *= 2;
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    if (buf && ferror(f)) {
-        free(buf);
-        buf = NULL;
-        errno = EIO;
-    }
-    fclose(f);
-    if (buf) {
-        buf[n] = '\0';
-        if (len)
-            *len = n;
-    }
-    return buf;
-}
 
 /* Iterates over the meaningful lines of a TetGen file: comments (from '#')
  * and blank lines are skipped; `line` is the 1-based line number. */
@@ -263,7 +227,7 @@ cf_status cf_mesh_load_tetgen_unchecked(const char *base, cf_mesh *m, cf_error *
     int first = 0;
     for (int pass = 0; pass < 2 && st == CF_OK; pass++) {
         snprintf(path, bl + 6, "%s%s", b, pass == 0 ? ".node" : ".ele");
-        char *text = slurp(path, NULL);
+        char *text = cf_file_read(path, NULL);
         if (!text) {
             st = cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
                               "%s: cannot read (%s); give the mesh as the base name of a "

@@ -1,6 +1,7 @@
 /* cohfrac — closed triangle surfaces: OBJ/OFF/STL input, OFF output,
  * enclosed volume, closedness, self-intersection search, the valence-3
  * repair of DESIGN §9 and quadric-error decimation. */
+#include "file_text.h"
 #include "cohfrac/surface.h"
 
 #include <ctype.h>
@@ -50,42 +51,6 @@ static int ibuf_push(ibuf *b, int v)
     return 0;
 }
 
-/* Whole file into a NUL-terminated buffer; NULL with errno on failure. */
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 1 << 16, n = 0;
-    unsigned char *buf = malloc(cap);
-    while (buf) {
-        if (n + 1 >= cap) {
-            unsigned char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                errno = ENOMEM;
-                break;
-            }
-            buf = nb, cap *= 2;
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    if (buf && ferror(f)) {
-        free(buf);
-        buf = NULL;
-        errno = EIO;
-    }
-    fclose(f);
-    if (buf) {
-        buf[n] = '\0';
-        *len = n;
-    }
-    return buf;
-}
 
 /* Cut the next line out of *p (NUL-terminating it in place). */
 static char *take_line(char **p, int *line)
@@ -506,7 +471,7 @@ cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err)
         return cf_error_set(err, CF_ERR_FILE_OPEN,
                             "%s: unknown surface format; use a .obj, .off or .stl file", path);
     size_t len;
-    unsigned char *buf = slurp(path, &len);
+    unsigned char *buf = (unsigned char *)cf_file_read(path, &len);
     if (!buf)
         return cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
                             "%s: cannot read (%s)", path, strerror(errno));
