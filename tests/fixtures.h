@@ -1,12 +1,41 @@
-/* Meshes built in the tests: structured boxes and the two-tet pair. */
+/* Shared test fixtures: structured boxes and the two-tet pair, reading a
+ * file whole, removing a temporary directory tree. */
 #ifndef COHFRAC_TEST_FIXTURES_H
 #define COHFRAC_TEST_FIXTURES_H
 
 #include "cohfrac/mesh.h"
 
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* rm -r: a test's own temporary directory tree (links are not followed). */
+static inline void fixture_remove_tree(const char *path)
+{
+    struct stat sb;
+    if (lstat(path, &sb) != 0)
+        return;
+    if (!S_ISDIR(sb.st_mode)) {
+        unlink(path);
+        return;
+    }
+    DIR *d = opendir(path);
+    if (d) {
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+                continue;
+            char child[1024];
+            if (snprintf(child, sizeof child, "%s/%s", path, e->d_name) < (int)sizeof child)
+                fixture_remove_tree(child);
+        }
+        closedir(d);
+    }
+    rmdir(path);
+}
 
 /* The whole file as a NUL-terminated string (malloc'd), or NULL. */
 static inline char *fixture_read_file(const char *path)

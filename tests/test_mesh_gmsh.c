@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "fixtures.h"
 #include "cohfrac/mesh.h"
 
 #define DATA COHFRAC_SOURCE_DIR "/tests/data/gmsh/"
@@ -37,18 +38,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    DIR *d = opendir(tmpdir);
-    if (d) {
-        struct dirent *e;
-        char p[512];
-        while ((e = readdir(d)))
-            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-                snprintf(p, sizeof p, "%s/%s", tmpdir, e->d_name);
-                remove(p);
-            }
-        closedir(d);
-    }
-    rmdir(tmpdir);
+    fixture_remove_tree(tmpdir);
     return 0;
 }
 

@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "fixtures.h"
 #include "cohfrac/mesh.h"
 
 static char cache[512]; /* a fresh cache directory under the build tree */
@@ -31,28 +32,10 @@ static int setup(void **state)
     return mkdtemp(cache) ? 0 : -1;
 }
 
-/* rm -r of our own temporary directory (two levels at most). */
-static void remove_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        char p[1024];
-        while ((e = readdir(d)))
-            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-                snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-                if (remove(p) != 0)
-                    remove_dir(p);
-            }
-        closedir(d);
-    }
-    rmdir(dir);
-}
-
 static int teardown(void **state)
 {
     (void)state;
-    remove_dir(cache);
+    fixture_remove_tree(cache);
     return 0;
 }
 
