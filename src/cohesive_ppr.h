@@ -24,9 +24,10 @@ void cf_ppr_init(cf_ppr *p, const cf_material *m);
  * tangential opening dt >= 0. */
 void cf_ppr_envelope(const cf_ppr *p, double dn, double dt, double *Tn, double *Tt);
 
-/* Traction with history for one node pair.  dn may be negative (contact:
- * Tn = -k_contact... given as kp_dn = penalty traction for dn < 0).
- * Updates *dn_max, *dt_max, *failed. */
+/* Traction with history for one node pair (Pa): on the envelope at the
+ * largest openings so far, else on the secant to the origin; zero after
+ * complete failure.  A negative dn counts as zero opening (the caller adds
+ * the compression penalty).  Updates *dn_max, *dt_max, *failed. */
 void cf_ppr_traction(const cf_ppr *p, double dn, double dt, double *dn_max, double *dt_max,
                      unsigned char *failed, double *Tn, double *Tt);
 

@@ -183,13 +183,11 @@ static void update_velocities(cf_sim *sim, cf_fragment *f, double dt, int fractu
     }
     sim->flow.boundary += w_bc;
     if (!fracture) {
-        double before = 0, after = 0;
-        for (int i = 0; i < nn; i++)
-            before += 0.5 * s->m[nodes[i]] * v3_dot(&s->v[3 * nodes[i]], &s->v[3 * nodes[i]]);
+        cf_node_state before, after;
+        cf_nodes_momenta(s, nodes, nn, &before);
         cf_global_damping(s, nodes, nn, sim->scene->solver.k_damping);
-        for (int i = 0; i < nn; i++)
-            after += 0.5 * s->m[nodes[i]] * v3_dot(&s->v[3 * nodes[i]], &s->v[3 * nodes[i]]);
-        sim->flow.damping += before - after;
+        cf_nodes_momenta(s, nodes, nn, &after);
+        sim->flow.damping += before.ke - after.ke;
     }
     double ke = 0, mx[3] = {0, 0, 0};
     for (int i = 0; i < nn; i++) {

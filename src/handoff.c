@@ -101,14 +101,12 @@ void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[
 void cf_fragment_ledger_reset(cf_sim *sim, int fi)
 {
     cf_fragment *f = &sim->frag[fi];
-    const cf_solid *s = &sim->solid;
-    f->e_kin = f->e_strain = 0;
-    f->mx[0] = f->mx[1] = f->mx[2] = 0;
-    for (int i = 0; i < f->nodes.n; i++) {
-        int a = f->nodes.v[i];
-        f->e_kin += 0.5 * s->m[a] * v3_dot(&s->v[3 * a], &s->v[3 * a]);
-        v3_axpy(s->m[a], &s->x[3 * a], f->mx);
-    }
+    cf_node_state ns;
+    cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
+    f->e_kin = ns.ke;
+    f->e_strain = 0;
+    for (int k = 0; k < 3; k++)
+        f->mx[k] = ns.M * ns.com[k];
 }
 
 static int count_dead(const cf_sim *sim)

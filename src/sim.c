@@ -706,8 +706,6 @@ static cf_status check_energy(cf_sim *sim, cf_error *err)
     cf_sim_ledger(sim, &l);
     double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated;
     double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary);
-    if (have > sim->e_peak)
-        sim->e_peak = have;
     if (have <= (1 + sim->scene->solver.max_energy_growth) * input + 1e-12)
         return CF_OK;
     char what[200];

@@ -78,7 +78,6 @@ struct cf_sim {
     cf_energy_flows flow;
     double e0;               /* J, initial kinetic + strain energy */
     double mx0[3];           /* kg m, initial sum m x */
-    double e_peak;           /* J, largest kinetic + strain + cohesive energy so far */
     int n_handoffs;
     double max_momentum_error, total_handoff_loss;
     double wall_start;
