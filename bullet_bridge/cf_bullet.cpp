@@ -50,6 +50,12 @@ struct Body {
     bool has_quat;
     double quat[4];
     btMatrix3x3 quat_basis;
+    // Owned by the body besides `shape`: the children of a compound shape,
+    // and the arrays of a triangle mesh (Bullet keeps pointers into them).
+    std::vector<btCollisionShape *> children;
+    btTriangleIndexVertexArray *mesh;
+    std::vector<btScalar> mesh_verts;
+    std::vector<int> mesh_tris;
 };
 
 // Exposes the fixed-step accumulator so each cfb_step runs a whole number of
@@ -65,7 +71,10 @@ public:
 };
 
 // Bodies of one collision family (user index 2, -1 = none) never collide
-// with each other.  Checked for every overlapping pair before narrow phase.
+// with each other.  Checked for every overlapping pair before narrow phase,
+// and by the CCD sweep (Bullet 3.24's btClosestNotMeConvexResultCallback asks
+// the dispatcher's needsCollision), so CCD does not stop a body at a member
+// of its family or an ignored partner either.
 class FamilyDispatcher : public btCollisionDispatcher {
 public:
     explicit FamilyDispatcher(btCollisionConfiguration *c) : btCollisionDispatcher(c) {}
@@ -89,6 +98,8 @@ struct cfb_world {
     std::vector<Body *> kinematic;
     int n_dynamic;
     int ticks;  // sub-steps run by the current cfb_step
+    // Sleeping thresholds (m/s, rad/s) for dynamic bodies; 0, 0 = never.
+    double sleep_linear, sleep_angular;
 };
 
 namespace {
@@ -157,6 +168,29 @@ bool friction_valid(double friction, double restitution)
     return true;
 }
 
+// Sleeping is off by default so that runs are reproducible and contact
+// impulses are reported every step (DISABLE_DEACTIVATION).  With thresholds
+// set (cfb_set_sleeping) dynamic bodies go to ACTIVE_TAG and Bullet puts an
+// island to sleep once all its bodies have been slow for gDeactivationTime
+// (2 s).  Kinematic bodies always stay awake: an awake kinematic body is what
+// wakes the sleeping bodies it touches.
+void apply_sleeping(const cfb_world *w, Body *b)
+{
+    if (b->kind == BODY_STATIC) return;
+    btRigidBody *rb = b->rb;
+    if (b->kind == BODY_DYNAMIC && w->sleep_linear > 0.0) {
+        rb->setSleepingThresholds(w->sleep_linear, w->sleep_angular);
+        // setActivationState cannot leave DISABLE_DEACTIVATION; a body that
+        // is already ACTIVE_TAG or asleep keeps its state.
+        if (rb->getActivationState() == DISABLE_DEACTIVATION) {
+            rb->forceActivationState(ACTIVE_TAG);
+            rb->setDeactivationTime(0);
+        }
+    } else {
+        rb->forceActivationState(DISABLE_DEACTIVATION);  // also wakes a sleeper
+    }
+}
+
 // Takes ownership of shape; registers the body and returns its id.
 int add_body(cfb_world *w, btCollisionShape *shape, double mass, const btVector3 &inertia,
              const btTransform &xf, BodyKind kind, const btVector3 &kin_v, double friction,
@@ -193,10 +227,8 @@ int add_body(cfb_world *w, btCollisionShape *shape, double mass, const btVector3
                                  btCollisionObject::CF_KINEMATIC_OBJECT);
         b->rb->setLinearVelocity(kin_v);
     }
-    // Sleeping is off so that runs are reproducible and contact impulses are
-    // reported every step.  To enable it later, leave dynamic bodies at
-    // ACTIVE_TAG and set sleeping thresholds (kinematic ones must stay awake).
-    if (kind != BODY_STATIC) b->rb->setActivationState(DISABLE_DEACTIVATION);
+    b->mesh = NULL;
+    apply_sleeping(w, b);
 
     w->bodies.push_back(b);
     if (kind == BODY_KINEMATIC) w->kinematic.push_back(b);
@@ -299,9 +331,129 @@ void destroy_body(cfb_world *w, Body *b)
     w->dyn->removeRigidBody(b->rb);
     delete b->rb;
     delete b->motion;
-    delete b->shape;
+    delete b->shape;  // before its children and its mesh
+    for (size_t i = 0; i < b->children.size(); ++i) delete b->children[i];
+    delete b->mesh;
     delete b;
 }
+
+bool mass_props_valid(double mass, const double inertia[3])
+{
+    if (!std::isfinite(mass) || !(mass > 0.0)) {
+        set_error("mass must be finite and > 0 (got %g)", mass);
+        return false;
+    }
+    if (!inertia || !finite3(inertia) || !(inertia[0] > 0.0) || !(inertia[1] > 0.0) ||
+        !(inertia[2] > 0.0)) {
+        set_error("principal moments must be finite and > 0");
+        return false;
+    }
+    return true;
+}
+
+// Hull vertices of pts[0..n) as the caller's own points: btConvexHullComputer
+// works on integer coordinates, and its `vertices` are those rounded back to
+// doubles (off by ~1e-9 of the extent unless the input happens to be on its
+// grid); original_vertex_index names the input point each one came from.
+void hull_vertices(const btConvexHullComputer &hull, const double *pts, int n,
+                   btAlignedObjectArray<btVector3> &out)
+{
+    const int nv = hull.vertices.size();
+    out.resize(nv);
+    for (int i = 0; i < nv; ++i) {
+        const int k = i < hull.original_vertex_index.size() ? hull.original_vertex_index[i] : -1;
+        out[i] = (k >= 0 && k < n) ? btVector3(pts[3 * k], pts[3 * k + 1], pts[3 * k + 2])
+                                   : hull.vertices[i];
+    }
+}
+
+// Convex hull shape over the hull vertices of pts[0..n) (support queries are
+// linear in the vertex count, and fragments may come with thousands of
+// surface nodes).  NULL, with *nv set, when the hull has under 4 vertices.
+btConvexHullShape *hull_shape(const double *pts, int n, double margin, int *nv)
+{
+    btConvexHullComputer hull;
+    hull.compute(pts, 3 * static_cast<int>(sizeof(double)), n, 0, 0);
+    *nv = hull.vertices.size();
+    if (*nv < 4) return NULL;
+    btAlignedObjectArray<btVector3> v;
+    hull_vertices(hull, pts, n, v);
+    btConvexHullShape *shape = new btConvexHullShape(&v[0][0], *nv, sizeof(btVector3));
+    shape->setMargin(margin);
+    shape->recalcLocalAabb();  // the cached box was built with the default margin
+    return shape;
+}
+
+// Registers a dynamic body of the given shape (owned) at state s.
+int add_dynamic(cfb_world *w, btCollisionShape *shape, double mass, const double inertia[3],
+                const cfb_state *s, double friction, double restitution)
+{
+    double q[4];
+    unit_quat(s->quat, q);
+    const btTransform xf = state_transform(q, s->pos);
+    // The body frame is the principal frame, so the given moments are the
+    // local inertia (not Bullet's estimate from the shape's bounding box).
+    const int id = add_body(w, shape, mass, btVector3(inertia[0], inertia[1], inertia[2]), xf,
+                            BODY_DYNAMIC, btVector3(0, 0, 0), friction, restitution);
+    if (id < 0) return -1;
+    Body *b = w->bodies[id];
+    b->rb->setLinearVelocity(btVector3(s->v[0], s->v[1], s->v[2]));
+    b->rb->setAngularVelocity(btVector3(s->w[0], s->w[1], s->w[2]));
+    b->rb->setInterpolationLinearVelocity(b->rb->getLinearVelocity());
+    b->rb->setInterpolationAngularVelocity(b->rb->getAngularVelocity());
+    remember_quat(b, q);
+    return id;
+}
+
+// Smallest world box around a shape, margin included: convex shapes from
+// their support points along the world axes (hull vertices + margin, exact
+// under rotation, where Bullet's own getAabb rotates a cached local box),
+// compounds from their children, others (plane, triangle mesh) from Bullet.
+void shape_aabb(const btCollisionShape *shape, const btTransform &xf, btVector3 &lo,
+                btVector3 &hi)
+{
+    if (shape->isCompound()) {
+        const btCompoundShape *c = static_cast<const btCompoundShape *>(shape);
+        lo.setValue(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
+        hi.setValue(-BT_LARGE_FLOAT, -BT_LARGE_FLOAT, -BT_LARGE_FLOAT);
+        for (int i = 0; i < c->getNumChildShapes(); ++i) {
+            btVector3 clo, chi;
+            shape_aabb(c->getChildShape(i), xf * c->getChildTransform(i), clo, chi);
+            lo.setMin(clo);
+            hi.setMax(chi);
+        }
+        return;
+    }
+    if (shape->isConvex()) {
+        const btConvexShape *cs = static_cast<const btConvexShape *>(shape);
+        const btScalar m = cs->getMargin();
+        const btMatrix3x3 &R = xf.getBasis();
+        double l[3], h[3];
+        for (int i = 0; i < 3; ++i) {
+            // Local direction R^T e_i is row i of R.
+            const btVector3 up = xf(cs->localGetSupportingVertexWithoutMargin(R.getRow(i)));
+            const btVector3 dn = xf(cs->localGetSupportingVertexWithoutMargin(-R.getRow(i)));
+            h[i] = up[i] + m;
+            l[i] = dn[i] - m;
+        }
+        lo.setValue(l[0], l[1], l[2]);
+        hi.setValue(h[0], h[1], h[2]);
+        return;
+    }
+    shape->getAabb(xf, lo, hi);
+}
+
+// Collects the deepest contact of a contactPairTest.
+struct DepthCallback : public btCollisionWorld::ContactResultCallback {
+    double min_distance;
+    DepthCallback() : min_distance(0.0) {}
+    btScalar addSingleResult(btManifoldPoint &cp, const btCollisionObjectWrapper *,
+                             int, int, const btCollisionObjectWrapper *, int, int) override
+    {
+        if (cp.getDistance() < min_distance) min_distance = cp.getDistance();
+        return 0;
+    }
+};
 
 }  // namespace
 
@@ -334,10 +486,16 @@ cfb_world *cfb_world_create(const double gravity[3])
     // 0.1% keeps the gap below one sub-step's travel at impact speeds.
     gContactBreakingThreshold = 1e-3;
     w->dyn->getSolverInfo().m_restingContactRestitutionThreshold = 1 << 30;
+    // CCD (cfb_set_ccd) ignores a time of impact unless the sub-step's
+    // motion along the contact normal exceeds this (4 cm by default): a 1 cm
+    // fragment moving 4 cm per sub-step would tunnel through a thin wall.
+    w->dyn->getDispatchInfo().m_allowedCcdPenetration = 0;
     w->dyn->setInternalTickCallback(pre_tick, w, true);
     w->dyn->setInternalTickCallback(post_tick, w, false);
     w->n_dynamic = 0;
     w->ticks = 0;
+    w->sleep_linear = 0.0;
+    w->sleep_angular = 0.0;
     return w;
 }
 
@@ -407,15 +565,7 @@ int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const 
         set_error("world is NULL");
         return -1;
     }
-    if (!std::isfinite(mass) || !(mass > 0.0)) {
-        set_error("mass must be finite and > 0 (got %g)", mass);
-        return -1;
-    }
-    if (!inertia || !finite3(inertia) || !(inertia[0] > 0.0) || !(inertia[1] > 0.0) ||
-        !(inertia[2] > 0.0)) {
-        set_error("principal moments must be finite and > 0");
-        return -1;
-    }
+    if (!mass_props_valid(mass, inertia)) return -1;
     if (!pts || n < 4) {
         set_error("a hull needs at least 4 points (got %d)", pts ? n : 0);
         return -1;
@@ -432,34 +582,335 @@ int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const 
     }
     if (!state_valid(s) || !friction_valid(friction, restitution)) return -1;
 
-    // Keep only the hull vertices: support queries are linear in the vertex
-    // count, and fragments may come with thousands of surface nodes.
-    btConvexHullComputer hull;
-    hull.compute(pts, 3 * static_cast<int>(sizeof(double)), n, 0, 0);
-    const int nv = hull.vertices.size();
-    if (nv < 4) {
+    int nv = 0;
+    btConvexHullShape *shape = hull_shape(pts, n, margin, &nv);
+    if (!shape) {
         set_error("hull points are degenerate (%d hull vertices)", nv);
         return -1;
     }
-    btConvexHullShape *shape = new btConvexHullShape(&hull.vertices[0][0], nv, sizeof(btVector3));
-    shape->setMargin(margin);
-    shape->recalcLocalAabb();  // the cached box was built with the default margin
+    return add_dynamic(w, shape, mass, inertia, s, friction, restitution);
+}
 
-    double q[4];
-    unit_quat(s->quat, q);
-    const btTransform xf = state_transform(q, s->pos);
-    // The body frame is the principal frame, so the given moments are the
-    // local inertia (not Bullet's estimate from the hull's bounding box).
-    const int id = add_body(w, shape, mass, btVector3(inertia[0], inertia[1], inertia[2]), xf,
-                            BODY_DYNAMIC, btVector3(0, 0, 0), friction, restitution);
-    if (id < 0) return -1;
-    Body *b = w->bodies[id];
-    b->rb->setLinearVelocity(btVector3(s->v[0], s->v[1], s->v[2]));
-    b->rb->setAngularVelocity(btVector3(s->w[0], s->w[1], s->w[2]));
-    b->rb->setInterpolationLinearVelocity(b->rb->getLinearVelocity());
-    b->rb->setInterpolationAngularVelocity(b->rb->getAngularVelocity());
-    remember_quat(b, q);
+int cfb_convex_hull(const double *pts, int n, double *out, double *volume)
+{
+    if (!pts || n < 1) {
+        set_error("convex hull needs at least 1 point (got %d)", pts ? n : 0);
+        return -1;
+    }
+    for (int i = 0; i < n; ++i) {
+        if (!finite3(pts + 3 * i)) {
+            set_error("hull point %d is non-finite", i);
+            return -1;
+        }
+    }
+    btConvexHullComputer hull;
+    hull.compute(pts, 3 * static_cast<int>(sizeof(double)), n, 0, 0);
+    const int nv = hull.vertices.size();
+    btAlignedObjectArray<btVector3> v;
+    hull_vertices(hull, pts, n, v);
+    if (out)
+        for (int i = 0; i < nv; ++i)
+            for (int c = 0; c < 3; ++c) out[3 * i + c] = v[i][c];
+    if (volume) {
+        // Divergence theorem: V = 1/6 sum over faces of fan triangles
+        // (a - o) . ((b - o) x (c - o)), o the first vertex (less round-off
+        // than the origin).
+        double six_v = 0.0;
+        if (nv >= 4) {
+            const btVector3 &o = v[0];
+            for (int f = 0; f < hull.faces.size(); ++f) {
+                const btConvexHullComputer::Edge *e0 = &hull.edges[hull.faces[f]];
+                const btVector3 a = v[e0->getSourceVertex()] - o;
+                const btConvexHullComputer::Edge *e = e0->getNextEdgeOfFace();
+                btVector3 b = v[e->getSourceVertex()] - o;
+                for (e = e->getNextEdgeOfFace(); e != e0; e = e->getNextEdgeOfFace()) {
+                    const btVector3 c = v[e->getSourceVertex()] - o;
+                    six_v += a.dot(b.cross(c));
+                    b = c;
+                }
+            }
+        }
+        // A flat hull (both sides of one polygon) sums to round-off.
+        btVector3 lo = nv > 0 ? v[0] : btVector3(0, 0, 0), hi = lo;
+        for (int i = 1; i < nv; ++i) {
+            lo.setMin(v[i]);
+            hi.setMax(v[i]);
+        }
+        const double L = (hi - lo).length();
+        const double vol = std::fabs(six_v) / 6.0;
+        *volume = vol <= 1e-12 * L * L * L ? 0.0 : vol;
+    }
+    return nv;
+}
+
+int cfb_add_compound_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
+                          const int *start, int n_hulls, double margin, const cfb_state *s,
+                          double friction, double restitution)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return -1;
+    }
+    if (!mass_props_valid(mass, inertia)) return -1;
+    if (!pts || !start || n_hulls < 1) {
+        set_error("compound needs points, hull starts and at least 1 hull (got %d)", n_hulls);
+        return -1;
+    }
+    if (start[0] != 0) {
+        set_error("hull starts must begin at 0 (got %d)", start[0]);
+        return -1;
+    }
+    for (int h = 0; h < n_hulls; ++h) {
+        if (start[h + 1] - start[h] < 4) {
+            set_error("hull %d needs at least 4 points (got %d)", h, start[h + 1] - start[h]);
+            return -1;
+        }
+    }
+    for (int i = 0; i < start[n_hulls]; ++i) {
+        if (!finite3(pts + 3 * i)) {
+            set_error("hull point %d is non-finite", i);
+            return -1;
+        }
+    }
+    if (!std::isfinite(margin) || margin < 0.0) {
+        set_error("margin must be finite and >= 0");
+        return -1;
+    }
+    if (!state_valid(s) || !friction_valid(friction, restitution)) return -1;
+
+    std::vector<btCollisionShape *> children;
+    for (int h = 0; h < n_hulls; ++h) {
+        int nv = 0;
+        btConvexHullShape *c =
+            hull_shape(pts + 3 * start[h], start[h + 1] - start[h], margin, &nv);
+        if (!c) {
+            for (size_t i = 0; i < children.size(); ++i) delete children[i];
+            set_error("hull %d is degenerate (%d hull vertices)", h, nv);
+            return -1;
+        }
+        children.push_back(c);
+    }
+    if (n_hulls == 1) return add_dynamic(w, children[0], mass, inertia, s, friction, restitution);
+
+    // The points are already in the principal frame: identity child
+    // transforms.  The compound's own margin stays 0 (it only pads its box).
+    btCompoundShape *compound = new btCompoundShape(true, n_hulls);
+    btTransform id_xf;
+    id_xf.setIdentity();
+    for (int h = 0; h < n_hulls; ++h) compound->addChildShape(id_xf, children[h]);
+    const int id = add_dynamic(w, compound, mass, inertia, s, friction, restitution);
+    if (id < 0) {
+        for (size_t i = 0; i < children.size(); ++i) delete children[i];
+        return -1;
+    }
+    w->bodies[id]->children.swap(children);
     return id;
+}
+
+int cfb_add_trimesh(cfb_world *w, const double *verts, int nv, const int *tris, int nt,
+                    double friction, double restitution)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return -1;
+    }
+    if (!verts || nv < 3 || !tris || nt < 1) {
+        set_error("triangle mesh needs >= 3 vertices and >= 1 triangle (got %d, %d)",
+                  verts ? nv : 0, tris ? nt : 0);
+        return -1;
+    }
+    for (int i = 0; i < nv; ++i) {
+        if (!finite3(verts + 3 * i)) {
+            set_error("mesh vertex %d is non-finite", i);
+            return -1;
+        }
+    }
+    for (int t = 0; t < nt; ++t) {
+        const int *v = tris + 3 * t;
+        for (int k = 0; k < 3; ++k) {
+            if (v[k] < 0 || v[k] >= nv) {
+                set_error("triangle %d: vertex index %d out of range [0, %d)", t, v[k], nv);
+                return -1;
+            }
+        }
+        if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) {
+            set_error("triangle %d repeats a vertex", t);
+            return -1;
+        }
+    }
+    if (!friction_valid(friction, restitution)) return -1;
+
+    // The body owns copies of the arrays: Bullet keeps pointers into them.
+    btTriangleIndexVertexArray *mesh = new btTriangleIndexVertexArray();
+    std::vector<btScalar> vcopy(verts, verts + 3 * static_cast<size_t>(nv));
+    std::vector<int> tcopy(tris, tris + 3 * static_cast<size_t>(nt));
+    btIndexedMesh part;
+    part.m_numTriangles = nt;
+    part.m_triangleIndexBase = reinterpret_cast<const unsigned char *>(&tcopy[0]);
+    part.m_triangleIndexStride = 3 * static_cast<int>(sizeof(int));
+    part.m_numVertices = nv;
+    part.m_vertexBase = reinterpret_cast<const unsigned char *>(&vcopy[0]);
+    part.m_vertexStride = 3 * static_cast<int>(sizeof(btScalar));
+    part.m_indexType = PHY_INTEGER;
+    part.m_vertexType = PHY_DOUBLE;
+    mesh->addIndexedMesh(part, PHY_INTEGER);
+    btBvhTriangleMeshShape *shape = new btBvhTriangleMeshShape(mesh, true, true);
+
+    btTransform xf;
+    xf.setIdentity();
+    const int id = add_body(w, shape, 0.0, btVector3(0, 0, 0), xf, BODY_STATIC,
+                            btVector3(0, 0, 0), friction, restitution);
+    if (id < 0) {
+        delete mesh;
+        return -1;
+    }
+    Body *b = w->bodies[id];
+    b->mesh = mesh;
+    // Swapping moves the buffers without copying: the pointers stay valid.
+    b->mesh_verts.swap(vcopy);
+    b->mesh_tris.swap(tcopy);
+    return id;
+}
+
+int cfb_set_ccd(cfb_world *w, int id, double motion_threshold, double swept_radius)
+{
+    Body *b = lookup(w, id);
+    if (!b) return -1;
+    if (b->kind != BODY_DYNAMIC) {
+        set_error("body %d is not dynamic", id);
+        return -1;
+    }
+    if (!std::isfinite(motion_threshold) || !std::isfinite(swept_radius) ||
+        motion_threshold < 0.0 || swept_radius < 0.0 ||
+        (motion_threshold > 0.0) != (swept_radius > 0.0)) {
+        set_error("CCD threshold and radius must both be > 0, or both 0 (got %g, %g)",
+                  motion_threshold, swept_radius);
+        return -1;
+    }
+    if (motion_threshold > 0.0 && !b->rb->getCollisionShape()->isConvex()) {
+        set_error("body %d is a compound: Bullet's CCD sweeps convex shapes only", id);
+        return -1;
+    }
+    b->rb->setCcdMotionThreshold(motion_threshold);
+    b->rb->setCcdSweptSphereRadius(swept_radius);
+    return 0;
+}
+
+int cfb_set_sleeping(cfb_world *w, double linear, double angular)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return -1;
+    }
+    if (!std::isfinite(linear) || !std::isfinite(angular) || linear < 0.0 || angular < 0.0 ||
+        (linear > 0.0) != (angular > 0.0)) {
+        set_error("sleeping thresholds must both be > 0, or both 0 (got %g, %g)", linear,
+                  angular);
+        return -1;
+    }
+    w->sleep_linear = linear;
+    w->sleep_angular = angular;
+    for (size_t i = 0; i < w->bodies.size(); ++i)
+        if (w->bodies[i]) apply_sleeping(w, w->bodies[i]);
+    return 0;
+}
+
+int cfb_is_sleeping(const cfb_world *w, int id)
+{
+    const Body *b = lookup(w, id);
+    if (!b) return -1;
+    // Bullet marks static bodies ISLAND_SLEEPING; only dynamic ones sleep.
+    if (b->kind != BODY_DYNAMIC) return 0;
+    return b->rb->getActivationState() == ISLAND_SLEEPING ? 1 : 0;
+}
+
+int cfb_apply_impulse(cfb_world *w, int id, const double J[3], const double p[3])
+{
+    Body *b = lookup(w, id);
+    if (!b) return -1;
+    if (b->kind != BODY_DYNAMIC) {
+        set_error("body %d is not dynamic", id);
+        return -1;
+    }
+    if (!J || !p || !finite3(J) || !finite3(p)) {
+        set_error("impulse or point missing or non-finite");
+        return -1;
+    }
+    btRigidBody *rb = b->rb;
+    const btVector3 r = btVector3(p[0], p[1], p[2]) - rb->getCenterOfMassPosition();
+    rb->applyImpulse(btVector3(J[0], J[1], J[2]), r);
+    rb->setInterpolationLinearVelocity(rb->getLinearVelocity());
+    rb->setInterpolationAngularVelocity(rb->getAngularVelocity());
+    rb->activate(true);
+    return 0;
+}
+
+int cfb_get_aabb(const cfb_world *w, int id, double lo[3], double hi[3])
+{
+    const Body *b = lookup(w, id);
+    if (!b) return -1;
+    if (!lo || !hi) {
+        set_error("box output is NULL");
+        return -1;
+    }
+    btVector3 l, h;
+    shape_aabb(b->rb->getCollisionShape(), b->rb->getWorldTransform(), l, h);
+    for (int i = 0; i < 3; ++i) {
+        lo[i] = l[i];
+        hi[i] = h[i];
+    }
+    return 0;
+}
+
+double cfb_pair_penetration(cfb_world *w, int a, int b)
+{
+    Body *ba = lookup(w, a);
+    if (!ba) return -1.0;
+    Body *bb = lookup(w, b);
+    if (!bb) return -1.0;
+    if (a == b) {
+        set_error("penetration of body %d with itself", a);
+        return -1.0;
+    }
+    // contactPairTest goes straight to the pair's collision algorithm: it
+    // asks neither the dispatcher's needsCollision (collision families) nor
+    // checkCollideWith (cfb_ignore_pair), so excluded pairs are measured too.
+    DepthCallback cb;
+    w->dyn->contactPairTest(ba->rb, bb->rb, cb);
+    return cb.min_distance < 0.0 ? -cb.min_distance : 0.0;
+}
+
+void cfb_unignore_pair(cfb_world *w, int a, int b)
+{
+    Body *ba = lookup(w, a);
+    if (!ba) return;
+    Body *bb = lookup(w, b);
+    if (!bb) return;
+    if (a == b) {
+        set_error("cannot unignore a body against itself (%d)", a);
+        return;
+    }
+    bool found = false;
+    for (size_t k = 0; k < ba->ignored.size(); ++k) {
+        if (ba->ignored[k] == b) {
+            ba->ignored.erase(ba->ignored.begin() + static_cast<std::ptrdiff_t>(k));
+            found = true;
+            break;
+        }
+    }
+    if (!found) return;  // not ignored: nothing to undo
+    for (size_t k = 0; k < bb->ignored.size(); ++k) {
+        if (bb->ignored[k] == a) {
+            bb->ignored.erase(bb->ignored.begin() + static_cast<std::ptrdiff_t>(k));
+            break;
+        }
+    }
+    ba->rb->setIgnoreCollisionCheck(bb->rb, false);
+    bb->rb->setIgnoreCollisionCheck(ba->rb, false);
+    // Two sleeping bodies are not tested against each other: wake them so
+    // an overlap shows up at the next step.
+    if (ba->kind == BODY_DYNAMIC) ba->rb->activate(true);
+    if (bb->kind == BODY_DYNAMIC) bb->rb->activate(true);
 }
 
 void cfb_remove_body(cfb_world *w, int id)

@@ -17,6 +17,8 @@ double cf_wall_time(void)
 
 static int ensure_scratch(cf_fragment *f)
 {
+    if (cf_node_impulses_reserve(&f->push, f->nodes.n))
+        return -1;
     if (f->scratch_cap >= f->nodes.n)
         return 0;
     int cap = f->nodes.n + f->nodes.n / 2 + 16;
@@ -69,14 +71,16 @@ static cf_status check_and_insert(cf_sim *sim, cf_fragment *f, int *inserted)
 static double contact_velocities(cf_sim *sim, cf_fragment *f, double t)
 {
     cf_solid *s = &sim->solid;
-    double mu = s->mat.friction, e = s->mat.restitution, removed = 0;
+    double removed = 0;
     for (int i = 0; i < f->nodes.n; i++) {
         int j = f->contact[i];
         if (j < 0)
             continue;
+        double mu = s->mat.friction * sim->obs.o[j].friction;
+        double e = s->mat.restitution * sim->obs.o[j].restitution;
         int a = f->nodes.v[i];
         double n[3], u[3], vr[3], *va = &s->v[3 * a];
-        cf_obstacle_distance(&sim->obs.o[j], t, &s->x[3 * a], n);
+        cf_obstacle_distance(&sim->obs, j, t, &s->x[3 * a], n);
         cf_obstacle_velocity(&sim->obs.o[j], u);
         v3_sub(va, u, vr);
         double vn = v3_dot(vr, n), vt[3];
@@ -90,9 +94,17 @@ static double contact_velocities(cf_sim *sim, cf_fragment *f, double t)
         double vtl = v3_norm(vt);
         double scale = vtl > 0 ? fmax(0.0, 1.0 - mu * dvn / vtl) : 0;
         removed += 0.5 * s->m[a] * v3_dot(va, va);
-        for (int k = 0; k < 3; k++)
-            va[k] = u[k] + vn_new * n[k] + scale * vt[k];
+        double dv[3];
+        for (int k = 0; k < 3; k++) {
+            double vk = u[k] + vn_new * n[k] + scale * vt[k];
+            dv[k] = vk - va[k];
+            va[k] = vk;
+        }
         removed -= 0.5 * s->m[a] * v3_dot(va, va);
+        /* A moving obstacle's work: the impulse it gives times its velocity. */
+        double w = s->m[a] * v3_dot(dv, u);
+        sim->flow.obstacles += w;
+        removed += w;
     }
     return removed;
 }
@@ -220,6 +232,7 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
                                           set->iteration_independent);
     if (set->constraints == CF_CONSTRAINTS_XPBD)
         cf_bars_reset_lambda(&f->bars);
+    double w_obs = 0; /* work of moving obstacles on the nodes */
     for (int it = 0; it < iterations; it++) {
         if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
             cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
@@ -229,7 +242,8 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
         for (int i = 0; i < nn; i++) {
             int a = nodes[i];
-            double n[3];
+            double n[3], before[3];
+            memcpy(before, &s->p[3 * a], sizeof before);
             int hit = cf_obstacles_project(&sim->obs, t_next, &s->p[3 * a], n);
             if (hit >= 0 && f->contact[i] < 0) {
                 double u[3], vr[3];
@@ -237,8 +251,24 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
                 v3_sub(&s->v[3 * a], u, vr);
                 f->vn_pre[i] = v3_dot(vr, n);
             }
-            if (hit >= 0)
+            if (hit >= 0) {
+                double u[3], dp[3];
                 f->contact[i] = hit;
+                cf_obstacle_velocity(&sim->obs.o[hit], u);
+                v3_sub(&s->p[3 * a], before, dp);
+                w_obs += s->m[a] * v3_dot(dp, u) / dt;
+            }
+            if (sim->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
+                double *pa = &s->p[3 * a], before[3], dJ[3];
+                memcpy(before, pa, sizeof before);
+                int h = cf_hull_set_project(&sim->near, &s->x[3 * a], pa);
+                if (h >= 0) {
+                    v3_sub(pa, before, dJ);
+                    for (int c = 0; c < 3; c++)
+                        dJ[c] *= s->m[a] / dt;
+                    cf_node_impulses_add(&f->push, i, sim->near.frag[h], dJ, pa);
+                }
+            }
         }
         for (int i = 0; i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
@@ -259,10 +289,13 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
             s->x[3 * a + c] = s->p[3 * a + c];
         }
     }
+    /* The kinetic change includes what moving obstacles put in: book that as
+     * their work, and the rest as the projection's own removal. */
+    sim->flow.obstacles += w_obs;
     if (bars)
-        sim->flow.pbd += removed;
+        sim->flow.pbd += removed + w_obs;
     else
-        sim->flow.contact += removed;
+        sim->flow.contact += removed + w_obs;
 }
 
 cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
@@ -295,7 +328,7 @@ int cf_pbd_impact(const cf_sim *sim, int fi, double dt)
         }
         for (int j = 0; j < sim->obs.n; j++) {
             double n[3];
-            if (cf_obstacle_distance(&sim->obs.o[j], sim->t + dt, p, n) >= 0)
+            if (cf_obstacle_distance(&sim->obs, j, sim->t + dt, p, n) >= 0)
                 continue;
             double u[3], vr[3];
             cf_obstacle_velocity(&sim->obs.o[j], u);

@@ -63,21 +63,27 @@ static const column_def FIELDS[FLD_COUNT] = {
     {"mode", 1, 1, NULL},
 };
 
-enum { FR_PARENT, FR_BIRTH, FR_MASS, FR_NTETS, FR_INERTIA, FR_COUNT };
+enum { FR_PARENT, FR_BIRTH, FR_MASS, FR_NTETS, FR_INERTIA, FR_NHULLS, FR_HULLERR, FR_DECOMP,
+       FR_COUNT };
 static const column_def FRAGMENT_COLUMNS[FR_COUNT] = {
     {"parent", 1, 1, NULL},
     {"birth_time", 1, 0, "s"},
     {"mass", 1, 0, "kg"},
     {"n_tets", 1, 1, NULL},
     {"inertia_principal", 3, 0, "kg m2"},
+    {"n_hulls", 1, 1, NULL},
+    {"hull_volume_error", 1, 0, NULL},
+    {"decomposition_time", 1, 0, "s"},
 };
 
 /* "time" is last: it is appended last, so its length counts complete rows. */
-enum { HO_FRAGMENT, HO_DIRECTION, HO_MOMERR, HO_LOSS, HO_TIME, HO_COUNT };
+enum { HO_FRAGMENT, HO_DIRECTION, HO_MOMERR, HO_DP, HO_DL, HO_LOSS, HO_TIME, HO_COUNT };
 static const column_def HANDOFF_COLUMNS[HO_COUNT] = {
     {"fragment", 1, 1, NULL},
     {"direction", 1, 1, NULL},
     {"momentum_error", 1, 0, NULL},
+    {"momentum_change", 3, 0, "kg m s-1"},
+    {"angular_momentum_change", 3, 0, "kg m2 s-1"},
     {"handoff_loss", 1, 0, "J"},
     {"time", 1, 0, "s"},
 };
@@ -847,11 +853,12 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
     if (n == 0)
         return CF_OK;
     size_t un = (size_t)n;
-    if (grow_scratch(h, 3 * un, 5 * un) < 0)
+    if (grow_scratch(h, 4 * un, 7 * un) < 0)
         return no_memory(err, h->path);
     /* Rows are stored by id; the batch may list the new ids in any order. */
     long long base = (long long)h->nfragments;
     int *src = h->ibuf, *parent = h->ibuf + un, *ntets = h->ibuf + 2 * un;
+    int *nhulls = h->ibuf + 3 * un;
     for (size_t i = 0; i < un; ++i)
         src[i] = -1;
     for (int i = 0; i < n; ++i) {
@@ -869,8 +876,12 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
         src[id - base] = i;
     }
     double *birth = h->dbuf, *mass = h->dbuf + un, *inertia = h->dbuf + 2 * un;
+    double *hull_error = h->dbuf + 5 * un, *decomp = h->dbuf + 6 * un;
     for (size_t r = 0; r < un; ++r) {
         const cf_frag_info *fi = &info[src[r]];
+        nhulls[r] = fi->n_hulls;
+        hull_error[r] = fi->n_hulls > 0 ? fi->hull_volume_error : NAN;
+        decomp[r] = fi->n_hulls > 0 ? fi->decomposition_time : NAN;
         parent[r] = fi->parent;
         ntets[r] = fi->n_tets;
         birth[r] = fi->birth_time;
@@ -878,7 +889,7 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
         for (int k = 0; k < 3; ++k)
             inertia[3 * r + (size_t)k] = fi->inertia_principal[k];
     }
-    const void *bufs[FR_COUNT] = {parent, birth, mass, ntets, inertia};
+    const void *bufs[FR_COUNT] = {parent, birth, mass, ntets, inertia, nhulls, hull_error, decomp};
     for (int c = 0; c < FR_COUNT; ++c)
         if (append_rows(h->fragment[c], h->nfragments, un, mem_type(&FRAGMENT_COLUMNS[c]),
                         bufs[c]) < 0)
@@ -993,8 +1004,10 @@ static cf_status add_handoff_impl(cf_h5 *h, const cf_handoff_record *r, cf_error
     if (!r)
         return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': no hand-off record given",
                             h->path);
-    const void *bufs[HO_COUNT] = {&r->fragment, &r->direction, &r->momentum_error,
-                                  &r->handoff_loss, &r->time};
+    const void *bufs[HO_COUNT] = {&r->fragment,        &r->direction,
+                                  &r->momentum_error,  r->momentum_change,
+                                  r->angular_momentum_change, &r->handoff_loss,
+                                  &r->time};
     for (int c = 0; c < HO_COUNT; ++c)
         if (append_rows(h->handoff[c], h->nhandoffs, 1, mem_type(&HANDOFF_COLUMNS[c]), bufs[c]) <
             0)

@@ -4,6 +4,8 @@
 
 #include "linalg.h"
 
+#include <math.h>
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,20 +46,34 @@ void cf_fragment_rest_props(cf_sim *sim, int fi)
     sym3_eigen(I, f->principal, f->Q);
 }
 
+/* Convex decomposition of fragment fi (DESIGN §5), kept in the principal
+ * frame for Bullet and for fracture-mode contact. */
+static int decompose_fragment(cf_sim *sim, cf_fragment *f)
+{
+    double t0 = cf_wall_time();
+    cf_hulls_free(&f->hulls);
+    if (cf_decompose(&sim->solid, f->tets, f->nt, CF_HULL_MAX_ERROR, CF_HULL_MAX_COUNT,
+                     CF_HULL_MIN_TETS, &f->hulls))
+        return -1;
+    for (int i = 0; i < f->hulls.start[f->hulls.n_hulls]; i++) {
+        double r[3];
+        v3_sub(&f->hulls.pts[3 * i], f->com_rest, r);
+        m3_tmulv(f->Q, r, &f->hulls.pts[3 * i]);
+    }
+    double dt = cf_wall_time() - t0;
+    sim->prof.decompose += dt;
+    f->decompose_time = dt;
+    return 0;
+}
+
 /* Rotation of the Bullet body frame: rest->current R times principal axes Q. */
 cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const double R[9],
                                const double v[3], const double w[3], cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;
-    double *pts = malloc((size_t)f->nodes.n * 3 * sizeof(double));
-    if (!pts)
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a fragment hull");
-    for (int i = 0; i < f->nodes.n; i++) {
-        double r[3];
-        v3_sub(&s->X[3 * f->nodes.v[i]], f->com_rest, r);
-        m3_tmulv(f->Q, r, &pts[3 * i]); /* principal frame */
-    }
+    if (decompose_fragment(sim, f))
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory decomposing fragment %d", fi);
     cfb_state st;
     double RQ[9];
     m3_mul(R, f->Q, RQ);
@@ -65,14 +81,19 @@ cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const d
     memcpy(st.pos, pos, sizeof st.pos);
     memcpy(st.v, v, sizeof st.v);
     memcpy(st.w, w, sizeof st.w);
-    /* Small margin: Bullet's default 4 cm would hold fragments off the ground. */
-    double margin = 1e-3 * cbrt(f->mass / s->mat.rho);
-    f->body = cfb_add_hull_body(sim->bullet, f->mass, f->principal, pts, f->nodes.n, margin, &st,
-                                s->mat.friction, s->mat.restitution);
-    free(pts);
+    f->body = cfb_add_compound_body(sim->bullet, f->mass, f->principal, f->hulls.pts,
+                                    f->hulls.start, f->hulls.n_hulls, cf_fragment_margin(sim, fi), &st,
+                                    s->mat.friction, s->mat.restitution);
     if (f->body < 0)
         return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused fragment %d: %s", fi,
                             cfb_last_error());
+    /* Continuous collision detection for fragments that move more than their
+     * smallest radius of gyration in a sub-step; the swept sphere stays
+     * inside the fragment. */
+    if (sim->scene->solver.ccd) {
+        double rg = sqrt(fmin(f->principal[0], fmin(f->principal[1], f->principal[2])) / f->mass);
+        cfb_set_ccd(sim->bullet, f->body, rg, 0.5 * rg);
+    }
     return CF_OK;
 }
 
@@ -117,21 +138,64 @@ static int count_dead(const cf_sim *sim)
     return n;
 }
 
-static cf_status record_handoff(cf_sim *sim, int fi, int direction, double merr, double loss,
-                                cf_error *err)
+/* Linear and angular momentum (about the origin) of fragment fi now: of its
+ * Bullet body, or of its nodes. */
+static void state_momenta(const cf_fragment *f, const cfb_state *st, double P[3], double L[3])
 {
+    double Rb[9], wb[3], Iw[3], c[3];
+    quat_to_mat(st->quat, Rb);
+    m3_tmulv(Rb, st->w, wb);
+    for (int k = 0; k < 3; k++)
+        wb[k] *= f->principal[k];
+    m3_mulv(Rb, wb, Iw);
+    v3_cross(st->pos, st->v, c);
+    for (int k = 0; k < 3; k++) {
+        P[k] = f->mass * st->v[k];
+        L[k] = f->mass * c[k] + Iw[k];
+    }
+}
+
+static void fragment_momenta(const cf_sim *sim, int fi, double P[3], double L[3])
+{
+    const cf_fragment *f = &sim->frag[fi];
+    const cf_solid *s = &sim->solid;
+    if (f->body >= 0) {
+        cfb_state st;
+        cfb_get_state(sim->bullet, f->body, &st);
+        state_momenta(f, &st, P, L);
+        return;
+    }
+    P[0] = P[1] = P[2] = L[0] = L[1] = L[2] = 0;
+    for (int i = 0; i < f->nodes.n; i++) {
+        int a = f->nodes.v[i];
+        double c[3];
+        v3_axpy(s->m[a], &s->v[3 * a], P);
+        v3_cross(&s->x[3 * a], &s->v[3 * a], c);
+        v3_axpy(s->m[a], c, L);
+    }
+}
+
+/* Log a hand-off of fragment fi: momenta before (P0, L0) and after (P1, L1). */
+static cf_status record_handoff(cf_sim *sim, int fi, int direction, const double P0[3],
+                                const double L0[3], const double P1[3], const double L1[3],
+                                double loss, cf_error *err)
+{
+    cf_handoff_record r = {sim->t, fi, direction, 0, {0}, {0}, loss};
+    v3_sub(P1, P0, r.momentum_change);
+    v3_sub(L1, L0, r.angular_momentum_change);
+    double pn = v3_norm(P0), dp = v3_norm(r.momentum_change);
+    r.momentum_error = pn > 0 ? dp / pn : dp;
     sim->n_handoffs++;
-    if (merr > sim->max_momentum_error)
-        sim->max_momentum_error = merr;
+    if (r.momentum_error > sim->max_momentum_error)
+        sim->max_momentum_error = r.momentum_error;
     sim->total_handoff_loss += loss;
     if (sim->opt.progress)
         fprintf(stderr, "hand-off t=%.4f s: fragment %d %s, linear momentum error %.2e, "
                         "handoff_loss %.4g J, %d fragments alive\n",
-                sim->t, fi, direction ? "fracture -> rigid" : "rigid -> fracture", merr, loss,
-                sim->n_frag - count_dead(sim));
+                sim->t, fi, direction ? "fracture -> rigid" : "rigid -> fracture",
+                r.momentum_error, loss, sim->n_frag - count_dead(sim));
     if (!sim->h5)
         return CF_OK;
-    cf_handoff_record r = {sim->t, fi, direction, merr, loss};
     return cf_h5_add_handoff(sim->h5, &r, err);
 }
 
@@ -152,6 +216,11 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
 {
     cf_fragment *f = &sim->frag[fi];
     cf_solid *s = &sim->solid;
+    double P0[3], L0[3], P1[3], L1[3];
+    if (st)
+        state_momenta(f, st, P0, L0);
+    else
+        fragment_momenta(sim, fi, P0, L0);
     if (st) { /* from Bullet: x = R (X - X_cm) + c, v = v_c + w x (x - c) */
         double Rb[9], R[9];
         quat_to_mat(st->quat, Rb);
@@ -176,16 +245,8 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
     cf_fragment_ledger_reset(sim, fi);
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
-    double merr = 0;
-    if (st) {
-        cf_node_state ns;
-        cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &ns);
-        double d[3], P = f->mass * v3_norm(st->v);
-        for (int k = 0; k < 3; k++)
-            d[k] = ns.M * ns.v[k] - f->mass * st->v[k];
-        merr = P > 0 ? v3_norm(d) / P : v3_norm(d);
-    }
-    return record_handoff(sim, fi, 0, merr, 0.0, err);
+    fragment_momenta(sim, fi, P1, L1);
+    return record_handoff(sim, fi, 0, P0, L0, P1, L1, 0.0, err);
 }
 
 /* Give the new fragment `ci` the tets of component `c` and their nodes. */
@@ -232,6 +293,53 @@ static void rigid_velocity(const cf_fragment *f, const cf_node_state *ns, double
         m3_mulv(Iinv, ns->L, w);
 }
 
+/* Siblings whose hulls overlap at birth (a hull bridging a concave crack
+ * face) would be pushed apart by Bullet at the speed that resolves the
+ * overlap: such pairs do not collide until they have parted.  Touching
+ * within a few margins is left to Bullet. */
+static int separate_siblings(cf_sim *sim, int first, int k)
+{
+    for (int a = first; a < first + k; a++)
+        for (int b = a + 1; b < first + k; b++) {
+            double lo[2][3], hi[2][3];
+            int ia = sim->frag[a].body, ib = sim->frag[b].body;
+            cfb_get_aabb(sim->bullet, ia, lo[0], hi[0]);
+            cfb_get_aabb(sim->bullet, ib, lo[1], hi[1]);
+            int apart = 0;
+            for (int d = 0; d < 3; d++)
+                apart |= lo[0][d] > hi[1][d] || lo[1][d] > hi[0][d];
+            if (apart || cfb_pair_penetration(sim->bullet, ia, ib) <= CF_SIBLING_TOUCH *
+                                                                         cf_fragment_margin(sim, b))
+                continue;
+            cfb_ignore_pair(sim->bullet, ia, ib);
+            if (cf_int_list_push(&sim->parting, a) || cf_int_list_push(&sim->parting, b))
+                return -1;
+        }
+    return 0;
+}
+
+void cf_release_parted(cf_sim *sim)
+{
+    int n = 0;
+    for (int i = 0; i < sim->parting.n; i += 2) {
+        int a = sim->parting.v[i], b = sim->parting.v[i + 1];
+        int ia = sim->frag[a].body, ib = sim->frag[b].body;
+        if (ia < 0 || ib < 0)
+            continue; /* one left rigid mode: its body is gone */
+        if (cfb_pair_penetration(sim->bullet, ia, ib) == 0) {
+            cfb_unignore_pair(sim->bullet, ia, ib);
+            continue;
+        }
+        sim->parting.v[n++] = a, sim->parting.v[n++] = b;
+    }
+    sim->parting.n = n;
+}
+
+double cf_fragment_margin(const cf_sim *sim, int fi)
+{
+    return 1e-3 * cbrt(sim->frag[fi].mass / sim->solid.mat.rho);
+}
+
 cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
 {
     cf_solid *s = &sim->solid;
@@ -250,8 +358,8 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
     f->e_strain = 0;
     cf_node_state before;
     cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &before);
-    double P_before[3] = {before.M * before.v[0], before.M * before.v[1], before.M * before.v[2]};
-    double P_after[3] = {0, 0, 0}, ke_after = 0;
+    double P0[3], L0[3], P1[3] = {0, 0, 0}, L1[3] = {0, 0, 0}, ke_after = 0;
+    fragment_momenta(sim, fi, P0, L0);
 
     /* One component: the fragment stays itself; several: children. */
     int first = fi;
@@ -282,7 +390,6 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
         cf_nodes_state(s, g->nodes.v, g->nodes.n, g->q_match, &ns);
         double w[3];
         rigid_velocity(g, &ns, w);
-        v3_axpy(ns.M, ns.v, P_after);
         ke_after += 0.5 * ns.M * v3_dot(ns.v, ns.v) + 0.5 * v3_dot(w, ns.L);
         if (sim->bullet) {
             cf_status st = cf_fragment_add_body(sim, ci, ns.com, ns.R, ns.v, w, err);
@@ -299,25 +406,21 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
             cf_fragment_ledger_reset(sim, ci);
         }
     }
-    /* Fragments of one body do not collide with each other: a single convex
-     * hull per fragment overlaps its neighbours wherever the crack surface is
-     * not convex, and Bullet would push them apart explosively. */
-    if (sim->bullet) {
-        int root = fi;
-        while (sim->frag[root].parent >= 0)
-            root = sim->frag[root].parent;
-        for (int a = 0; a < k; a++)
-            cfb_set_family(sim->bullet, sim->frag[first + a].body, root);
+    if (sim->bullet && k > 1 && separate_siblings(sim, first, k)) {
+        free(tets), free(comp), free(seen);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
     }
     if (sim->bullet || k > 1)
         cf_bars_free(&sim->frag[fi].bars);
     free(tets), free(comp), free(seen);
-    double d[3];
-    v3_sub(P_after, P_before, d);
-    double pn = v3_norm(P_before);
-    double merr = pn > 0 ? v3_norm(d) / pn : v3_norm(d);
+    for (int c = 0; c < k; c++) {
+        double P[3], L[3];
+        fragment_momenta(sim, first + c, P, L);
+        v3_axpy(1.0, P, P1);
+        v3_axpy(1.0, L, L1);
+    }
     double loss = before.ke - ke_after;
     if (sim->bullet) /* the pbd rigid backend keeps the nodes' velocities: damping removes it */
         sim->flow.handoff += loss;
-    return record_handoff(sim, fi, 1, merr, loss, err);
+    return record_handoff(sim, fi, 1, P0, L0, P1, L1, loss, err);
 }

@@ -2,12 +2,15 @@
  *
  *   cohfrac run SCENE.lua [--set key.path=value]... [--mesh-dir DIR]
  *               [--output FILE] [--threads N] [--quiet]
+ *   cohfrac compare SCENE.lua [--set key.path=value]... [-o DIR] [-j N]
+ *                   [-m MESH_DIR] [-q]
  *   cohfrac mesh SURFACE.{obj,off,stl} -o OUT [--target-tets N]
  *   cohfrac --help | --version
  *
  * Exit codes: 0 success, 1 usage, 2 bad input (mesh, surface, scene),
  * 3 diverged, 4 output not written, 5 external program or memory failure
  * (see include/cohfrac/error.h). */
+#include "cohfrac/compare.h"
 #include "cohfrac/error.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
@@ -29,6 +32,14 @@ static const char usage[] =
     "      -m, --mesh-dir DIR              where prepared meshes live (default build/meshes,\n"
     "                                      or $COHFRAC_MESH_DIR)\n"
     "      -o, --output FILE               output file (same as --set output.file=\"FILE\")\n"
+    "      -j, --threads N                 threads for element loops (default: all cores)\n"
+    "      -q, --quiet                     no progress display\n"
+    "  cohfrac compare SCENE.lua [options] run the scene with both rigid backends (bullet,\n"
+    "                                      pbd) in lockstep; write compare.md, compare.csv,\n"
+    "                                      fragments.csv, compare.png; print the headline\n"
+    "      -s, --set KEY.PATH=VALUE        override a scene key (Lua value), repeatable\n"
+    "      -o, --output DIR                report directory (default build/compare/<scene name>)\n"
+    "      -m, --mesh-dir DIR              as for 'run'\n"
     "      -j, --threads N                 threads for element loops (default: all cores)\n"
     "      -q, --quiet                     no progress display\n"
     "  cohfrac mesh SURFACE -o OUT [--target-tets N]\n"
@@ -130,6 +141,48 @@ static int cmd_run(int argc, char **argv)
     return rc;
 }
 
+static int cmd_compare(int argc, char **argv)
+{
+    static const struct option lo[] = {{"set", required_argument, 0, 's'},
+                                       {"mesh-dir", required_argument, 0, 'm'},
+                                       {"output", required_argument, 0, 'o'},
+                                       {"threads", required_argument, 0, 'j'},
+                                       {"quiet", no_argument, 0, 'q'},
+                                       {0, 0, 0, 0}};
+    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+    int n_sets = 0, c;
+    const char *mesh_dir = getenv("COHFRAC_MESH_DIR");
+    cf_compare_options opt = {.progress = 1, .plot = 1, .headline = stdout};
+    opt.mesh_dir = mesh_dir ? mesh_dir : "build/meshes";
+    while ((c = getopt_long(argc, argv, "s:m:o:j:q", lo, NULL)) != -1) {
+        switch (c) {
+        case 's': sets[n_sets++] = optarg; break;
+        case 'm': opt.mesh_dir = optarg; break;
+        case 'o': opt.out_dir = optarg; break;
+        case 'j': opt.threads = atoi(optarg); break;
+        case 'q': opt.progress = 0; break;
+        default: free(sets); return usage_error("bad option for 'compare'");
+        }
+    }
+    if (optind != argc - 1) {
+        free(sets);
+        return usage_error("'compare' needs exactly one scene file");
+    }
+    opt.scene = argv[optind];
+    opt.overrides = sets;
+    opt.n_overrides = n_sets;
+    cf_error err = {0};
+    cf_compare_result res;
+    int rc = 0;
+    if (cf_compare_run(&opt, &res, &err) != CF_OK)
+        rc = fail(&err);
+    else
+        printf("\nreport: %s/compare.md%s\n", res.out_dir,
+               res.plot_made ? " (plots: compare.png)" : "");
+    free(sets);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2)
@@ -144,6 +197,8 @@ int main(int argc, char **argv)
     }
     if (!strcmp(argv[1], "run"))
         return cmd_run(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "compare"))
+        return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(argv[1], "mesh"))
         return cmd_mesh(argc - 1, argv + 1);
     return usage_error("unknown command");

@@ -125,8 +125,10 @@ void cf_obstacle_velocity(const cf_obstacle *o, double u[3])
         u[k] = o->type == CF_OBSTACLE_PLANE ? 0.0 : o->velocity[k];
 }
 
-double cf_obstacle_distance(const cf_obstacle *o, double t, const double p[3], double normal[3])
+double cf_obstacle_distance(const cf_obstacles *obs, int j, double t, const double p[3],
+                            double normal[3])
 {
+    const cf_obstacle *o = &obs->o[j];
     double c[3] = {o->center[0] + t * o->velocity[0], o->center[1] + t * o->velocity[1],
                    o->center[2] + t * o->velocity[2]};
     double d[3];
@@ -164,6 +166,12 @@ double cf_obstacle_distance(const cf_obstacle *o, double t, const double p[3], d
         normal[axis] = d[axis] < 0 ? -1 : 1;
         return inside;
     }
+    case CF_OBSTACLE_MESH: {
+        double q[3], dist;
+        if (cff_mesh_closest(obs->mesh[j], p, obs->range[j], q, normal, &dist) == 1)
+            return dist;
+        return INFINITY;
+    }
     }
     return INFINITY;
 }
@@ -173,7 +181,7 @@ int cf_obstacles_project(const cf_obstacles *obs, double t, double p[3], double 
     int hit = -1;
     for (int j = 0; j < obs->n; j++) {
         double nrm[3];
-        double dist = cf_obstacle_distance(&obs->o[j], t, p, nrm);
+        double dist = cf_obstacle_distance(obs, j, t, p, nrm);
         if (dist < 0) {
             v3_axpy(-dist, nrm, p);
             memcpy(normal, nrm, sizeof nrm);

@@ -4,6 +4,7 @@
 #define COHFRAC_PBD_H
 
 #include "cohfrac/scene.h"
+#include "cf_fcl.h"
 #include "solid.h"
 
 /* One bar per unique edge of the current tets, rest length from s->X.
@@ -38,10 +39,15 @@ double cf_pbd_effective_stiffness(double k, int iterations, int iteration_indepe
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale);
 void cf_bars_reset_lambda(cf_bars *b);
 
-/* Obstacles at time t (moving ones at constant velocity). */
+/* Obstacles at time t (moving ones at constant velocity).  Mesh obstacles
+ * are queried through FCL: mesh[j] is the built mesh of obstacle j (NULL for
+ * the analytic ones), and a node counts as inside a mesh only within
+ * range[j] m behind its surface (deeper nodes have gone through). */
 typedef struct cf_obstacles {
     int n;
     const cf_obstacle *o;
+    cff_mesh **mesh;
+    double *range;
 } cf_obstacles;
 
 /* Move p of node i out of every obstacle along the obstacle's normal by its
@@ -55,6 +61,7 @@ void cf_obstacle_velocity(const cf_obstacle *o, double u[3]);
 
 /* Signed distance of point p from obstacle j at time t (negative inside) and
  * the outward normal there. */
-double cf_obstacle_distance(const cf_obstacle *o, double t, const double p[3], double normal[3]);
+double cf_obstacle_distance(const cf_obstacles *obs, int j, double t, const double p[3],
+                            double normal[3]);
 
 #endif

@@ -52,7 +52,7 @@ static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
                                             "beta",  "friction", "restitution"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
                                         "velocity", "angular_velocity", "expansion_rate",
-                                        "expansion_center"};
+                                        "expansion_center", "hollow_layers"};
 /* Primitive meshes (bodies[i].mesh = {type = ...}), one key list per type. */
 static const char *const prim_box_keys[] = {"type", "size", "cells", "tets_per_cell"};
 static const char *const prim_sphere_keys[] = {"type", "radius", "mesh_size"};
@@ -63,16 +63,22 @@ static const char *const boundary_keys[] = {"region", "velocity", "fixed", "axes
 static const char *const region_box_keys[] = {"type", "min", "max"};
 static const char *const region_plane_keys[] = {"type", "point", "normal", "tolerance"};
 static const char *const region_group_keys[] = {"type", "name"};
-static const char *const plane_keys[] = {"type", "point", "normal"};
-static const char *const sphere_keys[] = {"type", "center", "radius", "velocity"};
-static const char *const box_keys[] = {"type", "center", "half_extents", "velocity"};
+static const char *const plane_keys[] = {"type", "point", "normal", "friction", "restitution"};
+static const char *const sphere_keys[] = {"type",     "center",   "radius",
+                                          "velocity", "friction", "restitution"};
+static const char *const box_keys[] = {"type",     "center",   "half_extents",
+                                       "velocity", "friction", "restitution"};
+static const char *const mesh_obstacle_keys[] = {"type",     "file",     "scale",      "orientation",
+                                                 "position", "friction", "restitution"};
 static const char *const solver_keys[] = {
     "mode",              "rigid_backend",    "dt_rigid",       "rigid_substeps",
+    "ccd",               "sleeping",
     "dt_fracture",       "cfl_fraction",     "check_interval", "quiet_steps",
     "max_fracture_time",
     "impact_threshold",  "elasticity",       "criterion",      "crack_plane",
     "constraints",       "pbd",              "xpbd",           "contact_stiffness",
     "guard",             "threads"};
+static const char *const sleeping_keys[] = {"linear", "angular"};
 static const char *const crack_plane_keys[] = {"point", "normal", "tolerance"};
 static const char *const pbd_keys[] = {"k_stiffness", "iterations", "k_damping",
                                        "iteration_independent"};
@@ -85,7 +91,7 @@ static const char *const output_keys[] = {"file", "frame_interval"};
 static const char *const primitive_names[] = {"box", "sphere", "hollow_sphere", "plate",
                                               "notched_beam"};
 static const char *const region_names[] = {"box", "plane", "group"};
-static const char *const obstacle_names[] = {"plane", "sphere", "box"};
+static const char *const obstacle_names[] = {"plane", "sphere", "box", "mesh"};
 static const char *const mode_names[] = {"hybrid", "fracture"};
 static const char *const backend_names[] = {"bullet", "pbd"};
 static const char *const elasticity_names[] = {"corotational", "linear"};
@@ -96,7 +102,8 @@ _Static_assert(CF_PRIM_NONE == 0 && CF_PRIM_BOX == 1 && CF_PRIM_SPHERE == 2 &&
                "primitive_names follows cf_primitive_type");
 _Static_assert(CF_REGION_BOX == 0 && CF_REGION_PLANE == 1 && CF_REGION_GROUP == 2,
                "region_names follows cf_region_type");
-_Static_assert(CF_OBSTACLE_PLANE == 0 && CF_OBSTACLE_SPHERE == 1 && CF_OBSTACLE_BOX == 2,
+_Static_assert(CF_OBSTACLE_PLANE == 0 && CF_OBSTACLE_SPHERE == 1 && CF_OBSTACLE_BOX == 2 &&
+                   CF_OBSTACLE_MESH == 3,
                "obstacle_names follows cf_obstacle_type");
 _Static_assert(CF_RUN_HYBRID == 0 && CF_RUN_FRACTURE == 1, "mode_names follows cf_run_mode");
 _Static_assert(CF_RIGID_BULLET == 0 && CF_RIGID_PBD == 1, "backend_names follows cf_rigid_backend");
@@ -707,6 +714,64 @@ static cf_status resolve_mesh(loader *ld, const char *key, const char *name, cha
     return CF_OK;
 }
 
+/* A case-insensitive suffix test, for file extensions. */
+static int ends_with_nocase(const char *s, const char *suffix)
+{
+    size_t ls = strlen(s), lx = strlen(suffix);
+    if (ls < lx)
+        return 0;
+    for (size_t i = 0; i < lx; i++)
+        if (tolower((unsigned char)s[ls - lx + i]) != tolower((unsigned char)suffix[i]))
+            return 0;
+    return 1;
+}
+
+/* Turn a triangle-surface path (an obstacle's `file`) into an absolute path:
+ * relative paths start at the scene file's directory, as body mesh paths
+ * do; the directory part goes through realpath, the file name is kept. */
+static cf_status resolve_surface(loader *ld, const char *key, const char *name, char *out,
+                                 size_t size)
+{
+    char path[2048], dir[2048];
+    const char *cut;
+    char *real;
+    int w;
+
+    if (!ends_with_nocase(name, ".obj") && !ends_with_nocase(name, ".off") &&
+        !ends_with_nocase(name, ".stl"))
+        return fail(ld, CF_ERR_SCENE_VALUE,
+                    "'%s' is \"%s\"; a triangle surface must be an .obj, .off or .stl file",
+                    kp(ld, key), name);
+    if (name[0] == '/')
+        w = snprintf(path, sizeof path, "%s", name);
+    else
+        w = snprintf(path, sizeof path, "%s/%s", ld->dir, name);
+    if (w < 0 || (size_t)w >= sizeof path)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s': surface path too long", kp(ld, key));
+    if (!is_file(path))
+        return fail(ld, CF_ERR_FILE_OPEN,
+                    "%s: surface '%s' not found: no file %s (relative paths start at the scene "
+                    "file's directory)",
+                    kp(ld, key), name, path);
+    cut = strrchr(path, '/'); /* present: both branches above put one in */
+    assert(cut);
+    if (cut == path) {
+        snprintf(dir, sizeof dir, "/");
+    } else {
+        memcpy(dir, path, (size_t)(cut - path));
+        dir[cut - path] = '\0';
+    }
+    real = realpath(dir, NULL);
+    if (!real)
+        return fail(ld, CF_ERR_FILE_OPEN, "%s: cannot resolve directory %s: %s", kp(ld, key), dir,
+                    strerror(errno));
+    w = snprintf(out, size, "%s%s%s", real, ends_with(real, "/") ? "" : "/", cut + 1);
+    free(real);
+    if (w < 0 || (size_t)w >= size)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s': resolved surface path too long", kp(ld, key));
+    return CF_OK;
+}
+
 /* ---------------------------------------------------------------- sections */
 
 /* Runs `call` with the sub-table t[key] on top of the stack and the key
@@ -879,6 +944,7 @@ static cf_status read_body(loader *ld, int t, cf_body_def *b)
         TRY(get_vec(ld, t, "expansion_center", 3, NULL, b->expansion_center));
     }
     lua_pop(L, 1);
+    TRY(get_int(ld, t, "hollow_layers", 0, &NON_NEGATIVE, &b->hollow_layers));
     return CF_OK;
 }
 
@@ -974,7 +1040,8 @@ static cf_status read_boundary(loader *ld, int t, int n_bodies, cf_boundary *b)
 
 static cf_status read_obstacle(loader *ld, int t, cf_obstacle *o)
 {
-    int type;
+    static const double one = 1.0;
+    int type = 0;
     TRY(get_enum(ld, t, "type", obstacle_names, COUNT(obstacle_names), -1, &type));
     o->type = (cf_obstacle_type)type;
     switch (o->type) {
@@ -1002,7 +1069,22 @@ static cf_status read_obstacle(loader *ld, int t, cf_obstacle *o)
                             o->half_extents[2]);
         TRY(get_vec(ld, t, "velocity", 3, ZERO3, o->velocity));
         break;
+    case CF_OBSTACLE_MESH: {
+        char file[1024];
+        TRY(check_keys(ld, t, mesh_obstacle_keys, COUNT(mesh_obstacle_keys)));
+        TRY(get_str(ld, t, "file", NULL, file, sizeof file));
+        TRY(resolve_surface(ld, "file", file, o->file, sizeof o->file));
+        TRY(get_num(ld, t, "scale", &one, &POSITIVE, &o->scale));
+        TRY(get_vec(ld, t, "orientation", 4, IDENTITY_QUAT, o->orientation));
+        TRY(normalise(ld, "orientation", o->orientation, 4, "quaternion"));
+        TRY(get_vec(ld, t, "position", 3, ZERO3, o->position));
+        break;
     }
+    }
+    /* Factors on the material's values: the pair's coefficient is their
+     * product (Bullet multiplies the two bodies' coefficients). */
+    TRY(get_num(ld, t, "friction", &one, &NON_NEGATIVE, &o->friction));
+    TRY(get_num(ld, t, "restitution", &one, &NON_NEGATIVE, &o->restitution));
     return CF_OK;
 }
 
@@ -1015,6 +1097,15 @@ static cf_status read_crack_plane(loader *ld, int t, cf_solver_settings *s)
     TRY(normalise(ld, "normal", s->crack_plane_normal, 3, "vector"));
     TRY(get_num(ld, t, "tolerance", &tolerance, &POSITIVE, &s->crack_plane_tolerance));
     s->has_crack_plane = 1;
+    return CF_OK;
+}
+
+static cf_status read_sleeping(loader *ld, int t, cf_solver_settings *s)
+{
+    static const double zero = 0.0;
+    TRY(check_keys(ld, t, sleeping_keys, COUNT(sleeping_keys)));
+    TRY(get_num(ld, t, "linear", &zero, &NON_NEGATIVE, &s->sleep_linear));
+    TRY(get_num(ld, t, "angular", &zero, &NON_NEGATIVE, &s->sleep_angular));
     return CF_OK;
 }
 
@@ -1060,6 +1151,8 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     s->rigid_backend = (cf_rigid_backend)backend;
     TRY(get_num(ld, t, "dt_rigid", &dt_rigid, &POSITIVE, &s->dt_rigid));
     TRY(get_int(ld, t, "rigid_substeps", 5, &AT_LEAST_ONE, &s->rigid_substeps));
+    TRY(get_bool(ld, t, "ccd", 1, &s->ccd));
+    WITH_TABLE(ld, t, "sleeping", read_sleeping(ld, lua_gettop(L), s));
     TRY(get_num(ld, t, "dt_fracture", &dt_fracture, &POSITIVE, &s->dt_fracture));
     if (s->dt_fracture > s->dt_rigid)
         return fail(ld, CF_ERR_SCENE_VALUE,
@@ -1589,6 +1682,7 @@ static char *resolved_text(const cf_scene *s)
             put_vec(&b, 6, "expansion_center", d->expansion_center, 3);
         else
             put(&b, "      -- expansion_center: the body's centre of mass\n");
+        put(&b, "      hollow_layers = %d,\n", d->hollow_layers);
         put(&b, "    },\n");
     }
     put(&b, "  },\n  boundary = {\n");
@@ -1599,17 +1693,29 @@ static char *resolved_text(const cf_scene *s)
         const cf_obstacle *o = &s->obstacles[i];
         put(&b, "    {\n");
         put_str(&b, 6, "type", obstacle_names[o->type]);
-        if (o->type == CF_OBSTACLE_PLANE) {
+        switch (o->type) {
+        case CF_OBSTACLE_PLANE:
             put_vec(&b, 6, "point", o->point, 3);
             put_vec(&b, 6, "normal", o->normal, 3);
-        } else {
+            break;
+        case CF_OBSTACLE_SPHERE:
+        case CF_OBSTACLE_BOX:
             put_vec(&b, 6, "center", o->center, 3);
             if (o->type == CF_OBSTACLE_SPHERE)
                 put_num(&b, 6, "radius", o->radius);
             else
                 put_vec(&b, 6, "half_extents", o->half_extents, 3);
             put_vec(&b, 6, "velocity", o->velocity, 3);
+            break;
+        case CF_OBSTACLE_MESH:
+            put_str(&b, 6, "file", o->file);
+            put_num(&b, 6, "scale", o->scale);
+            put_vec(&b, 6, "orientation", o->orientation, 4);
+            put_vec(&b, 6, "position", o->position, 3);
+            break;
         }
+        put_num(&b, 6, "friction", o->friction);
+        put_num(&b, 6, "restitution", o->restitution);
         put(&b, "    },\n");
     }
     put(&b, "  },\n  solver = {\n");
@@ -1617,6 +1723,11 @@ static char *resolved_text(const cf_scene *s)
     put_str(&b, 4, "rigid_backend", backend_names[v->rigid_backend]);
     put_num(&b, 4, "dt_rigid", v->dt_rigid);
     put(&b, "    rigid_substeps = %d,\n", v->rigid_substeps);
+    put(&b, "    ccd = %s,\n", v->ccd ? "true" : "false");
+    put(&b, "    sleeping = {\n");
+    put_num(&b, 6, "linear", v->sleep_linear);
+    put_num(&b, 6, "angular", v->sleep_angular);
+    put(&b, "    },\n");
     put_num(&b, 4, "dt_fracture", v->dt_fracture);
     put_num(&b, 4, "cfl_fraction", v->cfl_fraction);
     put(&b, "    check_interval = %d,\n", v->check_interval);

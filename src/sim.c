@@ -6,6 +6,7 @@
  * steps is split into its components and handed back to rigid mode. */
 #include "sim.h"
 
+#include "cohfrac/surface.h"
 #include "linalg.h"
 
 #include <math.h>
@@ -83,9 +84,26 @@ static cf_status body_boundary(const cf_scene *sc, int b, const cf_mesh *m, int 
 
 static cf_status load_mesh(const cf_body_def *bd, const char *mesh_dir, cf_mesh *m, cf_error *err)
 {
-    if (bd->primitive.type != CF_PRIM_NONE)
-        return cf_mesh_primitive(&bd->primitive, mesh_dir ? mesh_dir : "build/meshes", m, err);
-    return cf_mesh_load(bd->mesh, m, err);
+    cf_status st = bd->primitive.type != CF_PRIM_NONE
+                       ? cf_mesh_primitive(&bd->primitive, mesh_dir ? mesh_dir : "build/meshes",
+                                           m, err)
+                       : cf_mesh_load(bd->mesh, m, err);
+    /* bodies[i].hollow_layers: keep a shell of tets along the surface. */
+    if (st == CF_OK && bd->hollow_layers > 0) {
+        st = cf_mesh_hollow(m, bd->hollow_layers, err);
+        if (st != CF_OK) {
+            if (err) {
+                char why[sizeof err->msg];
+                memcpy(why, err->msg, sizeof why);
+                cf_error_set(err, st, "%s mesh %s, hollow_layers = %d: %s",
+                             bd->mesh[0] ? "body" : "primitive",
+                             bd->mesh[0] ? bd->mesh : "(meshed from the scene)",
+                             bd->hollow_layers, why);
+            }
+            cf_mesh_free(m);
+        }
+    }
+    return st;
 }
 
 /* All bodies' meshes, placed and concatenated; body[t] is each tet's body,
@@ -267,24 +285,89 @@ static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *
     return CF_OK;
 }
 
+/* A mesh obstacle's surface placed in the world: x' = position + scale R x. */
+static cf_status load_obstacle_mesh(const cf_obstacle *o, int j, cf_surface *srf, cf_error *err)
+{
+    cf_status st = cf_surface_load(o->file, srf, err);
+    if (st != CF_OK)
+        return st;
+    double R[9];
+    quat_to_mat(o->orientation, R);
+    for (int i = 0; i < srf->n_verts; i++) {
+        double y[3];
+        m3_mulv(R, &srf->v[3 * i], y);
+        for (int k = 0; k < 3; k++)
+            srf->v[3 * i + k] = o->position[k] + o->scale * y[k];
+    }
+    if (srf->n_tris == 0) {
+        cf_surface_free(srf);
+        return cf_error_set(err, CF_ERR_SCENE_VALUE, "obstacles[%d].file %s has no triangle",
+                            j + 1, o->file);
+    }
+    return CF_OK;
+}
+
+/* Mesh obstacles for the in-house solver (FCL), and every obstacle for
+ * Bullet when there is a Bullet world.  Nodes count as inside a mesh down
+ * to 5% of its size behind the surface. */
 static cf_status add_obstacles(cf_sim *sim, cf_error *err)
 {
     const cf_scene *sc = sim->scene;
-    for (int j = 0; j < sc->n_obstacles; j++) {
+    int n = sc->n_obstacles;
+    sim->obs.n = n;
+    sim->obs.o = sc->obstacles;
+    if (n == 0)
+        return CF_OK;
+    sim->obs.mesh = calloc((size_t)n, sizeof *sim->obs.mesh);
+    sim->obs.range = calloc((size_t)n, sizeof *sim->obs.range);
+    sim->obstacle_body = malloc((size_t)n * sizeof(int));
+    sim->obstacle_moving = calloc((size_t)n, 1);
+    if (!sim->obs.mesh || !sim->obs.range || !sim->obstacle_body || !sim->obstacle_moving)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for obstacles");
+    for (int j = 0; j < n; j++) {
         const cf_obstacle *o = &sc->obstacles[j];
         int id = -1;
-        /* Bullet multiplies the two bodies' coefficients: obstacles carry 1 so
-         * that the contact uses the material's values. */
-        double mu = 1.0, e = 1.0;
-        if (o->type == CF_OBSTACLE_PLANE)
-            id = cfb_add_plane(sim->bullet, o->point, o->normal, mu, e);
-        else if (o->type == CF_OBSTACLE_SPHERE)
-            id = cfb_add_sphere(sim->bullet, o->center, o->radius, o->velocity, mu, e);
-        else
-            id = cfb_add_box(sim->bullet, o->center, o->half_extents, o->velocity, mu, e);
-        if (id < 0)
+        sim->obstacle_body[j] = -1;
+        sim->obstacle_moving[j] = o->type != CF_OBSTACLE_PLANE && o->type != CF_OBSTACLE_MESH &&
+                                  v3_dot(o->velocity, o->velocity) > 0;
+        if (o->type == CF_OBSTACLE_MESH) {
+            cf_surface srf;
+            cf_status st = load_obstacle_mesh(o, j, &srf, err);
+            if (st != CF_OK)
+                return st;
+            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (int i = 0; i < srf.n_verts; i++)
+                for (int k = 0; k < 3; k++) {
+                    lo[k] = fmin(lo[k], srf.v[3 * i + k]);
+                    hi[k] = fmax(hi[k], srf.v[3 * i + k]);
+                }
+            double diag[3];
+            v3_sub(hi, lo, diag);
+            sim->obs.range[j] = 0.05 * v3_norm(diag);
+            sim->obs.mesh[j] = cff_mesh_create(srf.v, srf.n_verts, srf.tri, srf.n_tris);
+            if (sim->obs.mesh[j] && sim->bullet)
+                id = cfb_add_trimesh(sim->bullet, srf.v, srf.n_verts, srf.tri, srf.n_tris,
+                                     o->friction, o->restitution);
+            cf_surface_free(&srf);
+            if (!sim->obs.mesh[j])
+                return cf_error_set(err, CF_ERR_EXTERNAL, "FCL refused obstacle %d (%s): %s",
+                                    j + 1, o->file, cff_last_error());
+        } else if (!sim->bullet) {
+            continue;
+        } else if (o->type == CF_OBSTACLE_PLANE) {
+            id = cfb_add_plane(sim->bullet, o->point, o->normal, o->friction, o->restitution);
+        } else if (o->type == CF_OBSTACLE_SPHERE) {
+            id = cfb_add_sphere(sim->bullet, o->center, o->radius, o->velocity, o->friction,
+                                o->restitution);
+        } else {
+            id = cfb_add_box(sim->bullet, o->center, o->half_extents, o->velocity, o->friction,
+                             o->restitution);
+        }
+        /* Bullet multiplies the two bodies' coefficients: material x obstacle factor. */
+        if (sim->bullet && id < 0)
             return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused obstacle %d: %s", j + 1,
                                 cfb_last_error());
+        sim->obstacle_body[j] = id;
     }
     return CF_OK;
 }
@@ -305,6 +388,9 @@ static cf_status write_fragment_infos(cf_sim *sim, int first, cf_error *err)
         info[i].mass = f->mass;
         info[i].n_tets = f->nt;
         memcpy(info[i].inertia_principal, f->principal, sizeof f->principal);
+        info[i].n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
+        info[i].hull_volume_error = cf_hulls_error(&f->hulls);
+        info[i].decomposition_time = f->decompose_time;
     }
     cf_status st = cf_h5_add_fragments(sim->h5, info, n, err);
     free(info);
@@ -324,8 +410,6 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
     int threads = opt->threads > 0 ? opt->threads : scene->solver.threads;
     if (threads > 0)
         omp_set_num_threads(threads);
-    sim->obs.n = scene->n_obstacles;
-    sim->obs.o = scene->obstacles;
     cf_ppr_init(&sim->ppr, &scene->material);
 
     cf_mesh all;
@@ -351,9 +435,13 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
     if (st == CF_OK && scene->solver.rigid_backend == CF_RIGID_BULLET &&
         scene->solver.mode == CF_RUN_HYBRID) {
         sim->bullet = cfb_world_create(scene->gravity);
-        st = sim->bullet ? add_obstacles(sim, err)
-                         : cf_error_set(err, CF_ERR_EXTERNAL, "Bullet world: %s", cfb_last_error());
+        if (!sim->bullet)
+            st = cf_error_set(err, CF_ERR_EXTERNAL, "Bullet world: %s", cfb_last_error());
+        else
+            cfb_set_sleeping(sim->bullet, scene->solver.sleep_linear, scene->solver.sleep_angular);
     }
+    if (st == CF_OK)
+        st = add_obstacles(sim, err);
     if (st == CF_OK)
         st = select_crack_plane(sim, err);
     if (st == CF_OK)
@@ -389,8 +477,15 @@ void cf_sim_destroy(cf_sim *sim)
         free(f->tets), free(f->nodes.v), free(f->coh.v), free(f->contact), free(f->vn_pre);
         free(f->v_old);
         cf_bars_free(&f->bars);
+        cf_hulls_free(&f->hulls);
+        cf_node_impulses_free(&f->push);
     }
     free(sim->frag);
+    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
+        cff_mesh_destroy(sim->obs.mesh[j]);
+    free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
+    cf_hull_set_free(&sim->near);
+    free(sim->parting.v);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
     cf_solid_free(&sim->solid);
@@ -398,7 +493,7 @@ void cf_sim_destroy(cf_sim *sim)
 }
 
 /* Kinetic energy (J) of rigid fragment f in Bullet state st. */
-static double body_kinetic_energy(const cf_fragment *f, const cfb_state *st)
+static double state_kinetic_energy(const cf_fragment *f, const cfb_state *st)
 {
     double Rb[9], wb[3];
     quat_to_mat(st->quat, Rb);
@@ -409,11 +504,18 @@ static double body_kinetic_energy(const cf_fragment *f, const cfb_state *st)
     return e;
 }
 
+double cf_body_kinetic_energy(const cf_sim *sim, int fi)
+{
+    cfb_state st;
+    cfb_get_state(sim->bullet, sim->frag[fi].body, &st);
+    return state_kinetic_energy(&sim->frag[fi], &st);
+}
+
 /* Kinetic energy minus gravity's potential work: what a Bullet body keeps
  * in free flight, J. */
 static double body_energy(const cf_sim *sim, const cf_fragment *f, const cfb_state *st)
 {
-    return body_kinetic_energy(f, st) - f->mass * v3_dot(sim->scene->gravity, st->pos);
+    return state_kinetic_energy(f, st) - f->mass * v3_dot(sim->scene->gravity, st->pos);
 }
 
 void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
@@ -428,7 +530,7 @@ void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
             cfb_state st;
             double Rb[9], D[9] = {0}, T[9], I[9], Iw[3], c[3];
             cfb_get_state(sim->bullet, f->body, &st);
-            l->kinetic += body_kinetic_energy(f, &st);
+            l->kinetic += state_kinetic_energy(f, &st);
             v3_axpy(f->mass, st.pos, l->mass_moment);
             v3_axpy(f->mass, st.v, l->momentum);
             quat_to_mat(st.quat, Rb); /* body frame = principal axes: I = Rb D Rb^T */
@@ -457,12 +559,79 @@ void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
     v3_sub(l->mass_moment, sim->mx0, dmx);
     l->work_gravity = v3_dot(sim->scene->gravity, dmx);
     l->work_boundary = sim->flow.boundary;
+    l->work_obstacles = sim->flow.obstacles;
     l->contact = sim->flow.contact, l->pbd = sim->flow.pbd;
     l->damping = sim->flow.damping, l->handoff = sim->flow.handoff;
     l->initial = sim->e0;
     l->residual = l->kinetic + l->strain + l->cohesive_stored + l->cohesive_dissipated +
                   l->contact + l->pbd + l->damping + l->handoff -
-                  (l->initial + l->work_gravity + l->work_boundary);
+                  (l->initial + l->work_gravity + l->work_boundary + l->work_obstacles);
+}
+
+int cf_sim_fragments(cf_sim *sim, cf_fragment_state *out, int cap)
+{
+    int n = 0;
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        cf_fragment *f = &sim->frag[fi];
+        if (f->mode == CF_MODE_DEAD)
+            continue;
+        if (n < cap) {
+            cf_fragment_state *o = &out[n];
+            double R[9];
+            memset(o, 0, sizeof *o);
+            o->id = fi, o->parent = f->parent, o->birth_time = f->birth_time;
+            o->mode = f->mode, o->n_tets = f->nt, o->mass = f->mass;
+            memcpy(o->principal, f->principal, sizeof o->principal);
+            memcpy(o->axes, f->Q, sizeof o->axes);
+            cf_fragment_pose(sim, fi, o->com, R, o->v, o->w);
+            mat_to_quat(R, o->quat);
+            for (int k = 0; k < 3; k++)
+                o->momentum[k] = f->mass * o->v[k];
+            if (f->body >= 0) {
+                cfb_state st;
+                double Rb[9], wb[3];
+                cfb_get_state(sim->bullet, f->body, &st);
+                quat_to_mat(st.quat, Rb);
+                m3_tmulv(Rb, st.w, wb);
+                for (int k = 0; k < 3; k++)
+                    wb[k] *= f->principal[k];
+                m3_mulv(Rb, wb, o->angular_momentum);
+                o->kinetic = state_kinetic_energy(f, &st);
+            } else {
+                cf_node_state ns;
+                cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
+                memcpy(o->angular_momentum, ns.L, sizeof ns.L);
+                for (int k = 0; k < 3; k++)
+                    o->momentum[k] = ns.M * ns.v[k];
+                o->kinetic = ns.ke;
+            }
+        }
+        n++;
+    }
+    return n;
+}
+
+double cf_sim_fragment_support(cf_sim *sim, int id, const double d[3])
+{
+    if (id < 0 || id >= sim->n_frag || sim->frag[id].mode == CF_MODE_DEAD)
+        return 0;
+    const cf_fragment *f = &sim->frag[id];
+    double com[3], R[9], v[3], w[3], Rd[3], best = -INFINITY;
+    cf_fragment_pose(sim, id, com, R, v, w);
+    m3_tmulv(R, d, Rd); /* (R r).d = r.(R^T d), r from the rest centre of mass */
+    for (int i = 0; i < f->nodes.n; i++) {
+        double r[3];
+        v3_sub(&sim->solid.X[3 * f->nodes.v[i]], f->com_rest, r);
+        best = fmax(best, v3_dot(r, Rd));
+    }
+    return f->nodes.n ? best : 0;
+}
+
+int cf_sim_tet_count(const cf_sim *sim) { return sim->solid.n_tets; }
+
+int cf_sim_tet_fragment(const cf_sim *sim, int t)
+{
+    return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[t] : -1;
 }
 
 static cf_status write_frame(cf_sim *sim, cf_error *err)
@@ -500,6 +669,7 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
         {"energy_cohesive_dissipated", l.cohesive_dissipated},
         {"work_gravity", l.work_gravity},
         {"work_boundary", l.work_boundary},
+        {"work_obstacles", l.work_obstacles},
         {"energy_contact_removed", l.contact},
         {"energy_pbd_removed", l.pbd},
         {"energy_damping_removed", l.damping},
@@ -590,47 +760,87 @@ static int can_break(const cf_sim *sim, const cf_fragment *f)
     return 0;
 }
 
+/* Rigid fragment fi is hit: Bullet's contact impulse plus the pushes of
+ * fracture-mode nodes, per unit mass, pass the impact threshold. */
+static int impact(const cf_sim *sim, const cf_fragment *f)
+{
+    double dv = (cfb_contact_impulse(sim->bullet, f->body) + f->pushed) / f->mass;
+    return dv > sim->scene->solver.impact_threshold && can_break(sim, f);
+}
+
+/* One Bullet step.  Fragments hit harder than the impact threshold go to
+ * fracture mode from their state at the start of the step; the step is
+ * then re-run from that start for every other body, so that none keeps the
+ * contact response of a fragment that is now sub-cycled instead (momentum is
+ * exchanged with it through its nodes). */
+static cf_status bullet_step(cf_sim *sim, double dt, cf_error *err)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
+    int n = sim->n_frag, no = sim->scene->n_obstacles;
+    cfb_state *pre = malloc((size_t)(n + no) * sizeof *pre), *pre_obs = pre + n;
+    if (!pre)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int fi = 0; fi < n; fi++)
+        if (sim->frag[fi].body >= 0)
+            cfb_get_state(sim->bullet, sim->frag[fi].body, &pre[fi]);
+    for (int j = 0; j < no; j++)
+        if (sim->obstacle_moving[j])
+            cfb_get_state(sim->bullet, sim->obstacle_body[j], &pre_obs[j]);
+    int any_moving = 0;
+    for (int j = 0; j < no; j++)
+        any_moving |= sim->obstacle_moving[j];
+    cf_status st = CF_OK;
+    for (int pass = 0; st == CF_OK; pass++) {
+        double t0 = cf_wall_time();
+        cfb_step(sim->bullet, dt, set->rigid_substeps);
+        sim->prof.rigid += cf_wall_time() - t0;
+        int hit = 0;
+        for (int fi = 0; fi < n && st == CF_OK; fi++) {
+            cf_fragment *f = &sim->frag[fi];
+            if (f->mode != CF_MODE_RIGID || f->body < 0 || !impact(sim, f))
+                continue;
+            double th = cf_wall_time();
+            st = cf_handoff_to_fracture(sim, fi, &pre[fi], err);
+            sim->prof.handoff += cf_wall_time() - th;
+            hit++;
+        }
+        if (st != CF_OK || hit == 0 || pass == CF_MAX_RESTEPS)
+            break;
+        for (int fi = 0; fi < n; fi++)
+            if (sim->frag[fi].mode == CF_MODE_RIGID && sim->frag[fi].body >= 0)
+                cfb_set_state(sim->bullet, sim->frag[fi].body, &pre[fi]);
+        for (int j = 0; j < no; j++)
+            if (sim->obstacle_moving[j])
+                cfb_set_state(sim->bullet, sim->obstacle_body[j], &pre_obs[j]);
+    }
+    /* What contact did to the rigid bodies' energy beyond gravity's work. */
+    for (int fi = 0; fi < n; fi++) {
+        cf_fragment *f = &sim->frag[fi];
+        f->pushed = 0;
+        if (f->mode != CF_MODE_RIGID || f->body < 0)
+            continue;
+        cfb_state now;
+        cfb_get_state(sim->bullet, f->body, &now);
+        double removed = body_energy(sim, f, &pre[fi]) - body_energy(sim, f, &now);
+        if (removed < 0 && any_moving) { /* a moving obstacle did work on it */
+            sim->flow.obstacles -= removed;
+            removed = 0;
+        }
+        sim->flow.contact += removed;
+    }
+    free(pre);
+    cf_release_parted(sim);
+    sim->steps_rigid++;
+    return st;
+}
+
 /* Advance the rigid fragments by one rigid step; detect impacts. */
 static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
-    int n = sim->n_frag;
+    if (sim->bullet)
+        return bullet_step(sim, dt, err);
     double t0 = cf_wall_time();
-    if (sim->bullet) {
-        cfb_state *pre = malloc((size_t)n * sizeof *pre);
-        if (!pre)
-            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-        for (int fi = 0; fi < n; fi++)
-            if (sim->frag[fi].body >= 0)
-                cfb_get_state(sim->bullet, sim->frag[fi].body, &pre[fi]);
-        cfb_step(sim->bullet, dt, set->rigid_substeps);
-        sim->prof.rigid += cf_wall_time() - t0;
-        sim->steps_rigid++;
-        for (int fi = 0; fi < n; fi++) {
-            cf_fragment *f = &sim->frag[fi];
-            if (f->body < 0 || f->mode != CF_MODE_RIGID)
-                continue;
-            cfb_state now;
-            cfb_get_state(sim->bullet, f->body, &now);
-            double de = body_energy(sim, f, &pre[fi]) - body_energy(sim, f, &now);
-            double dv = cfb_contact_impulse(sim->bullet, f->body) / f->mass;
-            if (dv > set->impact_threshold && can_break(sim, f)) {
-                /* redo this step in fracture mode */
-                double th = cf_wall_time();
-                cf_status st = cf_handoff_to_fracture(sim, fi, &pre[fi], err);
-                sim->prof.handoff += cf_wall_time() - th;
-                if (st != CF_OK) {
-                    free(pre);
-                    return st;
-                }
-                continue; /* the step is redone in fracture mode */
-            }
-            sim->flow.contact += de;
-        }
-        free(pre);
-        return CF_OK;
-    }
-    for (int fi = 0; fi < n; fi++) {
+    for (int fi = 0; fi < sim->n_frag; fi++) {
         if (sim->frag[fi].mode != CF_MODE_RIGID)
             continue;
         if (cf_pbd_impact(sim, fi, dt) && can_break(sim, &sim->frag[fi])) {
@@ -661,6 +871,19 @@ static cf_status diverged(const cf_sim *sim, cf_error *err, const char *what)
                         what, sim->t, sim->dt_fracture / sim->solid.dt_cfl, sim->solid.dt_cfl, fix);
 }
 
+/* How far beyond fragment fi's nodes a rigid body can be touched during a
+ * rigid step of dt: the fastest node's travel, plus gravity's. */
+static double contact_pad(const cf_sim *sim, int fi, double dt)
+{
+    const cf_fragment *f = &sim->frag[fi];
+    double v2 = 0;
+    for (int i = 0; i < f->nodes.n; i++) {
+        const double *v = &sim->solid.v[3 * f->nodes.v[i]];
+        v2 = fmax(v2, v3_dot(v, v));
+    }
+    return dt * (sqrt(v2) + dt * v3_norm(sim->scene->gravity));
+}
+
 /* Sub-cycle every fracture-mode fragment through the rigid step. */
 static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
 {
@@ -673,11 +896,15 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
     for (int fi = 0; fi < n; fi++) {
         if (sim->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
+        if (cf_hull_set_gather(sim, fi, contact_pad(sim, fi, dt), &sim->near))
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
         for (long k = 0; k < n_sub; k++) {
             if (cf_solver_step(sim, fi, sim->t + (double)k * h, h, 1) != CF_OK)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
             sim->steps_fracture++;
         }
+        sim->flow.contact -= cf_node_impulses_flush(sim, &sim->frag[fi].push);
+        sim->near.n = 0;
         const cf_fragment *f = &sim->frag[fi];
         char what[160];
         if (!nodes_sane(&sim->solid, f)) {
@@ -705,7 +932,8 @@ static cf_status check_energy(cf_sim *sim, cf_error *err)
     cf_ledger l;
     cf_sim_ledger(sim, &l);
     double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated;
-    double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary);
+    double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
+                   fmax(0.0, l.work_obstacles);
     if (have <= (1 + sim->scene->solver.max_energy_growth) * input + 1e-12)
         return CF_OK;
     char what[200];
@@ -787,6 +1015,66 @@ cf_status cf_sim_run(cf_sim *sim, cf_error *err)
     return st;
 }
 
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; i < n; i++) {
+        h ^= b[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+uint64_t cf_sim_state_hash(const cf_sim *sim)
+{
+    const cf_solid *s = &sim->solid;
+    uint64_t h = 14695981039346656037ull;
+    h = fnv1a(h, s->x, (size_t)s->n_nodes * 3 * sizeof(double));
+    h = fnv1a(h, s->v, (size_t)s->n_nodes * 3 * sizeof(double));
+    h = fnv1a(h, s->tet_frag, (size_t)s->n_tets * sizeof(int));
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        const cf_fragment *f = &sim->frag[fi];
+        int mode = f->mode;
+        h = fnv1a(h, &mode, sizeof mode);
+        if (f->body >= 0) {
+            cfb_state st;
+            cfb_get_state(sim->bullet, f->body, &st);
+            h = fnv1a(h, &st, sizeof st);
+        }
+    }
+    return h;
+}
+
+static int by_value(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Convex decomposition of the rigid fragments alive now: hull-volume error
+ * median and worst, and its share of the wall time. */
+static void print_hull_summary(const cf_sim *sim, FILE *out, double wall)
+{
+    double *e = malloc((size_t)(sim->n_frag + 1) * sizeof(double));
+    int n = 0, hulls = 0;
+    for (int fi = 0; e && fi < sim->n_frag; fi++) {
+        const cf_fragment *f = &sim->frag[fi];
+        if (f->mode == CF_MODE_RIGID && f->body >= 0) {
+            e[n++] = cf_hulls_error(&f->hulls);
+            hulls += f->hulls.n_hulls;
+        }
+    }
+    if (n > 0) {
+        qsort(e, (size_t)n, sizeof *e, by_value);
+        double median = n % 2 ? e[n / 2] : 0.5 * (e[n / 2 - 1] + e[n / 2]);
+        fprintf(out, "convex hulls       %d over %d rigid fragments; hull volume / tet volume - 1: "
+                     "median %.3g, worst %.3g; decomposition %.2f s (%.1f%% of wall time)\n",
+                hulls, n, median, e[n - 1], sim->prof.decompose,
+                100 * sim->prof.decompose / fmax(wall, 1e-300));
+    }
+    free(e);
+}
+
 void cf_sim_print_summary(const cf_sim *sim, FILE *out)
 {
     const cf_scene *sc = sim->scene;
@@ -812,15 +1100,18 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
     fprintf(out, "hand-offs          %d, max linear momentum error %.3g (relative), "
                  "handoff_loss %.4g J\n",
             sim->n_handoffs, sim->max_momentum_error, sim->total_handoff_loss);
+    print_hull_summary(sim, out, wall);
     double staged = p->rigid + p->stress + p->insertion + p->forces + p->pbd + p->handoff + p->output;
     cf_ledger l;
     cf_sim_ledger(sim, &l);
-    double scale = fmax(fabs(l.initial) + fabs(l.work_gravity) + fabs(l.work_boundary), 1e-300);
+    double scale = fmax(fabs(l.initial) + fabs(l.work_gravity) + fabs(l.work_boundary) +
+                            fabs(l.work_obstacles), 1e-300);
     fprintf(out, "energy ledger (J)  kinetic %.6g | strain %.6g | cohesive stored %.6g | "
                  "cohesive dissipated %.6g\n",
             l.kinetic, l.strain, l.cohesive_stored, l.cohesive_dissipated);
-    fprintf(out, "                   initial %.6g | work: gravity %.6g, boundary %.6g\n",
-            l.initial, l.work_gravity, l.work_boundary);
+    fprintf(out, "                   initial %.6g | work: gravity %.6g, boundary %.6g, "
+                 "moving obstacles %.6g\n",
+            l.initial, l.work_gravity, l.work_boundary, l.work_obstacles);
     fprintf(out, "                   removed: contact %.6g, PBD %.6g, damping %.6g, hand-off %.6g\n",
             l.contact, l.pbd, l.damping, l.handoff);
     fprintf(out, "                   residual %.4g J = %.3g of initial + work\n", l.residual,
@@ -828,6 +1119,8 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
     fprintf(out, "momentum           P = (%.6g, %.6g, %.6g) kg m/s, L = (%.6g, %.6g, %.6g) kg m^2/s\n",
             l.momentum[0], l.momentum[1], l.momentum[2], l.angular_momentum[0],
             l.angular_momentum[1], l.angular_momentum[2]);
+    fprintf(out, "state hash         %016llx (FNV-1a of the final state)\n",
+            (unsigned long long)cf_sim_state_hash(sim));
     fprintf(out, "wall time          %.2f s\n", wall);
     fprintf(out, "  rigid step %.2f s | stress %.2f s | insertion %.2f s | forces %.2f s | "
                  "PBD %.2f s | hand-off %.2f s | output %.2f s | other %.2f s\n",

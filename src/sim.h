@@ -5,6 +5,8 @@
 
 #include "cf_bullet.h"
 #include "cohesive_ppr.h"
+#include "contact.h"
+#include "decompose.h"
 #include "cohfrac/h5_output.h"
 #include "cohfrac/sim.h"
 #include "fragments.h"
@@ -38,12 +40,26 @@ typedef struct cf_fragment {
     double e_strain;         /* J */
     double mx[3];            /* kg m, sum m x */
     int n_inverted;          /* tets with det F <= 0 */
+    /* Rigid mode with Bullet: the convex decomposition (principal frame). */
+    cf_hulls hulls;
+    double decompose_time;   /* s of wall time to decompose it */
+    double pushed;           /* N s: impulse fracture-mode nodes gave its body
+                                since the last rigid step (impact trigger) */
+    cf_node_impulses push;   /* fracture mode: impulses its nodes gave bodies */
 } cf_fragment;
+
+/* Convex decomposition settings (DESIGN §5): split until the hulls exceed
+ * the tet volume by at most this fraction, into at most this many hulls of
+ * at least this many tets each. */
+#define CF_HULL_MAX_ERROR 0.05
+#define CF_HULL_MAX_COUNT 64
+#define CF_HULL_MIN_TETS 4
 
 /* Energy removed or put in by each mechanism since t = 0, J (DESIGN §3-§6;
  * the ledger balance is in cf_sim_ledger). */
 typedef struct cf_energy_flows {
     double boundary;   /* work of prescribed velocities */
+    double obstacles;  /* work of moving obstacles (the energy contact with them put in) */
     double contact;    /* removed by obstacle contact: restitution, friction, and
                           the Bullet bodies' energy change beyond gravity's work */
     double pbd;        /* removed by the PBD/XPBD projection */
@@ -53,7 +69,7 @@ typedef struct cf_energy_flows {
 } cf_energy_flows;
 
 typedef struct cf_profile {
-    double rigid, stress, insertion, forces, pbd, handoff, output; /* s of wall time */
+    double rigid, stress, insertion, forces, pbd, handoff, decompose, output; /* s of wall time */
 } cf_profile;
 
 struct cf_sim {
@@ -82,6 +98,11 @@ struct cf_sim {
     double max_momentum_error, total_handoff_loss;
     double wall_start;
     double last_progress;
+    int *obstacle_body;      /* [n_obstacles] Bullet body of each obstacle */
+    unsigned char *obstacle_moving; /* [n_obstacles] kinematic (restored on a re-step) */
+    cf_hull_set near;        /* hulls near the fragment being sub-cycled */
+    cf_int_list parting;     /* pairs of sibling fragments (flattened) whose hulls
+                                overlapped at birth: no contact until they part */
 };
 
 double cf_wall_time(void);
@@ -123,6 +144,24 @@ void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[
 /* The ledger state of fragment fi from its nodes now: exact kinetic energy,
  * zero strain energy, sum m x. */
 void cf_fragment_ledger_reset(cf_sim *sim, int fi);
+
+/* Bullet collision margin of fragment fi: 0.1% of its size, m (Bullet's
+ * default 4 cm would hold small fragments off the ground). */
+double cf_fragment_margin(const cf_sim *sim, int fi);
+
+/* Sibling pairs overlapping deeper than this many margins at a split do not
+ * collide until they part. */
+#define CF_SIBLING_TOUCH 2.5
+
+/* A rigid step is re-run at most this many times for fragments that go to
+ * fracture mode during it. */
+#define CF_MAX_RESTEPS 4
+
+/* Let the parting sibling pairs that no longer touch collide again. */
+void cf_release_parted(cf_sim *sim);
+
+/* Kinetic energy of rigid fragment fi's Bullet body, J. */
+double cf_body_kinetic_energy(const cf_sim *sim, int fi);
 
 /* Append a new fragment; returns its index or -1 (out of memory). */
 int cf_fragment_new(cf_sim *sim, int parent, double birth_time);

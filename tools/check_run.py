@@ -13,7 +13,10 @@ Prints and checks:
     against z0 - g t^2/2 (g from the scene's gravity), error relative to the
     fall height up to the last frame before the impact;
   * fragments alive at the end (>= --min-fragments);
-  * every hand-off's linear momentum error (<= --max-momentum-error).
+  * every hand-off's linear momentum error (<= --max-momentum-error);
+  * the convex decomposition of the fragments handed to Bullet: median
+    hull-volume error (hull volume / tet volume - 1) <= --max-hull-error,
+    and every hull-volume error >= -1e-9 (hulls cover their tets).
 Exit status 0 when every check holds, 1 otherwise.
 """
 import argparse
@@ -28,6 +31,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("file")
     ap.add_argument("--min-fragments", type=int, default=2)
+    ap.add_argument("--max-hull-error", type=float, default=0.10)
     ap.add_argument("--max-momentum-error", type=float, default=1e-9)
     ap.add_argument("--max-fall-error", type=float, default=1e-3)
     a = ap.parse_args()
@@ -77,6 +81,14 @@ def main():
         print(f"  hand-off linear momentum error: max {worst:.3e} (relative)")
         check(worst <= a.max_momentum_error,
               f"every hand-off conserves momentum to {a.max_momentum_error:g}")
+        nh = f["fragments/n_hulls"][()]
+        he = f["fragments/hull_volume_error"][()][nh > 0]
+        if len(he):
+            med = float(np.median(he))
+            print(f"  convex decomposition: {len(he)} fragments, {int(np.sum(nh))} hulls, "
+                  f"hull-volume error median {med:.4f}, worst {float(np.max(he)):.4f}")
+            check(med <= a.max_hull_error, f"median hull-volume error <= {a.max_hull_error:g}")
+            check(float(np.min(he)) >= -1e-9, "hulls cover their tets")
     return 0 if ok else 1
 
 

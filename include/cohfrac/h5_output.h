@@ -16,10 +16,15 @@
  *       mode        [T][N]     0 rigid, 1 fracture, -1 not alive -1
  *     Column j is fragment id j for the whole file; N grows as fragments are born.
  *   /fragments/{parent[N] int32 (-1 for an initial body), birth_time[N] s,
- *               mass[N] kg, n_tets[N], inertia_principal[N][3] kg m^2}
+ *               mass[N] kg, n_tets[N], inertia_principal[N][3] kg m^2,
+ *               n_hulls[N] (convex hulls of its Bullet shape, 0 when it was
+ *               born with none), hull_volume_error[N] (hull volume / tet
+ *               volume - 1, NaN without hulls), decomposition_time[N] s}
  *   /observables/<name>/{step[T] int64, time[T] s, value[T] float64}
  *   /handoffs/{time, fragment, direction (0 rigid->fracture, 1 fracture->rigid),
- *              momentum_error (relative), handoff_loss (J)}  one row per hand-off
+ *              momentum_error (relative), momentum_change[3] kg m/s and
+ *              angular_momentum_change[3] kg m^2/s (after - before, about the
+ *              origin), handoff_loss (J)}  one row per hand-off
  *   /h5md                  H5MD 1.1 metadata: attr version [1,1], author/ and
  *                          creator/ (attrs name, version), modules/units
  *   /particles/fragments/box  attrs dimension=3, boundary=["none"]*3 (H5MD)
@@ -81,6 +86,9 @@ typedef struct cf_frag_info {
     double mass;             /* kg */
     int n_tets;
     double inertia_principal[3]; /* kg m^2 */
+    int n_hulls;             /* convex hulls of its Bullet shape, 0 none */
+    double hull_volume_error;/* hull volume / tet volume - 1 */
+    double decomposition_time; /* s of wall time */
 } cf_frag_info;
 
 /* One hand-off between modes. */
@@ -89,6 +97,8 @@ typedef struct cf_handoff_record {
     int fragment;            /* the fragment that changed mode (the parent for a split) */
     int direction;           /* 0 rigid -> fracture, 1 fracture -> rigid */
     double momentum_error;   /* |P_after - P_before| / |P_before| */
+    double momentum_change[3];         /* P_after - P_before, kg m/s */
+    double angular_momentum_change[3]; /* L_after - L_before about the origin, kg m^2/s */
     double handoff_loss;     /* J: kinetic energy not carried by rigid motion */
 } cf_handoff_record;
 

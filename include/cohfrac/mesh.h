@@ -132,6 +132,19 @@ cf_status cf_mesh_box(const double size[3], const int cells[3], int tets_per_cel
 cf_status cf_mesh_primitive(const cf_primitive *p, const char *cache_dir, cf_mesh *m,
                             cf_error *err);
 
+/* Hollow a mesh out (scene key bodies[i].hollow_layers): keep only the tets
+ * within `layers` tet layers of the boundary and drop the rest.  The
+ * boundary is the set of faces used by one tet only; layer 1 is every tet
+ * with a boundary face or a node on the boundary, layer k+1 every tet that
+ * shares a node with a tet of layer k.  Nodes no kept tet uses are dropped
+ * and the others renumbered in their old order; tets keep their order and
+ * orientation; node groups lose the dropped nodes and are renumbered
+ * (still ascending).  The boundary, hence the bounding box, is unchanged.
+ * Errors (the mesh is then left as it was): CF_ERR_SCENE_VALUE when
+ * layers < 1, when nothing would be removed (every tet is within `layers`
+ * of the boundary: a coarse mesh) or nothing kept (no tets); CF_ERR_NOMEM. */
+cf_status cf_mesh_hollow(cf_mesh *m, int layers, cf_error *err);
+
 /* Release the arrays and zero `m` (NULL or an empty mesh is fine). */
 void cf_mesh_free(cf_mesh *m);
 

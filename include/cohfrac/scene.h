@@ -36,6 +36,11 @@
  *     velocity [{0,0,0}] m/s, angular_velocity [{0,0,0}] rad/s (about the COM),
  *     expansion_rate [0] 1/s: a number (radial) or {x,y,z} (per axis),
  *     expansion_center [the body's centre of mass] m
+ *     hollow_layers [0]: integer >= 0; > 0 keeps only the tets within this
+ *       many tet layers of the mesh's boundary (layer 1: tets with a boundary
+ *       face or a node on the boundary; layer k+1: tets sharing a node with
+ *       layer k) and drops the rest, a hollow shell (cf_mesh_hollow); 0 keeps
+ *       the solid.  The boundary, hence the bounding box, is unchanged.
  *   }, ... }
  *   boundary = { {                        prescribed nodes (fracture mode)
  *     region = {type="box", min={..}, max={..}}            nodes inside, m
@@ -48,9 +53,24 @@
  *   }, ... }  [{}]; needs solver.mode = "fracture"
  *   obstacles = { {type="plane", point={0,0,0}, normal={0,0,1}},
  *                 {type="sphere", center=..., radius=..., velocity={0,0,0}},
- *                 {type="box", center=..., half_extents=..., velocity={0,0,0}} }
- *                 [{}]; `type` is required, as are a sphere's center and radius
- *                 and a box's center and half_extents (no sensible default)
+ *                 {type="box", center=..., half_extents=..., velocity={0,0,0}},
+ *                 {type="mesh", file=..., scale [1], orientation [{1,0,0,0}]
+ *                  (w,x,y,z, normalised), position [{0,0,0}] m} }
+ *                 [{}]; `type` is required, as are a sphere's center and radius,
+ *                 a box's center and half_extents and a mesh's file (no
+ *                 sensible default).  Spheres and boxes move at their constant
+ *                 velocity m/s (kinematic), planes and meshes are static.
+ *                 mesh: a triangle surface (.obj, .off or .stl), closed or
+ *                 open; relative paths start at the scene file's directory
+ *                 (as body mesh paths do) and the file must exist; its
+ *                 vertices are scaled, then rotated, then moved by position
+ *                 (where the file's origin goes).
+ *                 Every type also takes friction [1] and restitution [1]:
+ *                 factors >= 0 on the material's friction and restitution;
+ *                 the contact's coefficient is their product (as Bullet
+ *                 combines two bodies' coefficients), so 1 uses the
+ *                 material's values and 0 a frictionless / fully plastic
+ *                 obstacle (a restitution product above 1 adds energy)
  *   solver = {
  *     mode ["hybrid"]: rigid mode with fracture mode on impact
  *          | "fracture": every body stays in fracture mode (no rigid mode,
@@ -59,13 +79,21 @@
  *     dt_rigid [1e-3] s, rigid_substeps [5] (Bullet sub-steps per dt_rigid);
  *       with mode = "fracture" it only paces output and checks, rounded down
  *       to a whole number of fracture steps
+ *     ccd [true]: Bullet continuous collision detection for rigid fragments
+ *       (no tunnelling of small, fast fragments through thin obstacles)
+ *     sleeping = { linear [0.0] m/s, angular [0.0] rad/s }: Bullet
+ *       deactivates (puts to sleep) a rigid body whose linear speed and
+ *       angular speed both stay below these thresholds for 2 s; a contact
+ *       wakes it.  Both 0: no sleeping
  *     dt_fracture [5e-6] s, check_interval [1] steps, quiet_steps [400]
  *     cfl_fraction [0]: when > 0, dt_fracture = cfl_fraction x dt_cfl of the
  *       mesh (DESIGN §3.2) instead of the dt_fracture value
  *     max_fracture_time [0.05] s (a fragment returns to rigid mode after this
  *       long in fracture mode even if still cracking)
- *     impact_threshold [0.2] m/s: normal contact impulse per unit mass in one
- *       rigid step that sends a rigid fragment to fracture mode
+ *     impact_threshold [0.2] m/s: the normal contact impulse a rigid fragment
+ *       receives in one rigid step divided by its mass (m/s, i.e. the
+ *       velocity change contact gives it); when it reaches this value the
+ *       fragment goes to fracture mode; default 0.2 m/s
  *     elasticity ["corotational"] | "linear"
  *     criterion ["traction"] | "source": cohesive insertion rule, DESIGN §3.3
  *       (facet traction sigma_n >= sigma_max or tau >= tau_max; or the
@@ -117,6 +145,8 @@ typedef struct cf_body_def {
     double expansion_rate[3];  /* 1/s, per axis */
     int has_expansion_center;  /* 0: the body's centre of mass */
     double expansion_center[3];/* m */
+    int hollow_layers;         /* > 0: keep only the tets within this many tet
+                                  layers of the surface (a hollow shell); 0 solid */
 } cf_body_def;
 
 typedef enum { CF_REGION_BOX, CF_REGION_PLANE, CF_REGION_GROUP } cf_region_type;
@@ -132,7 +162,12 @@ typedef struct cf_boundary {
     double velocity[3];          /* m/s (zero when fixed) */
 } cf_boundary;
 
-typedef enum { CF_OBSTACLE_PLANE, CF_OBSTACLE_SPHERE, CF_OBSTACLE_BOX } cf_obstacle_type;
+typedef enum {
+    CF_OBSTACLE_PLANE,
+    CF_OBSTACLE_SPHERE,
+    CF_OBSTACLE_BOX,
+    CF_OBSTACLE_MESH
+} cf_obstacle_type;
 
 typedef struct cf_obstacle {
     cf_obstacle_type type;
@@ -141,6 +176,13 @@ typedef struct cf_obstacle {
     double radius;               /* sphere, m */
     double half_extents[3];      /* box (axis-aligned), m */
     double velocity[3];          /* sphere, box: constant, m/s */
+    char file[1024];             /* mesh: resolved path of a closed or open
+                                    triangle surface (.obj/.off/.stl) */
+    double scale;                /* mesh: applied first */
+    double orientation[4];       /* mesh: w,x,y,z, normalised, then */
+    double position[3];          /* mesh: where the file's origin goes, m */
+    double friction, restitution;/* factors on the material's values (the
+                                    pair's coefficient is their product) */
 } cf_obstacle;
 
 typedef enum { CF_RUN_HYBRID, CF_RUN_FRACTURE } cf_run_mode;
@@ -160,6 +202,8 @@ typedef struct cf_solver_settings {
     int quiet_steps;
     double max_fracture_time;
     double impact_threshold;
+    int ccd;                      /* Bullet continuous collision detection */
+    double sleep_linear, sleep_angular; /* m/s, rad/s; 0, 0: no sleeping */
     cf_elasticity elasticity;
     cf_criterion criterion;
     int has_crack_plane;

@@ -9,6 +9,7 @@
 #ifndef COHFRAC_SIM_H
 #define COHFRAC_SIM_H
 
+#include <stdint.h>
 #include <stdio.h>
 
 #include "cohfrac/error.h"
@@ -25,14 +26,17 @@ typedef struct cf_run_options {
 /* The energy ledger (J) and momenta of the whole scene at the current
  * state.  Balance: residual = kinetic + strain + cohesive_stored +
  * cohesive_dissipated + contact + pbd + damping + handoff
- * - (initial + work_gravity + work_boundary); zero for an exact integrator.
+ * - (initial + work_gravity + work_boundary + work_obstacles); zero for an
+ * exact integrator.  work_obstacles is the work of moving obstacles: the
+ * impulse they give a node times their velocity, and for Bullet bodies the
+ * energy gained in a rigid step in contact when the scene has moving ones.
  * Kinetic energy of the in-house solver is the leapfrog estimate
  * 1/2 sum m v(n-1/2).v(n+1/2) at the last force evaluation; Bullet bodies'
  * is 1/2 M v^2 + 1/2 w.I w.  `contact`, `pbd`, `damping`, `handoff` are
  * energies removed since t = 0 (see DESIGN §3-§6 and docs/physics.md). */
 typedef struct cf_ledger {
     double kinetic, strain, cohesive_stored, cohesive_dissipated;
-    double work_gravity, work_boundary;
+    double work_gravity, work_boundary, work_obstacles;
     double contact, pbd, damping, handoff;
     double initial;            /* kinetic + strain at t = 0 */
     double residual;
@@ -65,6 +69,48 @@ double cf_sim_time(const cf_sim *sim);
 
 /* The energy ledger and momenta now. */
 void cf_sim_ledger(const cf_sim *sim, cf_ledger *out);
+
+/* One alive fragment's rigid state now (pose as DESIGN §2).  `kinetic` is
+ * the kinetic energy of its nodes (fracture mode, pbd rigid backend) or of
+ * its Bullet body; momenta are those of the same. */
+typedef struct cf_fragment_state {
+    int id;                     /* fragment index, as in /fragments */
+    int parent;                 /* -1 for an initial body */
+    double birth_time;          /* s */
+    int mode;                   /* 0 rigid, 1 fracture */
+    int n_tets;
+    double mass;                /* kg */
+    double com[3];              /* m */
+    double quat[4];             /* w,x,y,z: rest shape -> current */
+    double v[3];                /* m/s, centre of mass */
+    double w[3];                /* rad/s, world frame */
+    double kinetic;             /* J */
+    double momentum[3];         /* kg m/s */
+    double angular_momentum[3]; /* kg m^2/s, about the fragment's centre of mass */
+    double principal[3];        /* kg m^2 */
+    double axes[9];             /* principal axes in the rest frame, columns */
+} cf_fragment_state;
+
+/* The alive fragments now, in id order: writes up to `cap` to out (may be
+ * NULL with cap 0) and returns how many are alive. */
+int cf_sim_fragments(cf_sim *sim, cf_fragment_state *out, int cap);
+
+/* Number of tets of the scene's solid, and the fragment (id) that tet t
+ * belongs to now: fragments of two runs of one scene are matched through
+ * their tets.  -1 for t out of range. */
+int cf_sim_tet_count(const cf_sim *sim);
+int cf_sim_tet_fragment(const cf_sim *sim, int t);
+
+/* Support distance of fragment `id` along unit direction d now: the largest
+ * (x - com).d over its nodes, m (0 for a dead or unknown fragment). */
+double cf_sim_fragment_support(cf_sim *sim, int id, const double d[3]);
+
+/* FNV-1a hash of the state's bits: every node's position and velocity,
+ * each tet's fragment, each fragment's mode and its Bullet body's state.
+ * Two runs of one scene give the same hash at the same step, for any thread
+ * count (the element loops write per-element results and sum them in a
+ * fixed order). */
+uint64_t cf_sim_state_hash(const cf_sim *sim);
 
 void cf_sim_print_summary(const cf_sim *sim, FILE *out);
 void cf_sim_destroy(cf_sim *sim);

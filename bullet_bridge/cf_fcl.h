@@ -1,0 +1,41 @@
+/* cohfrac — C face of FCL (the Flexible Collision Library) for point queries
+ * against static triangle meshes (mesh obstacles seen by fracture-mode
+ * nodes, DESIGN §5).  The implementation is C++; no C++ type or exception
+ * crosses this header.  Units SI (m).  Functions are thread-safe on a
+ * built mesh (queries do not modify it). */
+#ifndef COHFRAC_FCL_BRIDGE_H
+#define COHFRAC_FCL_BRIDGE_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct cff_mesh cff_mesh;
+
+/* Build a bounding-volume hierarchy over a triangle mesh: verts [nv][3] m,
+ * tris [nt][3] 0-based, counter-clockwise seen from outside (the outward
+ * side).  The arrays are copied.  NULL on error (message in
+ * cff_last_error()): nv < 3, nt < 1, a non-finite vertex, an index out of
+ * range, a triangle of zero area (repeated or collinear corners). */
+cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt);
+void cff_mesh_destroy(cff_mesh *m);
+
+/* Closest point of the mesh to p, looked for within max_dist (m, >= 0,
+ * inclusive up to round-off; INFINITY for no bound).  Returns 1 and fills q
+ * (closest point on the mesh, m), n (unit outward normal at q: the
+ * triangle's normal, or the angle-weighted pseudo-normal at an edge or
+ * vertex, also when p - q is along a face's normal) and *d (signed
+ * distance, m: > 0 in front of the surface, < 0 behind it; the sign is
+ * exact for a closed, consistently oriented mesh); 0 when no part of the
+ * mesh is within max_dist (outputs untouched); -1 on error (NULL argument,
+ * non-finite p, negative or NaN max_dist). */
+int cff_mesh_closest(const cff_mesh *m, const double p[3], double max_dist, double q[3],
+                     double n[3], double *d);
+
+/* Message of the last failed call (per thread). */
+const char *cff_last_error(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

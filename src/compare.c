@@ -1,0 +1,930 @@
+/* cohfrac — the two rigid backends side by side (see include/cohfrac/compare.h
+ * for the metrics, the reference rules and the files). */
+#include "cohfrac/compare.h"
+#include "cohfrac/scene.h"
+#include "cohfrac/sim.h"
+#include "linalg.h"
+
+#include <errno.h>
+#include <math.h>
+#include <spawn.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+extern char **environ;
+
+static const char *const backend_name[2] = {"bullet", "pbd"};
+
+/* Two principal moments agreeing within this (relative) make a symmetric top. */
+#define TOP_TOLERANCE 1e-3
+#define TWO_PI 6.283185307179586
+
+/* The alive fragments of one run at one sample, with an id -> index map. */
+typedef struct snap {
+    cf_fragment_state *f;
+    int n, cap;
+    int *index; /* [max id + 1]: position in f, -1 when not alive */
+    int index_cap;
+} snap;
+
+typedef struct sample {
+    double t;                    /* s */
+    double com_dist, orient;     /* m, rad: mass-weighted over matched fragments */
+    int nfrag[2];
+    double com[2][3];            /* m, whole-body centre of mass per backend */
+    double ref[3];               /* m, analytic centre of mass (NaN: none) */
+    double ref_err[2];           /* m */
+    double ke[2], p[2], l[2];    /* drifts (see compare.h) */
+    double axis_angle[2];        /* rad, top's symmetry axis about L, wrapped */
+} sample;
+
+/* Everything the reference needs, fixed at t = 0. */
+typedef struct reference {
+    cf_compare_ref kind;
+    double x0[3], v0[3], g[3];   /* m, m/s, m/s^2 */
+    /* bounce */
+    double n[3], e, t1, t2, x1[3], v1[3]; /* plane normal; restitution; contacts, s;
+                                             state just after the first contact */
+    /* symmetric top */
+    int top;
+    double omega_p;              /* rad/s */
+    double Lhat[3], u1[3], u2[3];/* L direction and a basis of the plane normal to it */
+    double e_sym[3];             /* rest frame */
+} reference;
+
+typedef struct totals {
+    double M, E, P[3], L[3], com[3];
+} totals;
+
+/* ---- small helpers ---- */
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double v3_dist(const double a[3], const double b[3])
+{
+    double d[3];
+    v3_sub(a, b, d);
+    return v3_norm(d);
+}
+
+/* Angle of q_a^-1 q_b, rad, in [0, pi]. */
+static double quat_angle(const double a[4], const double b[4])
+{
+    /* conj(a) b: scalar part and the norm of the vector part */
+    double w = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    double x = a[0] * b[1] - a[1] * b[0] - a[2] * b[3] + a[3] * b[2];
+    double y = a[0] * b[2] + a[1] * b[3] - a[2] * b[0] - a[3] * b[1];
+    double z = a[0] * b[3] - a[1] * b[2] + a[2] * b[1] - a[3] * b[0];
+    return 2.0 * atan2(sqrt(x * x + y * y + z * z), fabs(w));
+}
+
+static cf_status snap_take(cf_sim *sim, snap *s, cf_error *err)
+{
+    int n = cf_sim_fragments(sim, NULL, 0);
+    if (n > s->cap) {
+        int cap = n + n / 2 + 4;
+        cf_fragment_state *f = realloc(s->f, (size_t)cap * sizeof *f);
+        if (!f)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for %d fragment states", n);
+        s->f = f, s->cap = cap;
+    }
+    s->n = cf_sim_fragments(sim, s->f, s->cap);
+    int max_id = -1;
+    for (int i = 0; i < s->n; i++)
+        if (s->f[i].id > max_id)
+            max_id = s->f[i].id;
+    if (max_id + 1 > s->index_cap) {
+        int cap = max_id + 1 + (max_id + 1) / 2 + 4;
+        int *ix = realloc(s->index, (size_t)cap * sizeof *ix);
+        if (!ix)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a fragment index");
+        s->index = ix, s->index_cap = cap;
+    }
+    for (int i = 0; i < s->index_cap; i++)
+        s->index[i] = -1;
+    for (int i = 0; i < s->n; i++)
+        s->index[s->f[i].id] = i;
+    return CF_OK;
+}
+
+static void snap_free(snap *s)
+{
+    free(s->f), free(s->index);
+    memset(s, 0, sizeof *s);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* partner[i]: index in sb of the fragment of run b holding the most tets of
+ * sa's fragment i (-1: none); shared[i]: how many.  keys: scratch [tets]. */
+static void match_fragments(const cf_sim *a, const cf_sim *b, const snap *sa, const snap *sb,
+                            uint64_t *keys, int *partner, int *shared)
+{
+    int nt = cf_sim_tet_count(a), nk = 0;
+    for (int t = 0; t < nt; t++) {
+        int fa = cf_sim_tet_fragment(a, t), fb = cf_sim_tet_fragment(b, t);
+        if (fa >= 0 && fb >= 0)
+            keys[nk++] = (uint64_t)fa << 32 | (uint64_t)(uint32_t)fb;
+    }
+    qsort(keys, (size_t)nk, sizeof *keys, cmp_u64);
+    for (int i = 0; i < sa->n; i++)
+        partner[i] = -1, shared[i] = 0;
+    for (int k = 0; k < nk;) {
+        int run = k;
+        while (run < nk && keys[run] == keys[k])
+            run++;
+        int fa = (int)(keys[k] >> 32), fb = (int)(keys[k] & 0xffffffffu);
+        int ia = fa < sa->index_cap ? sa->index[fa] : -1;
+        int ib = fb < sb->index_cap ? sb->index[fb] : -1;
+        if (ia >= 0 && ib >= 0 && run - k > shared[ia])
+            partner[ia] = ib, shared[ia] = run - k;
+        k = run;
+    }
+}
+
+static void sum_totals(const snap *s, const double g[3], totals *o)
+{
+    memset(o, 0, sizeof *o);
+    for (int i = 0; i < s->n; i++) {
+        const cf_fragment_state *f = &s->f[i];
+        o->M += f->mass;
+        o->E += f->kinetic - f->mass * v3_dot(g, f->com);
+        v3_axpy(1.0, f->momentum, o->P);
+        v3_axpy(1.0, f->angular_momentum, o->L);
+        v3_axpy(f->mass, f->com, o->com);
+    }
+    if (o->M > 0)
+        for (int k = 0; k < 3; k++)
+            o->com[k] /= o->M;
+}
+
+static int heaviest(const snap *s)
+{
+    int best = -1;
+    for (int i = 0; i < s->n; i++)
+        if (best < 0 || s->f[i].mass > s->f[best].mass)
+            best = i;
+    return best;
+}
+
+/* ---- the analytic reference ---- */
+
+static void ballistic(const double x0[3], const double v0[3], const double g[3], double t,
+                      double x[3])
+{
+    for (int k = 0; k < 3; k++)
+        x[k] = x0[k] + v0[k] * t + 0.5 * g[k] * t * t;
+}
+
+/* Centre of mass of the reference at t; returns 0 (x NaN) past its validity. */
+static int reference_at(const reference *r, double t, double x[3])
+{
+    if (r->kind == CF_CMP_REF_NONE || (r->kind == CF_CMP_REF_BOUNCE && t > r->t2 + 1e-12)) {
+        x[0] = x[1] = x[2] = NAN;
+        return 0;
+    }
+    if (r->kind == CF_CMP_REF_BOUNCE && t > r->t1)
+        ballistic(r->x1, r->v1, r->g, t - r->t1, x);
+    else
+        ballistic(r->x0, r->v0, r->g, t, x);
+    return 1;
+}
+
+/* Decide the reference from the scene and the state at t = 0 (Bullet run). */
+static void reference_setup(const cf_scene *sc, cf_sim *sim, const snap *first, reference *r)
+{
+    memset(r, 0, sizeof *r);
+    r->kind = CF_CMP_REF_NONE;
+    r->t2 = INFINITY;
+    if (sc->n_bodies != 1 || sc->n_boundaries != 0 || first->n != 1)
+        return;
+    const cf_body_def *b = &sc->bodies[0];
+    const cf_fragment_state *f = &first->f[0];
+    memcpy(r->x0, f->com, sizeof r->x0);
+    memcpy(r->g, sc->gravity, sizeof r->g);
+    /* v0 from the scene's velocity field at the centre of mass (the spin
+     * term vanishes there), not from either backend */
+    for (int k = 0; k < 3; k++) {
+        double c = b->has_expansion_center ? b->expansion_center[k] : f->com[k];
+        r->v0[k] = b->velocity[k] + b->expansion_rate[k] * (f->com[k] - c);
+    }
+    double w0n = v3_norm(b->angular_velocity);
+    if (sc->n_obstacles == 0) {
+        r->kind = v3_norm(r->v0) == 0 ? CF_CMP_REF_FREE_FALL : CF_CMP_REF_PROJECTILE;
+        /* symmetric top: which moment is the distinct one */
+        const double *p = f->principal;
+        int k_sym = -1;
+        for (int k = 0; k < 3; k++) {
+            int i = (k + 1) % 3, j = (k + 2) % 3;
+            double pij = fmax(p[i], p[j]);
+            if (pij > 0 && fabs(p[i] - p[j]) <= TOP_TOLERANCE * pij &&
+                fabs(p[k] - 0.5 * (p[i] + p[j])) > TOP_TOLERANCE * pij)
+                k_sym = k;
+        }
+        if (w0n == 0 || k_sym < 0)
+            return;
+        double I1 = 0.5 * (p[(k_sym + 1) % 3] + p[(k_sym + 2) % 3]);
+        /* L = R0 A diag(p) A^T R0^T w0, A the rest principal axes */
+        double R0[9], RA[9], tmp[3], L[3];
+        quat_to_mat(f->quat, R0);
+        m3_mul(R0, f->axes, RA);
+        m3_tmulv(RA, b->angular_velocity, tmp);
+        for (int k = 0; k < 3; k++)
+            tmp[k] *= p[k];
+        m3_mulv(RA, tmp, L);
+        double Ln = v3_norm(L);
+        for (int k = 0; k < 3; k++) {
+            r->e_sym[k] = f->axes[3 * k + k_sym];
+            r->Lhat[k] = L[k] / Ln;
+        }
+        double a0[3];
+        m3_mulv(R0, r->e_sym, a0);
+        double along = v3_dot(a0, r->Lhat);
+        for (int k = 0; k < 3; k++)
+            r->u1[k] = a0[k] - along * r->Lhat[k];
+        double u1n = v3_norm(r->u1);
+        if (!(u1n > 1e-6)) /* spinning about the symmetry axis: nothing precesses */
+            return;
+        for (int k = 0; k < 3; k++)
+            r->u1[k] /= u1n;
+        v3_cross(r->Lhat, r->u1, r->u2);
+        r->top = 1;
+        r->omega_p = Ln / I1;
+        return;
+    }
+    if (sc->n_obstacles != 1 || sc->obstacles[0].type != CF_OBSTACLE_PLANE ||
+        sc->solver.criterion != CF_CRITERION_NONE || w0n != 0)
+        return;
+    const cf_obstacle *o = &sc->obstacles[0];
+    memcpy(r->n, o->normal, sizeof r->n);
+    double mn[3] = {-r->n[0], -r->n[1], -r->n[2]}, d[3];
+    double h = cf_sim_fragment_support(sim, f->id, mn);
+    v3_sub(r->x0, o->point, d);
+    double s0 = v3_dot(d, r->n), vn0 = v3_dot(r->v0, r->n), gn = v3_dot(r->g, r->n);
+    if (!(gn < 0) || !(s0 > h))
+        return;
+    r->kind = CF_CMP_REF_BOUNCE;
+    r->e = sc->material.restitution * o->restitution;
+    double disc = vn0 * vn0 - 2.0 * gn * (s0 - h);
+    r->t1 = (vn0 + sqrt(disc)) / -gn;
+    double vt1[3];
+    ballistic(r->x0, r->v0, r->g, r->t1, r->x1);
+    for (int k = 0; k < 3; k++)
+        vt1[k] = r->v0[k] + r->g[k] * r->t1;
+    double vn1 = v3_dot(vt1, r->n); /* < 0: approaching */
+    for (int k = 0; k < 3; k++)
+        r->v1[k] = vt1[k] - (1.0 + r->e) * vn1 * r->n[k];
+    r->t2 = r->t1 + 2.0 * (-r->e * vn1) / -gn;
+}
+
+/* Wrapped angle (rad) of the top's symmetry axis about L. */
+static double axis_angle(const reference *r, const cf_fragment_state *f)
+{
+    double R[9], a[3];
+    quat_to_mat(f->quat, R);
+    m3_mulv(R, r->e_sym, a);
+    return atan2(v3_dot(a, r->u2), v3_dot(a, r->u1));
+}
+
+/* ---- sampling ---- */
+
+typedef struct state {
+    cf_sim *sim[2];
+    const cf_scene *scene;
+    snap s[2];
+    uint64_t *keys;
+    int *partner, *shared, match_cap;
+    totals t0[2];
+    double p_scale, T;
+    reference ref;
+    sample *smp;
+    int n_smp, cap_smp;
+} state;
+
+static cf_status take_sample(state *st, cf_error *err)
+{
+    for (int b = 0; b < 2; b++) {
+        cf_status rc = snap_take(st->sim[b], &st->s[b], err);
+        if (rc != CF_OK)
+            return rc;
+    }
+    if (st->n_smp == st->cap_smp) {
+        int cap = 2 * st->cap_smp + 16;
+        sample *p = realloc(st->smp, (size_t)cap * sizeof *p);
+        if (!p)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for samples");
+        st->smp = p, st->cap_smp = cap;
+    }
+    if (st->s[0].n > st->match_cap) {
+        int cap = st->s[0].n + st->s[0].n / 2 + 4;
+        int *p = realloc(st->partner, (size_t)cap * sizeof *p);
+        if (p)
+            st->partner = p;
+        int *q = p ? realloc(st->shared, (size_t)cap * sizeof *q) : NULL;
+        if (!q)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for fragment matching");
+        st->shared = q, st->match_cap = cap;
+    }
+    const snap *sa = &st->s[0], *sb = &st->s[1];
+    match_fragments(st->sim[0], st->sim[1], sa, sb, st->keys, st->partner, st->shared);
+
+    sample *o = &st->smp[st->n_smp];
+    memset(o, 0, sizeof *o);
+    o->t = cf_sim_time(st->sim[0]);
+    double wsum = 0, dsum = 0, asum = 0;
+    for (int i = 0; i < sa->n; i++) {
+        int j = st->partner[i];
+        if (j < 0)
+            continue;
+        wsum += sa->f[i].mass;
+        dsum += sa->f[i].mass * v3_dist(sa->f[i].com, sb->f[j].com);
+        asum += sa->f[i].mass * quat_angle(sa->f[i].quat, sb->f[j].quat);
+    }
+    o->com_dist = wsum > 0 ? dsum / wsum : NAN;
+    o->orient = wsum > 0 ? asum / wsum : NAN;
+    int has_ref = reference_at(&st->ref, o->t, o->ref);
+    const double *g = st->scene->gravity;
+    for (int b = 0; b < 2; b++) {
+        totals tt;
+        sum_totals(&st->s[b], g, &tt);
+        if (st->n_smp == 0) {
+            st->t0[b] = tt;
+            if (b == 0)
+                st->p_scale = fmax(v3_norm(tt.P), tt.M * v3_norm(g) * st->T);
+        }
+        const totals *z = &st->t0[b];
+        o->nfrag[b] = st->s[b].n;
+        memcpy(o->com[b], tt.com, sizeof tt.com);
+        o->ref_err[b] = has_ref ? v3_dist(tt.com, o->ref) : NAN;
+        o->ke[b] = (tt.E - z->E) / (z->E != 0 ? fabs(z->E) : 1.0);
+        double dP[3], dL[3];
+        for (int k = 0; k < 3; k++) {
+            dP[k] = tt.P[k] - z->P[k] - z->M * g[k] * o->t;
+            dL[k] = tt.L[k] - z->L[k];
+        }
+        o->p[b] = v3_norm(dP) / (st->p_scale > 0 ? st->p_scale : 1.0);
+        double l0 = v3_norm(z->L);
+        o->l[b] = v3_norm(dL) / (l0 > 0 ? l0 : 1.0);
+        int h = heaviest(&st->s[b]);
+        o->axis_angle[b] = st->ref.top && h >= 0 ? axis_angle(&st->ref, &st->s[b].f[h]) : NAN;
+    }
+    st->n_smp++;
+    return CF_OK;
+}
+
+/* Least-squares slope of the unwrapped angle series a[0..n) over t; unwraps in place. */
+static double unwrap_slope(const sample *s, int n, double *a)
+{
+    for (int i = 1; i < n; i++) {
+        double d = a[i] - a[i - 1];
+        a[i] -= TWO_PI * floor((d + 0.5 * TWO_PI) / TWO_PI);
+    }
+    double tm = 0, am = 0;
+    for (int i = 0; i < n; i++)
+        tm += s[i].t, am += a[i];
+    tm /= n, am /= n;
+    double num = 0, den = 0;
+    for (int i = 0; i < n; i++)
+        num += (s[i].t - tm) * (a[i] - am), den += (s[i].t - tm) * (s[i].t - tm);
+    return den > 0 ? num / den : NAN;
+}
+
+/* ---- files ---- */
+
+/* mkdir -p */
+static cf_status make_dirs(const char *path, cf_error *err)
+{
+    char d[1024];
+    if (snprintf(d, sizeof d, "%s", path) >= (int)sizeof d)
+        return cf_error_set(err, CF_ERR_OUTPUT, "output directory path too long: %s", path);
+    for (char *p = d + 1;; p++) {
+        if (*p == '/' || *p == 0) {
+            char c = *p;
+            *p = 0;
+            if (mkdir(d, 0777) != 0 && errno != EEXIST)
+                return cf_error_set(err, CF_ERR_OUTPUT, "cannot create directory %s: %s", d,
+                                    strerror(errno));
+            *p = c;
+            if (!c)
+                break;
+        }
+    }
+    struct stat sb;
+    if (stat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
+        return cf_error_set(err, CF_ERR_OUTPUT, "%s is not a directory", path);
+    return CF_OK;
+}
+
+typedef struct outfile {
+    FILE *f;
+    char tmp[1100], final[1100];
+} outfile;
+
+static cf_status out_open(outfile *o, const char *dir, const char *name, cf_error *err)
+{
+    snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
+    snprintf(o->tmp, sizeof o->tmp, "%s/%s.tmp", dir, name);
+    o->f = fopen(o->tmp, "w");
+    if (!o->f)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s: %s", o->tmp, strerror(errno));
+    return CF_OK;
+}
+
+/* Close and move into place: the final name only ever holds a whole file. */
+static cf_status out_close(outfile *o, cf_error *err)
+{
+    int bad = ferror(o->f);
+    bad |= fclose(o->f) != 0;
+    o->f = NULL;
+    if (bad || rename(o->tmp, o->final) != 0) {
+        int e = errno;
+        remove(o->tmp);
+        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s: %s", o->final, strerror(e));
+    }
+    return CF_OK;
+}
+
+/* A number for the report: "—" for NaN. */
+static const char *num(char *buf, size_t n, double x)
+{
+    if (isnan(x))
+        snprintf(buf, n, "—");
+    else
+        snprintf(buf, n, "%.4g", x);
+    return buf;
+}
+
+static const char *ref_name(cf_compare_ref r)
+{
+    switch (r) {
+    case CF_CMP_REF_FREE_FALL: return "free fall";
+    case CF_CMP_REF_PROJECTILE: return "projectile";
+    case CF_CMP_REF_BOUNCE: return "bounce";
+    default: return "none";
+    }
+}
+
+static void row(FILE *f, const char *metric, const char *unit, const double fin[2],
+                const double mx[2])
+{
+    char a[32], b[32], c[32], d[32];
+    const char *closer = "—";
+    if (!isnan(mx[0]) && !isnan(mx[1]))
+        closer = mx[0] < mx[1] ? "bullet" : mx[1] < mx[0] ? "pbd" : "tie";
+    fprintf(f, "| %s | %s | %s | %s | %s | %s | %s |\n", metric, unit, num(a, 32, fin[0]),
+            num(b, 32, mx[0]), num(c, 32, fin[1]), num(d, 32, mx[1]), closer);
+}
+
+static void write_headline(FILE *f, const cf_compare_options *opt, const cf_scene *sc,
+                           const cf_compare_result *r, const reference *ref, cf_status run_st)
+{
+    char a[32], b[32], c[32];
+    fprintf(f, "# Rigid backends compared: %s\n\n", r->scene_name);
+    fprintf(f, "- scene: `%s`", opt->scene);
+    for (int i = 0; i < opt->n_overrides; i++)
+        fprintf(f, " `--set %s`", opt->overrides[i]);
+    fprintf(f, "\n- simulated %.4g s of %.4g s, dt_rigid %.3g s, %d samples every %.3g s\n",
+            r->duration, sc->duration, sc->solver.dt_rigid, r->n_samples,
+            sc->output.frame_interval);
+    fprintf(f, "- backends: **bullet** (Bullet, %d sub-steps per dt_rigid) and **pbd** "
+               "(damped PBD rigid mode: k_damping = 1, k_stiffness %.3g, %d iterations)\n",
+            sc->solver.rigid_substeps, sc->solver.k_stiffness, sc->solver.iterations);
+    double ratio = r->wall[0] > 0 ? r->wall[1] / r->wall[0] : NAN;
+    fprintf(f, "- wall time of the steps: bullet %.3f s, pbd %.3f s (pbd / bullet = %s)\n",
+            r->wall[0], r->wall[1], num(a, 32, ratio));
+    fprintf(f, "- fragments at the end: bullet %d, pbd %d\n", r->n_fragments[0],
+            r->n_fragments[1]);
+    fprintf(f, "- analytic reference: %s", ref_name(r->reference));
+    if (r->reference == CF_CMP_REF_BOUNCE)
+        fprintf(f, " (restitution %.3g, contacts at %.4g s and %.4g s; compared until %.4g s)",
+                ref->e, ref->t1, ref->t2, r->ref_until);
+    if (r->top)
+        fprintf(f, " + symmetric top");
+    fputs("\n", f);
+    if (sc->solver.mode == CF_RUN_FRACTURE)
+        fprintf(f, "- solver.mode = \"fracture\": no rigid mode, so the backend makes no "
+                   "difference\n");
+    if (sc->n_obstacles > 0)
+        fprintf(f, "- drifts include the obstacles' impulses and the energy contact removes "
+                   "(they measure conservation in free flight only)\n");
+    if (run_st != CF_OK)
+        fprintf(f, "- **the runs stopped early: %s**\n", cf_status_name(run_st));
+
+    fprintf(f, "\n| between the backends | unit | final | max |\n|---|---|---|---|\n");
+    fprintf(f, "| COM distance (mass-weighted) | m | %s | %s |\n", num(a, 32, r->com_dist_final),
+            num(b, 32, r->com_dist_max));
+    fprintf(f, "| orientation difference (mass-weighted) | rad | %s | %s |\n",
+            num(a, 32, r->orient_final), num(b, 32, r->orient_max));
+
+    fprintf(f, "\n| metric | unit | bullet final | bullet max | pbd final | pbd max | "
+               "closer |\n|---|---|---|---|---|---|---|\n");
+    if (r->reference != CF_CMP_REF_NONE) {
+        char m[64];
+        snprintf(m, sizeof m, "COM error vs %s", ref_name(r->reference));
+        row(f, m, "m", r->ref_err_final, r->ref_err_max);
+    }
+    row(f, "kinetic-energy drift", "rel.", r->ke_drift_final, r->ke_drift_max);
+    row(f, "linear momentum drift", "rel.", r->p_drift_final, r->p_drift_max);
+    row(f, "angular momentum drift", "rel.", r->l_drift_final, r->l_drift_max);
+    if (r->top) {
+        double fin[2] = {r->omega_measured[0], r->omega_measured[1]};
+        /* one fit over the whole run: final and max are the same figure */
+        row(f, "precession rate error", "rel.", r->omega_rel_err, r->omega_rel_err);
+        fprintf(f, "\nSymmetric top: Ω_p = |L| / I_1\n\n| | precession rate (rad/s) | "
+                   "relative error |\n|---|---|---|\n");
+        fprintf(f, "| analytic | %s | |\n", num(a, 32, r->omega_p));
+        for (int k = 0; k < 2; k++)
+            fprintf(f, "| %s | %s | %s |\n", backend_name[k], num(b, 32, fin[k]),
+                    num(c, 32, r->omega_rel_err[k]));
+    }
+    /* the verdict: closer to the analytic reference, and at what cost */
+    const double *crit = r->top ? r->omega_rel_err
+                         : r->reference != CF_CMP_REF_NONE ? r->ref_err_max
+                                                           : r->ke_drift_max;
+    const char *what = r->top ? "precession rate error"
+                       : r->reference != CF_CMP_REF_NONE ? "max COM error"
+                                                         : "max kinetic-energy drift";
+    /* with obstacles and no reference the drifts mix contact losses in: no verdict */
+    int judged = r->reference != CF_CMP_REF_NONE || sc->n_obstacles == 0;
+    if (judged && !isnan(crit[0]) && !isnan(crit[1]) && r->wall[0] > 0 && r->wall[1] > 0) {
+        int w = crit[1] < crit[0];
+        fprintf(f, "\n**%s is closer%s** (%s %s vs %s) at %s× the wall time of %s.\n",
+                backend_name[w], r->reference != CF_CMP_REF_NONE ? " to the analytic reference"
+                                                                 : " to conservation",
+                what, num(a, 32, crit[w]), num(b, 32, crit[!w]),
+                num(c, 32, r->wall[w] / r->wall[!w]), backend_name[!w]);
+    }
+}
+
+static cf_status write_md(const char *dir, const char *headline, const state *st,
+                          cf_error *err)
+{
+    outfile o;
+    cf_status rc = out_open(&o, dir, "compare.md", err);
+    if (rc != CF_OK)
+        return rc;
+    fputs(headline, o.f);
+    const snap *sa = &st->s[0], *sb = &st->s[1];
+    int *order = malloc((size_t)(sa->n + 1) * sizeof *order);
+    if (!order) {
+        fclose(o.f), remove(o.tmp);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    for (int i = 0; i < sa->n; i++)
+        order[i] = i;
+    int shown = sa->n < 20 ? sa->n : 20;
+    for (int i = 0; i < shown; i++) /* partial selection sort: the 20 heaviest */
+        for (int j = i + 1; j < sa->n; j++)
+            if (sa->f[order[j]].mass > sa->f[order[i]].mass) {
+                int t = order[i];
+                order[i] = order[j], order[j] = t;
+            }
+    fprintf(o.f, "\n## The %d heaviest fragments at the end (of %d in the Bullet run)\n\n",
+            shown, sa->n);
+    fprintf(o.f, "| bullet id | pbd partner | mass (kg) | shared tets | COM distance (m) | "
+                 "orientation difference (rad) |\n|---|---|---|---|---|---|\n");
+    for (int i = 0; i < shown; i++) {
+        const cf_fragment_state *f = &sa->f[order[i]];
+        int j = st->partner[order[i]];
+        if (j < 0) {
+            fprintf(o.f, "| %d | — | %.4g | 0 | — | — |\n", f->id, f->mass);
+            continue;
+        }
+        fprintf(o.f, "| %d | %d | %.4g | %d of %d | %.4g | %.4g |\n", f->id, sb->f[j].id,
+                f->mass, st->shared[order[i]], f->n_tets, v3_dist(f->com, sb->f[j].com),
+                quat_angle(f->quat, sb->f[j].quat));
+    }
+    fprintf(o.f, "\nFiles: `compare.csv` (time series), `fragments.csv` (every fragment at "
+                 "the end), `compare.png` (plots by tools/compare_plot.py, when "
+                 "python3-matplotlib is installed).\n");
+    free(order);
+    return out_close(&o, err);
+}
+
+static void csv_num(FILE *f, double x) { fprintf(f, isnan(x) ? ",nan" : ",%.10g", x); }
+
+static cf_status write_csv(const char *dir, const state *st, cf_error *err)
+{
+    outfile o;
+    cf_status rc = out_open(&o, dir, "compare.csv", err);
+    if (rc != CF_OK)
+        return rc;
+    fprintf(o.f, "time,com_dist,orient_diff,n_frag_bullet,n_frag_pbd,"
+                 "com_x_bullet,com_y_bullet,com_z_bullet,com_x_pbd,com_y_pbd,com_z_pbd,"
+                 "ref_x,ref_y,ref_z,ref_err_bullet,ref_err_pbd,ke_drift_bullet,ke_drift_pbd,"
+                 "p_drift_bullet,p_drift_pbd,l_drift_bullet,l_drift_pbd,"
+                 "axis_angle_bullet,axis_angle_pbd,axis_angle_ref\n");
+    for (int i = 0; i < st->n_smp; i++) {
+        const sample *s = &st->smp[i];
+        fprintf(o.f, "%.10g", s->t);
+        csv_num(o.f, s->com_dist), csv_num(o.f, s->orient);
+        fprintf(o.f, ",%d,%d", s->nfrag[0], s->nfrag[1]);
+        for (int b = 0; b < 2; b++)
+            for (int k = 0; k < 3; k++)
+                csv_num(o.f, s->com[b][k]);
+        for (int k = 0; k < 3; k++)
+            csv_num(o.f, s->ref[k]);
+        csv_num(o.f, s->ref_err[0]), csv_num(o.f, s->ref_err[1]);
+        csv_num(o.f, s->ke[0]), csv_num(o.f, s->ke[1]);
+        csv_num(o.f, s->p[0]), csv_num(o.f, s->p[1]);
+        csv_num(o.f, s->l[0]), csv_num(o.f, s->l[1]);
+        csv_num(o.f, s->axis_angle[0]), csv_num(o.f, s->axis_angle[1]);
+        /* analytic: starts where the Bullet run's axis starts */
+        csv_num(o.f, st->ref.top ? st->smp[0].axis_angle[0] + st->ref.omega_p * s->t : NAN);
+        fputc('\n', o.f);
+    }
+    return out_close(&o, err);
+}
+
+static cf_status write_fragments_csv(const char *dir, const state *st, cf_error *err)
+{
+    outfile o;
+    cf_status rc = out_open(&o, dir, "fragments.csv", err);
+    if (rc != CF_OK)
+        return rc;
+    const snap *sa = &st->s[0], *sb = &st->s[1];
+    fprintf(o.f, "id_bullet,id_pbd,mass_bullet,mass_pbd,n_tets_bullet,shared_tets,"
+                 "com_dist,orient_diff,speed_bullet,speed_pbd,kinetic_bullet,kinetic_pbd,"
+                 "qw_bullet,qx_bullet,qy_bullet,qz_bullet,qw_pbd,qx_pbd,qy_pbd,qz_pbd,"
+                 "wx_bullet,wy_bullet,wz_bullet,wx_pbd,wy_pbd,wz_pbd\n");
+    for (int i = 0; i < sa->n; i++) {
+        const cf_fragment_state *f = &sa->f[i];
+        int j = st->partner[i];
+        const cf_fragment_state *g = j >= 0 ? &sb->f[j] : NULL;
+        fprintf(o.f, "%d,%d,%.10g", f->id, g ? g->id : -1, f->mass);
+        csv_num(o.f, g ? g->mass : NAN);
+        fprintf(o.f, ",%d,%d", f->n_tets, st->shared[i]);
+        csv_num(o.f, g ? v3_dist(f->com, g->com) : NAN);
+        csv_num(o.f, g ? quat_angle(f->quat, g->quat) : NAN);
+        csv_num(o.f, v3_norm(f->v));
+        csv_num(o.f, g ? v3_norm(g->v) : NAN);
+        csv_num(o.f, f->kinetic);
+        csv_num(o.f, g ? g->kinetic : NAN);
+        for (int k = 0; k < 4; k++)
+            csv_num(o.f, f->quat[k]);
+        for (int k = 0; k < 4; k++)
+            csv_num(o.f, g ? g->quat[k] : NAN);
+        for (int k = 0; k < 3; k++)
+            csv_num(o.f, f->w[k]);
+        for (int k = 0; k < 3; k++)
+            csv_num(o.f, g ? g->w[k] : NAN);
+        fputc('\n', o.f);
+    }
+    return out_close(&o, err);
+}
+
+/* tools/compare_plot.py: the given path, ./tools/, or ../tools/ of the executable. */
+static int find_plot_script(const cf_compare_options *opt, char *out, size_t n)
+{
+    if (opt->plot_script) {
+        snprintf(out, n, "%s", opt->plot_script);
+        return access(out, R_OK) == 0;
+    }
+    snprintf(out, n, "tools/compare_plot.py");
+    if (access(out, R_OK) == 0)
+        return 1;
+    char exe[900];
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (len <= 0)
+        return 0;
+    exe[len] = 0;
+    char *slash = strrchr(exe, '/');
+    if (slash)
+        *slash = 0;
+    snprintf(out, n, "%s/../tools/compare_plot.py", exe);
+    return access(out, R_OK) == 0;
+}
+
+/* Make compare.png; returns 1 when it was written (warnings on stderr otherwise). */
+static int run_plot(const cf_compare_options *opt, const char *dir, const cf_compare_result *r)
+{
+    char script[1024], csv[1100], png[1100], title[300];
+    if (!find_plot_script(opt, script, sizeof script)) {
+        fprintf(stderr, "cohfrac: warning: tools/compare_plot.py not found: no compare.png "
+                        "(compare.md and compare.csv are written)\n");
+        return 0;
+    }
+    snprintf(csv, sizeof csv, "%s/compare.csv", dir);
+    snprintf(png, sizeof png, "%s/compare.png", dir);
+    snprintf(title, sizeof title, "%s (reference: %s%s)", r->scene_name, ref_name(r->reference),
+             r->top ? ", symmetric top" : "");
+    const char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+    char *argv[] = {(char *)py, script, csv, png, title, NULL};
+    pid_t pid;
+    int rc = posix_spawnp(&pid, py, NULL, NULL, argv, environ);
+    int status = 0;
+    if (rc == 0 && waitpid(pid, &status, 0) < 0)
+        rc = errno;
+    if (rc != 0) {
+        fprintf(stderr, "cohfrac: warning: cannot run python3 (%s): no compare.png; install "
+                        "python3 and python3-matplotlib\n", strerror(rc));
+        return 0;
+    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && access(png, R_OK) == 0)
+        return 1;
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 3)
+        fprintf(stderr, "cohfrac: warning: matplotlib is missing (install the Debian package "
+                        "python3-matplotlib): no compare.png; compare.md and compare.csv are "
+                        "written\n");
+    else
+        fprintf(stderr, "cohfrac: warning: %s %s failed (status %d): no compare.png "
+                        "(needs python3-matplotlib)\n", py, script,
+                WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    return 0;
+}
+
+/* ---- the run ---- */
+
+static void summarise(const state *st, cf_compare_result *r)
+{
+    const sample *s = st->smp;
+    int n = st->n_smp;
+    r->n_samples = n;
+    r->duration = n ? s[n - 1].t : 0;
+    r->com_dist_max = r->orient_max = 0;
+    for (int b = 0; b < 2; b++) {
+        r->n_fragments[b] = st->s[b].n;
+        r->ke_drift_max[b] = r->p_drift_max[b] = r->l_drift_max[b] = 0;
+        r->ref_err_max[b] = r->ref_err_final[b] = NAN;
+    }
+    r->ref_until = NAN;
+    for (int i = 0; i < n; i++) {
+        r->com_dist_max = fmax(r->com_dist_max, s[i].com_dist);
+        r->orient_max = fmax(r->orient_max, s[i].orient);
+        for (int b = 0; b < 2; b++) {
+            r->ke_drift_max[b] = fmax(r->ke_drift_max[b], fabs(s[i].ke[b]));
+            r->p_drift_max[b] = fmax(r->p_drift_max[b], s[i].p[b]);
+            r->l_drift_max[b] = fmax(r->l_drift_max[b], s[i].l[b]);
+            if (!isnan(s[i].ref_err[b])) {
+                r->ref_err_final[b] = s[i].ref_err[b];
+                r->ref_err_max[b] = isnan(r->ref_err_max[b])
+                                        ? s[i].ref_err[b]
+                                        : fmax(r->ref_err_max[b], s[i].ref_err[b]);
+                r->ref_until = s[i].t;
+            }
+        }
+    }
+    if (n) {
+        r->com_dist_final = s[n - 1].com_dist;
+        r->orient_final = s[n - 1].orient;
+        for (int b = 0; b < 2; b++) {
+            r->ke_drift_final[b] = s[n - 1].ke[b];
+            r->p_drift_final[b] = s[n - 1].p[b];
+            r->l_drift_final[b] = s[n - 1].l[b];
+        }
+    }
+    r->reference = st->ref.kind;
+    r->top = st->ref.top;
+    r->omega_p = st->ref.top ? st->ref.omega_p : NAN;
+    for (int b = 0; b < 2; b++)
+        r->omega_measured[b] = r->omega_rel_err[b] = NAN;
+    if (st->ref.top && n >= 3) {
+        double *a = malloc((size_t)n * sizeof *a);
+        for (int b = 0; a && b < 2; b++) {
+            for (int i = 0; i < n; i++)
+                a[i] = s[i].axis_angle[b];
+            r->omega_measured[b] = unwrap_slope(s, n, a);
+            r->omega_rel_err[b] = fabs(r->omega_measured[b] - r->omega_p) / r->omega_p;
+        }
+        free(a);
+    }
+}
+
+cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, cf_error *err)
+{
+    static const char *const extra[2][3] = {
+        {"solver.rigid_backend=\"bullet\"", "output.file=\"\"", NULL},
+        {"solver.rigid_backend=\"pbd\"", "solver.pbd.k_damping=1", "output.file=\"\""}};
+    const char *mesh_dir = opt->mesh_dir ? opt->mesh_dir : "build/meshes";
+    cf_compare_result local, *r = res ? res : &local;
+    memset(r, 0, sizeof *r);
+    cf_scene sc[2];
+    memset(sc, 0, sizeof sc);
+    state st;
+    memset(&st, 0, sizeof st);
+    cf_status rc = CF_OK, run_st = CF_OK;
+    const char **sets = malloc((size_t)(opt->n_overrides + 3) * sizeof *sets);
+    if (!sets)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+
+    for (int b = 0; b < 2 && rc == CF_OK; b++) {
+        int n = 0;
+        for (int i = 0; i < opt->n_overrides; i++)
+            sets[n++] = opt->overrides[i];
+        for (int i = 0; i < 3 && extra[b][i]; i++)
+            sets[n++] = extra[b][i];
+        rc = cf_scene_load(opt->scene, sets, n, mesh_dir, &sc[b], err);
+    }
+    free(sets);
+    cf_run_options ro = {.progress = 0, .threads = opt->threads, .mesh_dir = mesh_dir};
+    for (int b = 0; b < 2 && rc == CF_OK; b++)
+        rc = cf_sim_create(&sc[b], &ro, &st.sim[b], err);
+    if (rc == CF_OK && cf_sim_tet_count(st.sim[0]) != cf_sim_tet_count(st.sim[1]))
+        rc = cf_error_set(err, CF_ERR_SCENE_VALUE, "the two runs of %s have different meshes",
+                          opt->scene);
+    if (rc == CF_OK) {
+        st.keys = malloc(((size_t)cf_sim_tet_count(st.sim[0]) + 1) * sizeof *st.keys);
+        if (!st.keys)
+            rc = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    if (rc != CF_OK)
+        goto done;
+    st.scene = &sc[0];
+    st.T = sc[0].duration;
+    snprintf(r->scene_name, sizeof r->scene_name, "%s", sc[0].name);
+    if (opt->out_dir)
+        snprintf(r->out_dir, sizeof r->out_dir, "%s", opt->out_dir);
+    else
+        snprintf(r->out_dir, sizeof r->out_dir, "build/compare/%s", sc[0].name);
+    /* fail on an unwritable directory before spending the run's time */
+    if ((rc = make_dirs(r->out_dir, err)) != CF_OK)
+        goto done;
+
+    if ((rc = snap_take(st.sim[0], &st.s[0], err)) != CF_OK)
+        goto done;
+    reference_setup(&sc[0], st.sim[0], &st.s[0], &st.ref);
+    if ((rc = take_sample(&st, err)) != CF_OK)
+        goto done;
+    double dt = sc[0].solver.dt_rigid, every = sc[0].output.frame_interval;
+    double next = every, next_report = 0.1 * st.T;
+    cf_error run_err = {0};
+    while (!cf_sim_done(st.sim[0]) || !cf_sim_done(st.sim[1])) {
+        for (int b = 0; b < 2 && run_st == CF_OK; b++) {
+            if (cf_sim_done(st.sim[b]))
+                continue;
+            double t0 = now_s();
+            run_st = cf_sim_advance(st.sim[b], &run_err);
+            r->wall[b] += now_s() - t0;
+            if (run_st != CF_OK)
+                fprintf(stderr, "cohfrac: %s run: error [%s]: %s\n", backend_name[b],
+                        cf_status_name(run_st), run_err.msg);
+        }
+        if (run_st != CF_OK)
+            break;
+        double t = cf_sim_time(st.sim[0]);
+        int done = cf_sim_done(st.sim[0]) && cf_sim_done(st.sim[1]);
+        if (t >= next - 1e-9 * dt || done) {
+            if ((rc = take_sample(&st, err)) != CF_OK)
+                goto done;
+            while (next <= t + 1e-9 * dt)
+                next += every;
+        }
+        if (opt->progress && t >= next_report) {
+            fprintf(stderr, "compare: t = %.4g of %.4g s, wall bullet %.2f s, pbd %.2f s\n", t,
+                    st.T, r->wall[0], r->wall[1]);
+            next_report += 0.1 * st.T;
+        }
+    }
+    summarise(&st, r);
+
+    /* the files: the headline in memory first (it also goes to opt->headline) */
+    char *head = NULL;
+    size_t head_len = 0;
+    FILE *hf = open_memstream(&head, &head_len);
+    if (!hf) {
+        rc = cf_error_set(err, CF_ERR_NOMEM, "out of memory for the report");
+        goto done;
+    }
+    write_headline(hf, opt, &sc[0], r, &st.ref, run_st);
+    fclose(hf);
+    rc = write_md(r->out_dir, head, &st, err);
+    if (rc == CF_OK)
+        rc = write_csv(r->out_dir, &st, err);
+    if (rc == CF_OK)
+        rc = write_fragments_csv(r->out_dir, &st, err);
+    if (rc == CF_OK && opt->headline)
+        fputs(head, opt->headline);
+    free(head);
+    if (rc == CF_OK && opt->plot)
+        r->plot_made = run_plot(opt, r->out_dir, r);
+    if (rc == CF_OK && run_st != CF_OK) {
+        if (err)
+            *err = run_err;
+        rc = run_st;
+    }
+
+done:
+    for (int b = 0; b < 2; b++) {
+        cf_sim_destroy(st.sim[b]);
+        cf_scene_free(&sc[b]);
+        snap_free(&st.s[b]);
+    }
+    free(st.keys), free(st.partner), free(st.shared), free(st.smp);
+    return rc;
+}

@@ -1,0 +1,58 @@
+/* Contact of fracture-mode nodes with rigid fragments (DESIGN §5): each node
+ * is a point pushed out of the convex hulls of the Bullet bodies near its
+ * fragment (penetration by Minkowski portal refinement in libccd), and the impulse
+ * that push gives the node goes back to the body, so linear momentum is
+ * conserved across the coupling. */
+#ifndef COHFRAC_CONTACT_H
+#define COHFRAC_CONTACT_H
+
+typedef struct cf_sim cf_sim;
+
+/* Convex hulls of the rigid bodies near one fragment, in world coordinates
+ * at the bodies' poses after the rigid step (they stay put while the
+ * fragment is sub-cycled). */
+typedef struct cf_hull_set {
+    int n;             /* hulls */
+    double *pts;       /* [start[n]][3] world vertices, m */
+    int *start;        /* [n + 1] */
+    double *lo, *hi;   /* [n][3] bounding box of each hull, m */
+    double *center;    /* [n][3] centroid of each hull's vertices, m */
+    int *frag;         /* [n] fragment owning the hull */
+    double tolerance;  /* m, MPR tolerance */
+} cf_hull_set;
+
+/* Per-node impulse bookkeeping of one fragment during a rigid step. */
+typedef struct cf_node_impulses {
+    int n;             /* nodes of the fragment */
+    int *frag;         /* [n] body fragment the node pushed, -1 none */
+    double *J;         /* [n][3] impulse given to the node, N s */
+    double *point;     /* [n][3] last contact point, m */
+} cf_node_impulses;
+
+/* Hulls of every rigid Bullet fragment whose box overlaps fragment fi's
+ * node box (grown by `pad` m).  Returns 0, or -1 out of memory. */
+int cf_hull_set_gather(cf_sim *sim, int fi, double pad, cf_hull_set *hs);
+void cf_hull_set_free(cf_hull_set *hs);
+
+/* Push the predicted position p of a node at x out of every hull of hs
+ * that contains p but not x, onto the hull face it crossed.  A
+ * node already inside at the start of the step (a hull bridging a concave
+ * crack face over its neighbour) is left alone rather than thrown out in
+ * one step.  Returns the index of the last hull that pushed it, or -1. */
+int cf_hull_set_project(const cf_hull_set *hs, const double x[3], double p[3]);
+
+/* Make room for n nodes (new ones with no impulse).  0, or -1 out of memory. */
+int cf_node_impulses_reserve(cf_node_impulses *ni, int n);
+
+/* Node i gave impulse -dJ (N s) to body fragment `frag` at `point`.  A node
+ * that pushes a second body in one rigid step hands it the whole sum. */
+void cf_node_impulses_add(cf_node_impulses *ni, int i, int frag, const double dJ[3],
+                          const double point[3]);
+void cf_node_impulses_free(cf_node_impulses *ni);
+
+/* Apply minus each node's accumulated impulse to the body it pushed, at its
+ * contact point, add its size to the body fragment's `pushed`, and clear the
+ * record.  Returns the kinetic energy the bodies gained, J. */
+double cf_node_impulses_flush(cf_sim *sim, cf_node_impulses *ni);
+
+#endif
