@@ -212,6 +212,37 @@ static int collect_cohesive(cf_sim *sim, cf_fragment *f)
     return 0;
 }
 
+/* Momentum-preserving rigid velocities: v = P/M, w = (R I_rest R^T)^-1 L. */
+static void rigid_velocity(const cf_fragment *f, const cf_node_state *ns, double w[3])
+{
+    double RQ[9], D[9] = {0}, I[9], tmp[9], Iinv[9];
+    m3_mul(ns->R, f->Q, RQ);
+    D[0] = f->principal[0], D[4] = f->principal[1], D[8] = f->principal[2];
+    m3_mul(RQ, D, tmp);
+    m3_mul_nt(tmp, RQ, I);
+    w[0] = w[1] = w[2] = 0;
+    if (m3_inv(I, Iinv) != 0)
+        m3_mulv(Iinv, ns->L, w);
+}
+
+/* Put fragment f's nodes on the rigid motion (com, R rest -> current, v, w):
+ * x = R (X - X_cm) + com, v = v + w x (x - com). */
+static void place_rigid(cf_solid *s, const cf_fragment *f, const double com[3], const double R[9],
+                        const double v[3], const double w[3])
+{
+    for (int i = 0; i < f->nodes.n; i++) {
+        int a = f->nodes.v[i];
+        double r[3], x[3], wr[3];
+        v3_sub(&s->X[3 * a], f->com_rest, r);
+        m3_mulv(R, r, x);
+        v3_cross(w, x, wr);
+        for (int k = 0; k < 3; k++) {
+            s->x[3 * a + k] = com[k] + x[k];
+            s->v[3 * a + k] = v[k] + wr[k];
+        }
+    }
+}
+
 cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
@@ -221,23 +252,26 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
         state_momenta(f, st, P0, L0);
     else
         fragment_momenta(sim, fi, P0, L0);
-    if (st) { /* from Bullet: x = R (X - X_cm) + c, v = v_c + w x (x - c) */
+    /* Fracture mode starts from the rigid motion: from the Bullet body, or,
+     * with the pbd backend, from its nodes' best rigid fit (shape matching)
+     * and momenta, so that the bars start at rest length instead of
+     * releasing the residual strain of the long rigid step at dt_fracture. */
+    double loss = 0;
+    if (st) {
         double Rb[9], R[9];
         quat_to_mat(st->quat, Rb);
         m3_mul_nt(Rb, f->Q, R);
-        for (int i = 0; i < f->nodes.n; i++) {
-            int a = f->nodes.v[i];
-            double r[3], x[3], wr[3];
-            v3_sub(&s->X[3 * a], f->com_rest, r);
-            m3_mulv(R, r, x);
-            v3_cross(st->w, x, wr);
-            for (int k = 0; k < 3; k++) {
-                s->x[3 * a + k] = st->pos[k] + x[k];
-                s->v[3 * a + k] = st->v[k] + wr[k];
-            }
-        }
+        place_rigid(s, f, st->pos, R, st->v, st->w);
         cfb_remove_body(sim->bullet, f->body);
         f->body = -1;
+    } else {
+        cf_node_state ns;
+        double w[3];
+        cf_nodes_state(s, f->nodes.v, f->nodes.n, f->q_match, &ns);
+        rigid_velocity(f, &ns, w);
+        place_rigid(s, f, ns.com, ns.R, ns.v, w);
+        loss = ns.ke - (0.5 * ns.M * v3_dot(ns.v, ns.v) + 0.5 * v3_dot(w, ns.L));
+        sim->flow.handoff += loss;
     }
     f->mode = CF_MODE_FRACTURE;
     f->steps = f->quiet = 0;
@@ -246,7 +280,7 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
     fragment_momenta(sim, fi, P1, L1);
-    return record_handoff(sim, fi, 0, P0, L0, P1, L1, 0.0, err);
+    return record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, err);
 }
 
 /* Give the new fragment `ci` the tets of component `c` and their nodes. */
@@ -278,19 +312,6 @@ static int take_component(cf_sim *sim, int ci, const int *tets, const int *comp,
         }
     }
     return 0;
-}
-
-/* Momentum-preserving rigid velocities: v = P/M, w = (R I_rest R^T)^-1 L. */
-static void rigid_velocity(const cf_fragment *f, const cf_node_state *ns, double w[3])
-{
-    double RQ[9], D[9] = {0}, I[9], tmp[9], Iinv[9];
-    m3_mul(ns->R, f->Q, RQ);
-    D[0] = f->principal[0], D[4] = f->principal[1], D[8] = f->principal[2];
-    m3_mul(RQ, D, tmp);
-    m3_mul_nt(tmp, RQ, I);
-    w[0] = w[1] = w[2] = 0;
-    if (m3_inv(I, Iinv) != 0)
-        m3_mulv(Iinv, ns->L, w);
 }
 
 /* Siblings whose hulls overlap at birth (a hull bridging a concave crack

@@ -40,6 +40,13 @@ static int setup(void **state)
         return -1;
     fprintf(f, "1 4 0\n1 1 3 2 4\n");
     fclose(f);
+    /* A 4 m x 4 m ground of two triangles at z = 0, facing up. */
+    snprintf(path, sizeof path, "%s/ground.obj", dir);
+    f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fprintf(f, "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nf 1 2 3\nf 1 3 4\n");
+    fclose(f);
     return 0;
 }
 
@@ -246,12 +253,61 @@ static void test_reentry_keeps_the_family_tree(void **state)
     cf_scene_free(&sc);
 }
 
+/* An elastic box in fracture mode dropped on the ground: as a plane, and
+ * as a triangle mesh through FCL. */
+static const char *ground_scene =
+    "return {\n"
+    "  name = 'ground', duration = 0.25,\n"
+    "  material = {E = 1e5, nu = 0.3, rho = 1000, friction = 0.5, restitution = 0},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {2, 2, 2}},\n"
+    "             position = {0.3, -0.2, 0.1}, velocity = {0.5, 0, 0}}},\n"
+    "  obstacles = {%s},\n"
+    "  solver = {mode = 'fracture', criterion = 'none', dt_rigid = 1e-3, dt_fracture = 1e-4},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void run_ground(const char *obstacle, cf_fragment_state *out)
+{
+    char text[2048];
+    snprintf(text, sizeof text, ground_scene, obstacle);
+    cf_scene sc;
+    cf_sim *sim = make_sim(text, &sc);
+    cf_error err = {0};
+    while (!cf_sim_done(sim))
+        if (cf_sim_advance(sim, &err) != CF_OK)
+            fail_msg("run: %s", err.msg);
+    assert_int_equal(cf_sim_fragments(sim, out, 1), 1);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
+/* The mesh ground holds the box exactly where the plane does: the closest
+ * point on a flat triangle is the plane's projection, with the same normal,
+ * friction and restitution. */
+static void test_mesh_obstacle_matches_plane(void **state)
+{
+    (void)state;
+    cf_fragment_state plane, mesh;
+    char obstacle[600];
+    run_ground("{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}", &plane);
+    snprintf(obstacle, sizeof obstacle, "{type = 'mesh', file = '%s/ground.obj'}", dir);
+    run_ground(obstacle, &mesh);
+    double d = 0;
+    for (int k = 0; k < 3; k++)
+        d = fmax(d, fabs(plane.com[k] - mesh.com[k]));
+    printf("FIGURE mesh obstacle: resting centre of mass z = %.9f m (plane), %.9f m (mesh), "
+           "largest difference %.3g m\n", plane.com[2], mesh.com[2], d);
+    assert_true(plane.com[2] > 0.045 && plane.com[2] < 0.055); /* resting on its face */
+    assert_true(d < 1e-9);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_momentum_across_fracture_mode_contact),
         cmocka_unit_test(test_determinism_hash),
         cmocka_unit_test(test_reentry_keeps_the_family_tree),
+        cmocka_unit_test(test_mesh_obstacle_matches_plane),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
