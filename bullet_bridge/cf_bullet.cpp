@@ -561,34 +561,12 @@ int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const 
                       int n, double margin, const cfb_state *s, double friction,
                       double restitution)
 {
-    if (!w) {
-        set_error("world is NULL");
-        return -1;
-    }
-    if (!mass_props_valid(mass, inertia)) return -1;
     if (!pts || n < 4) {
         set_error("a hull needs at least 4 points (got %d)", pts ? n : 0);
         return -1;
     }
-    for (int i = 0; i < n; ++i) {
-        if (!finite3(pts + 3 * i)) {
-            set_error("hull point %d is non-finite", i);
-            return -1;
-        }
-    }
-    if (!std::isfinite(margin) || margin < 0.0) {
-        set_error("margin must be finite and >= 0");
-        return -1;
-    }
-    if (!state_valid(s) || !friction_valid(friction, restitution)) return -1;
-
-    int nv = 0;
-    btConvexHullShape *shape = hull_shape(pts, n, margin, &nv);
-    if (!shape) {
-        set_error("hull points are degenerate (%d hull vertices)", nv);
-        return -1;
-    }
-    return add_dynamic(w, shape, mass, inertia, s, friction, restitution);
+    const int start[2] = {0, n};  // one hull: a plain convex hull shape
+    return cfb_add_compound_body(w, mass, inertia, pts, start, 1, margin, s, friction, restitution);
 }
 
 int cfb_convex_hull(const double *pts, int n, double *out, double *volume)
