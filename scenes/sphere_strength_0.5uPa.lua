@@ -8,15 +8,17 @@
 -- k_damping = 1, 3 iterations, insertion rule "source".  Geometry is ours:
 -- a solid sphere of radius 0.5 m dropped from 1 m (bottom), hitting at
 -- t = 0.45 s at 4.4 m/s.
--- Expected: it breaks "even more" than at 5 mPa (here into nearly every tet).
--- Finer mesh: --set bodies[1].mesh.mesh_size=0.05 (~2x the tets)
--- Wall time here (2 cores): see README "Scenes".
+-- Expected: it breaks "even more" than at 5 mPa: here into nearly every tet
+-- (~2,650 pieces), which then costs most of the wall time in Bullet.
+-- Finer mesh: --set bodies[1].mesh.mesh_size=0.07 (7,458 tets; default 2,704;
+-- ~7,400 pieces, over an hour here)
+-- Wall time here (2 shared cores, tools/scene_times.sh): 4.6 min (Bullet with ~2,600 pieces).
 return {
   name = "sphere_strength_0.5uPa",
-  duration = 1.0,
+  duration = 0.6,               -- 0.15 s after the impact
   material = { E = 100, nu = 0.1, rho = 2400, G_I = 22, sigma_max = 5e-7, alpha = 2 },
   bodies = { {
-    mesh = { type = "sphere", radius = 0.5, mesh_size = 0.07 },
+    mesh = { type = "sphere", radius = 0.5, mesh_size = 0.1 },
     position = {0, 0, 1.5},
   } },
   obstacles = { { type = "plane", point = {0, 0, 0}, normal = {0, 0, 1} } },

@@ -314,48 +314,6 @@ static int take_component(cf_sim *sim, int ci, const int *tets, const int *comp,
     return 0;
 }
 
-/* Siblings whose hulls overlap at birth (a hull bridging a concave crack
- * face) would be pushed apart by Bullet at the speed that resolves the
- * overlap: such pairs do not collide until they have parted.  Touching
- * within a few margins is left to Bullet. */
-static int separate_siblings(cf_sim *sim, int first, int k)
-{
-    for (int a = first; a < first + k; a++)
-        for (int b = a + 1; b < first + k; b++) {
-            double lo[2][3], hi[2][3];
-            int ia = sim->frag[a].body, ib = sim->frag[b].body;
-            cfb_get_aabb(sim->bullet, ia, lo[0], hi[0]);
-            cfb_get_aabb(sim->bullet, ib, lo[1], hi[1]);
-            int apart = 0;
-            for (int d = 0; d < 3; d++)
-                apart |= lo[0][d] > hi[1][d] || lo[1][d] > hi[0][d];
-            if (apart || cfb_pair_penetration(sim->bullet, ia, ib) <= CF_SIBLING_TOUCH *
-                                                                         cf_fragment_margin(sim, b))
-                continue;
-            cfb_ignore_pair(sim->bullet, ia, ib);
-            if (cf_int_list_push(&sim->parting, a) || cf_int_list_push(&sim->parting, b))
-                return -1;
-        }
-    return 0;
-}
-
-void cf_release_parted(cf_sim *sim)
-{
-    int n = 0;
-    for (int i = 0; i < sim->parting.n; i += 2) {
-        int a = sim->parting.v[i], b = sim->parting.v[i + 1];
-        int ia = sim->frag[a].body, ib = sim->frag[b].body;
-        if (ia < 0 || ib < 0)
-            continue; /* one left rigid mode: its body is gone */
-        if (cfb_pair_penetration(sim->bullet, ia, ib) == 0) {
-            cfb_unignore_pair(sim->bullet, ia, ib);
-            continue;
-        }
-        sim->parting.v[n++] = a, sim->parting.v[n++] = b;
-    }
-    sim->parting.n = n;
-}
-
 double cf_fragment_margin(const cf_sim *sim, int fi)
 {
     return 1e-3 * cbrt(sim->frag[fi].mass / sim->solid.mat.rho);
@@ -427,9 +385,16 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
             cf_fragment_ledger_reset(sim, ci);
         }
     }
-    if (sim->bullet && k > 1 && separate_siblings(sim, first, k)) {
-        free(tets), free(comp), free(seen);
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
+    /* Fragments of one initial body do not collide with each other in
+     * Bullet: their hulls may overlap where a crack face is not convex, and
+     * thousands of touching pieces would dominate Bullet's narrow phase
+     * (about 14 times the rigid-step cost on a shattering sphere). */
+    if (sim->bullet) {
+        int root = fi;
+        while (sim->frag[root].parent >= 0)
+            root = sim->frag[root].parent;
+        for (int a = 0; a < k; a++)
+            cfb_set_family(sim->bullet, sim->frag[first + a].body, root);
     }
     if (sim->bullet || k > 1)
         cf_bars_free(&sim->frag[fi].bars);

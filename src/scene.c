@@ -1106,6 +1106,14 @@ static cf_status read_sleeping(loader *ld, int t, cf_solver_settings *s)
     TRY(check_keys(ld, t, sleeping_keys, COUNT(sleeping_keys)));
     TRY(get_num(ld, t, "linear", &zero, &NON_NEGATIVE, &s->sleep_linear));
     TRY(get_num(ld, t, "angular", &zero, &NON_NEGATIVE, &s->sleep_angular));
+    /* Bullet compares both speeds: a 0 in one would keep every body awake. */
+    if ((s->sleep_linear > 0.0) != (s->sleep_angular > 0.0)) {
+        char a[40], b[40];
+        return fail(ld, CF_ERR_SCENE_VALUE,
+                    "'%s' needs linear and angular both > 0 (or both 0: no sleeping), got "
+                    "linear = %s m/s, angular = %s rad/s",
+                    ld->path, shortest(a, s->sleep_linear), shortest(b, s->sleep_angular));
+    }
     return CF_OK;
 }
 

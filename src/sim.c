@@ -95,10 +95,8 @@ static cf_status load_mesh(const cf_body_def *bd, const char *mesh_dir, cf_mesh 
             if (err) {
                 char why[sizeof err->msg];
                 memcpy(why, err->msg, sizeof why);
-                cf_error_set(err, st, "%s mesh %s, hollow_layers = %d: %s",
-                             bd->mesh[0] ? "body" : "primitive",
-                             bd->mesh[0] ? bd->mesh : "(meshed from the scene)",
-                             bd->hollow_layers, why);
+                cf_error_set(err, st, "hollow_layers = %d on %s: %s", bd->hollow_layers,
+                             bd->mesh[0] ? bd->mesh : "the body's primitive mesh", why);
             }
             cf_mesh_free(m);
         }
@@ -485,7 +483,6 @@ void cf_sim_destroy(cf_sim *sim)
         cff_mesh_destroy(sim->obs.mesh[j]);
     free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
     cf_hull_set_free(&sim->near);
-    free(sim->parting.v);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
     cf_solid_free(&sim->solid);
@@ -829,7 +826,6 @@ static cf_status bullet_step(cf_sim *sim, double dt, cf_error *err)
         sim->flow.contact += removed;
     }
     free(pre);
-    cf_release_parted(sim);
     sim->steps_rigid++;
     return st;
 }

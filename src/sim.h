@@ -101,8 +101,6 @@ struct cf_sim {
     int *obstacle_body;      /* [n_obstacles] Bullet body of each obstacle */
     unsigned char *obstacle_moving; /* [n_obstacles] kinematic (restored on a re-step) */
     cf_hull_set near;        /* hulls near the fragment being sub-cycled */
-    cf_int_list parting;     /* pairs of sibling fragments (flattened) whose hulls
-                                overlapped at birth: no contact until they part */
 };
 
 double cf_wall_time(void);
@@ -149,16 +147,9 @@ void cf_fragment_ledger_reset(cf_sim *sim, int fi);
  * default 4 cm would hold small fragments off the ground). */
 double cf_fragment_margin(const cf_sim *sim, int fi);
 
-/* Sibling pairs overlapping deeper than this many margins at a split do not
- * collide until they part. */
-#define CF_SIBLING_TOUCH 2.5
-
 /* A rigid step is re-run at most this many times for fragments that go to
  * fracture mode during it. */
 #define CF_MAX_RESTEPS 4
-
-/* Let the parting sibling pairs that no longer touch collide again. */
-void cf_release_parted(cf_sim *sim);
 
 /* Kinetic energy of rigid fragment fi's Bullet body, J. */
 double cf_body_kinetic_energy(const cf_sim *sim, int fi);

@@ -748,8 +748,9 @@ static void test_round_trip(void **state)
     {
         static const char *const ov[] = {"bodies[1].hollow_layers=3", "solver.ccd=false",
                                          "solver.sleeping.angular=0.25",
+                                         "solver.sleeping.linear=1/3",
                                          "obstacles[1].restitution=1/3"};
-        round_trip("return { " MIN_BODY ", obstacles = { { type = 'plane' } } }", ov, 4);
+        round_trip("return { " MIN_BODY ", obstacles = { { type = 'plane' } } }", ov, 5);
     }
 }
 
@@ -803,17 +804,18 @@ static void test_shell_obstacle_keys(void **state)
     {
         char text[1200];
         static const char *const ov[] = {"solver.sleeping.linear=0.5", "solver.ccd=true",
+                                         "solver.sleeping.angular=0.125",
                                          "bodies[1].hollow_layers=1",
                                          "obstacles[1].friction=0.75"};
         snprintf(text, sizeof text,
                  "return { " MIN_BODY ", obstacles = { { type = 'mesh', file = '%s/sub/wall.obj' } },"
                  " solver = { ccd = false } }",
                  tmp);
-        load_ok(text, ov, 4, &s);
+        load_ok(text, ov, 5, &s);
         assert_mesh(s.obstacles[0].file, "sub/wall.obj");
         assert_double_equal(s.obstacles[0].friction, 0.75, 0);
         assert_double_equal(s.solver.sleep_linear, 0.5, 0);
-        assert_double_equal(s.solver.sleep_angular, 0.0, 0);
+        assert_double_equal(s.solver.sleep_angular, 0.125, 0);
         assert_int_equal(s.solver.ccd, 1);
         assert_int_equal(s.bodies[0].hollow_layers, 1);
         cf_scene_free(&s);
@@ -885,6 +887,11 @@ static void test_error_shell_obstacle_keys(void **state)
          "'solver.sleeping.angular' must be a number, got string"},
         {"return { " MIN_BODY ", solver = { sleeping = { time = 2 } } }", CF_ERR_SCENE_KEY,
          "unknown key 'solver.sleeping.time'; allowed: linear, angular"},
+        {"return { " MIN_BODY ", solver = { sleeping = { linear = 0.1 } } }", CF_ERR_SCENE_VALUE,
+         "'solver.sleeping' needs linear and angular both > 0 (or both 0: no sleeping), got "
+         "linear = 0.1 m/s, angular = 0 rad/s"},
+        {"return { " MIN_BODY ", solver = { sleeping = { linear = 0, angular = 0.2 } } }",
+         CF_ERR_SCENE_VALUE, "got linear = 0 m/s, angular = 0.2 rad/s"},
     };
     (void)state;
     for (int i = 0; i < (int)(sizeof cases / sizeof cases[0]); i++)

@@ -3,8 +3,11 @@
 # print a Markdown table of what each run's summary says: mesh size,
 # simulated time, wall time, fragments at the end, and how the run ended.
 #
-# usage: tools/scene_times.sh [COHFRAC_EXE [MESH_DIR [SCENES_DIR]]]
+# usage: [SCENE_TIMEOUT=S] tools/scene_times.sh [COHFRAC_EXE [MESH_DIR [SCENES_DIR]]]
 #   defaults: build/cohfrac, build/meshes (or $COHFRAC_MESH_DIR), scenes/
+#   SCENE_TIMEOUT: stop a run after S seconds of wall time (default 0: no
+#   limit); its row then gives how far it got, read from its HDF5 file
+#   (needs /usr/bin/python3 with h5py, as tools/check_run.py).
 #
 # scenes/verification/ and scenes/compare/ are left out (ctest runs those).
 # Each run writes its HDF5 file to a temporary directory (removed at the
@@ -24,12 +27,28 @@ trap 'rm -rf "$tmp"' EXIT
 find "$scenes" -name '*.lua' ! -path '*/verification/*' ! -path '*/compare/*' | sort >"$tmp/list"
 echo "| scene | nodes / tets | simulated | wall | fragments at the end | end |"
 echo "|---|---|---|---|---|---|"
+tmo=${SCENE_TIMEOUT:-0}
 fails=0
 while IFS= read -r scene; do
     name=${scene#"$scenes"/}
     echo "running $name ..." >&2
-    "$exe" run "$scene" --mesh-dir "$meshes" -q -o "$tmp/run.h5" >"$tmp/log" 2>&1 </dev/null
+    if [ "$tmo" -gt 0 ]; then
+        timeout "$tmo" "$exe" run "$scene" --mesh-dir "$meshes" -q -o "$tmp/run.h5" \
+            >"$tmp/log" 2>&1 </dev/null
+    else
+        "$exe" run "$scene" --mesh-dir "$meshes" -q -o "$tmp/run.h5" >"$tmp/log" 2>&1 </dev/null
+    fi
     rc=$?
+    partial=""
+    if [ "$rc" -eq 124 ] && [ -f "$tmp/run.h5" ]; then
+        # "<time reached> <fragments then> <tets of the first body>" from
+        # the last flushed frame.
+        partial=$(/usr/bin/python3 -c '
+import sys, h5py
+f = h5py.File(sys.argv[1], "r")
+o = f["observables/fragment_count"]
+print("%g %d %d" % (o["time"][-1], o["value"][-1], f["fragments/n_tets"][0]))' "$tmp/run.h5" 2>/dev/null)
+    fi
     rm -f "$tmp/run.h5" "$tmp/run.xdmf"
     # "mesh               3982 tets, 1334 nodes (1975 after duplication)"
     mesh=$(sed -n 's/^mesh  *\([0-9]*\) tets, \([0-9]*\) nodes.*/\2 \/ \1/p' "$tmp/log" | head -n 1)
@@ -40,6 +59,16 @@ while IFS= read -r scene; do
     frag=$(sed -n 's/^fragments  *\([0-9]*\) alive.*/\1/p' "$tmp/log" | head -n 1)
     if [ "$rc" -eq 0 ]; then
         end="ok"
+    elif [ "$rc" -eq 124 ]; then
+        fails=$((fails + 1))
+        end="stopped after $tmo s (SCENE_TIMEOUT)"
+        if [ -n "$partial" ]; then
+            set -- $partial
+            sim="$1 s reached"
+            frag="$2 (then)"
+            mesh="? / $3"
+        fi
+        wall="> $tmo s"
     else
         fails=$((fails + 1))
         why=$(sed -n 's/^cohfrac: error \[\([A-Z_]*\)\].*/\1/p' "$tmp/log" | head -n 1)

@@ -84,7 +84,8 @@
  *     sleeping = { linear [0.0] m/s, angular [0.0] rad/s }: Bullet
  *       deactivates (puts to sleep) a rigid body whose linear speed and
  *       angular speed both stay below these thresholds for 2 s; a contact
- *       wakes it.  Both 0: no sleeping
+ *       with an awake body wakes it.  Both 0: no sleeping; otherwise both
+ *       must be > 0
  *     dt_fracture [5e-6] s, check_interval [1] steps, quiet_steps [400]
  *     cfl_fraction [0]: when > 0, dt_fracture = cfl_fraction x dt_cfl of the
  *       mesh (DESIGN §3.2) instead of the dt_fracture value
