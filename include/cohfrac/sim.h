@@ -102,7 +102,9 @@ int cf_sim_tet_count(const cf_sim *sim);
 int cf_sim_tet_fragment(const cf_sim *sim, int t);
 
 /* Support distance of fragment `id` along unit direction d now: the largest
- * (x - com).d over its nodes, m (0 for a dead or unknown fragment). */
+ * (R (X - X_cm)).d over its nodes, m, with X the rest positions and R the
+ * fragment's rigid pose (deformation is not seen); 0 for a dead or unknown
+ * fragment. */
 double cf_sim_fragment_support(cf_sim *sim, int id, const double d[3]);
 
 /* FNV-1a hash of the state's bits: every node's position and velocity,
