@@ -639,14 +639,38 @@ static int ends_with(const char *s, const char *suffix)
  * The directory part goes through realpath so that the resolved scene loads
  * the same mesh from any working directory; the file name is kept as given
  * (not following a symlinked .node), so the .ele beside it still matches. */
+/* `path` (which contains a '/') made absolute: its directory goes through
+ * realpath, its file name is kept.  `what` names the file in errors. */
+static cf_status absolute_path(loader *ld, const char *key, const char *path, const char *what,
+                               char *out, size_t size)
+{
+    char dir[2048];
+    const char *cut = strrchr(path, '/');
+    assert(cut);
+    if (cut == path) {
+        snprintf(dir, sizeof dir, "/");
+    } else {
+        memcpy(dir, path, (size_t)(cut - path));
+        dir[cut - path] = '\0';
+    }
+    char *real = realpath(dir, NULL);
+    if (!real)
+        return fail(ld, CF_ERR_FILE_OPEN, "%s: cannot resolve directory %s: %s", kp(ld, key), dir,
+                    strerror(errno));
+    int w = snprintf(out, size, "%s%s%s", real, ends_with(real, "/") ? "" : "/", cut + 1);
+    free(real);
+    if (w < 0 || (size_t)w >= size)
+        return fail(ld, CF_ERR_SCENE_VALUE, "'%s': resolved %s path too long", kp(ld, key), what);
+    return CF_OK;
+}
+
 static cf_status resolve_mesh(loader *ld, const char *key, const char *name, char *out,
                               size_t size)
 {
-    char base[2048], node[2100], dir[2048];
+    char base[2048], node[2100];
     const char *slash = strrchr(name, '/');
     const char *leaf = slash ? slash + 1 : name;
     int prepared = !slash && !strchr(leaf, '.');
-    char *real, *cut;
     int w;
 
     if (prepared) {
@@ -695,23 +719,7 @@ static cf_status resolve_mesh(loader *ld, const char *key, const char *name, cha
                     kp(ld, key), name, node);
     }
 
-    cut = strrchr(base, '/'); /* present: every branch above put one in */
-    assert(cut);
-    if (cut == base) {
-        snprintf(dir, sizeof dir, "/");
-    } else {
-        memcpy(dir, base, (size_t)(cut - base));
-        dir[cut - base] = '\0';
-    }
-    real = realpath(dir, NULL);
-    if (!real)
-        return fail(ld, CF_ERR_FILE_OPEN, "%s: cannot resolve directory %s: %s", kp(ld, key), dir,
-                    strerror(errno));
-    w = snprintf(out, size, "%s%s%s", real, ends_with(real, "/") ? "" : "/", cut + 1);
-    free(real);
-    if (w < 0 || (size_t)w >= size)
-        return fail(ld, CF_ERR_SCENE_VALUE, "'%s': resolved mesh path too long", kp(ld, key));
-    return CF_OK;
+    return absolute_path(ld, key, base, "mesh", out, size);
 }
 
 /* A case-insensitive suffix test, for file extensions. */
@@ -732,9 +740,7 @@ static int ends_with_nocase(const char *s, const char *suffix)
 static cf_status resolve_surface(loader *ld, const char *key, const char *name, char *out,
                                  size_t size)
 {
-    char path[2048], dir[2048];
-    const char *cut;
-    char *real;
+    char path[2048];
     int w;
 
     if (!ends_with_nocase(name, ".obj") && !ends_with_nocase(name, ".off") &&
@@ -753,23 +759,7 @@ static cf_status resolve_surface(loader *ld, const char *key, const char *name, 
                     "%s: surface '%s' not found: no file %s (relative paths start at the scene "
                     "file's directory)",
                     kp(ld, key), name, path);
-    cut = strrchr(path, '/'); /* present: both branches above put one in */
-    assert(cut);
-    if (cut == path) {
-        snprintf(dir, sizeof dir, "/");
-    } else {
-        memcpy(dir, path, (size_t)(cut - path));
-        dir[cut - path] = '\0';
-    }
-    real = realpath(dir, NULL);
-    if (!real)
-        return fail(ld, CF_ERR_FILE_OPEN, "%s: cannot resolve directory %s: %s", kp(ld, key), dir,
-                    strerror(errno));
-    w = snprintf(out, size, "%s%s%s", real, ends_with(real, "/") ? "" : "/", cut + 1);
-    free(real);
-    if (w < 0 || (size_t)w >= size)
-        return fail(ld, CF_ERR_SCENE_VALUE, "'%s': resolved surface path too long", kp(ld, key));
-    return CF_OK;
+    return absolute_path(ld, key, path, "surface", out, size);
 }
 
 /* ---------------------------------------------------------------- sections */
