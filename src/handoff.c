@@ -138,16 +138,20 @@ static int count_dead(const cf_sim *sim)
     return n;
 }
 
-/* Linear and angular momentum (about the origin) of fragment fi now: of its
- * Bullet body, or of its nodes. */
-static void state_momenta(const cf_fragment *f, const cfb_state *st, double P[3], double L[3])
+void cf_body_spin(const cf_fragment *f, const cfb_state *st, double Iw[3])
 {
-    double Rb[9], wb[3], Iw[3], c[3];
+    double Rb[9], wb[3];
     quat_to_mat(st->quat, Rb);
     m3_tmulv(Rb, st->w, wb);
     for (int k = 0; k < 3; k++)
         wb[k] *= f->principal[k];
     m3_mulv(Rb, wb, Iw);
+}
+
+void cf_body_momenta(const cf_fragment *f, const cfb_state *st, double P[3], double L[3])
+{
+    double Iw[3], c[3];
+    cf_body_spin(f, st, Iw);
     v3_cross(st->pos, st->v, c);
     for (int k = 0; k < 3; k++) {
         P[k] = f->mass * st->v[k];
@@ -155,14 +159,14 @@ static void state_momenta(const cf_fragment *f, const cfb_state *st, double P[3]
     }
 }
 
-static void fragment_momenta(const cf_sim *sim, int fi, double P[3], double L[3])
+void cf_fragment_momenta(const cf_sim *sim, int fi, double P[3], double L[3])
 {
     const cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;
     if (f->body >= 0) {
         cfb_state st;
         cfb_get_state(sim->bullet, f->body, &st);
-        state_momenta(f, &st, P, L);
+        cf_body_momenta(f, &st, P, L);
         return;
     }
     P[0] = P[1] = P[2] = L[0] = L[1] = L[2] = 0;
@@ -249,9 +253,9 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
     cf_solid *s = &sim->solid;
     double P0[3], L0[3], P1[3], L1[3];
     if (st)
-        state_momenta(f, st, P0, L0);
+        cf_body_momenta(f, st, P0, L0);
     else
-        fragment_momenta(sim, fi, P0, L0);
+        cf_fragment_momenta(sim, fi, P0, L0);
     /* Fracture mode starts from the rigid motion: from the Bullet body, or,
      * with the pbd backend, from its nodes' best rigid fit (shape matching)
      * and momenta, so that the bars start at rest length instead of
@@ -279,7 +283,7 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
     cf_fragment_ledger_reset(sim, fi);
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
-    fragment_momenta(sim, fi, P1, L1);
+    cf_fragment_momenta(sim, fi, P1, L1);
     return record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, err);
 }
 
@@ -338,7 +342,7 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
     cf_node_state before;
     cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &before);
     double P0[3], L0[3], P1[3] = {0, 0, 0}, L1[3] = {0, 0, 0}, ke_after = 0;
-    fragment_momenta(sim, fi, P0, L0);
+    cf_fragment_momenta(sim, fi, P0, L0);
 
     /* One component: the fragment stays itself; several: children. */
     int first = fi;
@@ -401,7 +405,7 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
     free(tets), free(comp), free(seen);
     for (int c = 0; c < k; c++) {
         double P[3], L[3];
-        fragment_momenta(sim, first + c, P, L);
+        cf_fragment_momenta(sim, first + c, P, L);
         v3_axpy(1.0, P, P1);
         v3_axpy(1.0, L, L1);
     }

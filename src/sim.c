@@ -523,33 +523,21 @@ void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
         const cf_fragment *f = &sim->frag[fi];
         if (f->mode == CF_MODE_DEAD)
             continue;
+        double P[3], L[3];
         if (f->body >= 0) {
             cfb_state st;
-            double Rb[9], D[9] = {0}, T[9], I[9], Iw[3], c[3];
             cfb_get_state(sim->bullet, f->body, &st);
             l->kinetic += state_kinetic_energy(f, &st);
             v3_axpy(f->mass, st.pos, l->mass_moment);
-            v3_axpy(f->mass, st.v, l->momentum);
-            quat_to_mat(st.quat, Rb); /* body frame = principal axes: I = Rb D Rb^T */
-            D[0] = f->principal[0], D[4] = f->principal[1], D[8] = f->principal[2];
-            m3_mul(Rb, D, T);
-            m3_mul_nt(T, Rb, I);
-            m3_mulv(I, st.w, Iw);
-            v3_cross(st.pos, st.v, c);
-            v3_axpy(f->mass, c, l->angular_momentum);
-            v3_axpy(1.0, Iw, l->angular_momentum);
-            continue;
+            cf_body_momenta(f, &st, P, L);
+        } else {
+            l->kinetic += f->e_kin;
+            l->strain += f->e_strain;
+            v3_axpy(1.0, f->mx, l->mass_moment);
+            cf_fragment_momenta(sim, fi, P, L);
         }
-        l->kinetic += f->e_kin;
-        l->strain += f->e_strain;
-        v3_axpy(1.0, f->mx, l->mass_moment);
-        for (int i = 0; i < f->nodes.n; i++) {
-            int a = f->nodes.v[i];
-            double c[3];
-            v3_axpy(s->m[a], &s->v[3 * a], l->momentum);
-            v3_cross(&s->x[3 * a], &s->v[3 * a], c);
-            v3_axpy(s->m[a], c, l->angular_momentum);
-        }
+        v3_axpy(1.0, P, l->momentum);
+        v3_axpy(1.0, L, l->angular_momentum);
     }
     cf_cohesive_energy(s, NULL, 0, &l->cohesive_stored, &l->cohesive_dissipated);
     double dmx[3];
@@ -586,13 +574,8 @@ int cf_sim_fragments(cf_sim *sim, cf_fragment_state *out, int cap)
                 o->momentum[k] = f->mass * o->v[k];
             if (f->body >= 0) {
                 cfb_state st;
-                double Rb[9], wb[3];
                 cfb_get_state(sim->bullet, f->body, &st);
-                quat_to_mat(st.quat, Rb);
-                m3_tmulv(Rb, st.w, wb);
-                for (int k = 0; k < 3; k++)
-                    wb[k] *= f->principal[k];
-                m3_mulv(Rb, wb, o->angular_momentum);
+                cf_body_spin(f, &st, o->angular_momentum);
                 o->kinetic = state_kinetic_energy(f, &st);
             } else {
                 cf_node_state ns;

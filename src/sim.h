@@ -151,6 +151,17 @@ double cf_fragment_margin(const cf_sim *sim, int fi);
  * fracture mode during it. */
 #define CF_MAX_RESTEPS 4
 
+/* Angular momentum of fragment f's Bullet body about its centre of mass,
+ * I w with I = Rb diag(principal) Rb^T, kg m^2/s. */
+void cf_body_spin(const cf_fragment *f, const cfb_state *st, double Iw[3]);
+
+/* Linear (kg m/s) and angular momentum (kg m^2/s, about the origin) of
+ * fragment f's Bullet body in state st: P = M v, L = M c x v + I w. */
+void cf_body_momenta(const cf_fragment *f, const cfb_state *st, double P[3], double L[3]);
+
+/* The same for fragment fi now: of its Bullet body, or of its nodes. */
+void cf_fragment_momenta(const cf_sim *sim, int fi, double P[3], double L[3]);
+
 /* Kinetic energy of rigid fragment fi's Bullet body, J. */
 double cf_body_kinetic_energy(const cf_sim *sim, int fi);
 
