@@ -86,7 +86,19 @@ static int cmd_mesh(int argc, char **argv)
     return 0;
 }
 
-static int cmd_run(int argc, char **argv)
+/* The options `run` and `compare` share: --set (repeatable), --mesh-dir,
+ * --output (a file for `run`, a directory for `compare`), --threads,
+ * --quiet, and one scene file. */
+typedef struct scene_args {
+    const char **sets; /* [argc + 1]: room for one more --set */
+    int n_sets;
+    const char *mesh_dir, *output, *scene;
+    int output_at; /* --sets given before the last --output */
+    int threads, progress;
+} scene_args;
+
+/* Returns 0, or the usage exit code (a message printed); free a->sets. */
+static int parse_scene_args(int argc, char **argv, const char *cmd, scene_args *a)
 {
     static const struct option lo[] = {{"set", required_argument, 0, 's'},
                                        {"mesh-dir", required_argument, 0, 'm'},
@@ -94,37 +106,55 @@ static int cmd_run(int argc, char **argv)
                                        {"threads", required_argument, 0, 'j'},
                                        {"quiet", no_argument, 0, 'q'},
                                        {0, 0, 0, 0}};
-    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
-    char *out_set = NULL;
-    int n_sets = 0, c, rc = 0;
-    const char *mesh_dir = getenv("COHFRAC_MESH_DIR");
-    if (!mesh_dir)
-        mesh_dir = "build/meshes";
-    cf_run_options opt = {.progress = 1};
+    char msg[64];
+    const char *env = getenv("COHFRAC_MESH_DIR");
+    memset(a, 0, sizeof *a);
+    a->sets = calloc((size_t)argc + 2, sizeof *a->sets);
+    a->mesh_dir = env ? env : "build/meshes";
+    a->progress = 1;
+    int c;
     while ((c = getopt_long(argc, argv, "s:m:o:j:q", lo, NULL)) != -1) {
         switch (c) {
-        case 's': sets[n_sets++] = optarg; break;
-        case 'm': mesh_dir = optarg; break;
-        case 'o':
-            free(out_set);
-            out_set = malloc(strlen(optarg) + 32);
-            sprintf(out_set, "output.file=[==[%s]==]", optarg);
-            sets[n_sets++] = out_set;
-            break;
-        case 'j': opt.threads = atoi(optarg); break;
-        case 'q': opt.progress = 0; break;
-        default: free(sets), free(out_set); return usage_error("bad option for 'run'");
+        case 's': a->sets[a->n_sets++] = optarg; break;
+        case 'm': a->mesh_dir = optarg; break;
+        case 'o': a->output = optarg, a->output_at = a->n_sets; break;
+        case 'j': a->threads = atoi(optarg); break;
+        case 'q': a->progress = 0; break;
+        default:
+            snprintf(msg, sizeof msg, "bad option for '%s'", cmd);
+            return usage_error(msg);
         }
     }
     if (optind != argc - 1) {
-        free(sets), free(out_set);
-        return usage_error("'run' needs exactly one scene file");
+        snprintf(msg, sizeof msg, "'%s' needs exactly one scene file", cmd);
+        return usage_error(msg);
+    }
+    a->scene = argv[optind];
+    return 0;
+}
+
+static int cmd_run(int argc, char **argv)
+{
+    scene_args a;
+    char *out_set = NULL;
+    int rc = parse_scene_args(argc, argv, "run", &a);
+    if (rc == 0 && a.output) { /* -o FILE is --set output.file="FILE" in its place */
+        out_set = malloc(strlen(a.output) + 32);
+        sprintf(out_set, "output.file=[==[%s]==]", a.output);
+        memmove(&a.sets[a.output_at + 1], &a.sets[a.output_at],
+                (size_t)(a.n_sets - a.output_at) * sizeof *a.sets);
+        a.sets[a.output_at] = out_set;
+        a.n_sets++;
+    }
+    if (rc != 0) {
+        free(a.sets);
+        return rc;
     }
     cf_error err = {0};
     cf_scene scene;
     cf_sim *sim = NULL;
-    opt.mesh_dir = mesh_dir;
-    if (cf_scene_load(argv[optind], sets, n_sets, mesh_dir, &scene, &err) != CF_OK) {
+    cf_run_options opt = {.progress = a.progress, .threads = a.threads, .mesh_dir = a.mesh_dir};
+    if (cf_scene_load(a.scene, a.sets, a.n_sets, a.mesh_dir, &scene, &err) != CF_OK) {
         rc = fail(&err);
     } else {
         cf_status st = cf_sim_create(&scene, &opt, &sim, &err);
@@ -137,49 +167,33 @@ static int cmd_run(int argc, char **argv)
         cf_sim_destroy(sim);
         cf_scene_free(&scene);
     }
-    free(sets), free(out_set);
+    free(a.sets), free(out_set);
     return rc;
 }
 
 static int cmd_compare(int argc, char **argv)
 {
-    static const struct option lo[] = {{"set", required_argument, 0, 's'},
-                                       {"mesh-dir", required_argument, 0, 'm'},
-                                       {"output", required_argument, 0, 'o'},
-                                       {"threads", required_argument, 0, 'j'},
-                                       {"quiet", no_argument, 0, 'q'},
-                                       {0, 0, 0, 0}};
-    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
-    int n_sets = 0, c;
-    const char *mesh_dir = getenv("COHFRAC_MESH_DIR");
-    cf_compare_options opt = {.progress = 1, .plot = 1, .headline = stdout};
-    opt.mesh_dir = mesh_dir ? mesh_dir : "build/meshes";
-    while ((c = getopt_long(argc, argv, "s:m:o:j:q", lo, NULL)) != -1) {
-        switch (c) {
-        case 's': sets[n_sets++] = optarg; break;
-        case 'm': opt.mesh_dir = optarg; break;
-        case 'o': opt.out_dir = optarg; break;
-        case 'j': opt.threads = atoi(optarg); break;
-        case 'q': opt.progress = 0; break;
-        default: free(sets); return usage_error("bad option for 'compare'");
-        }
+    scene_args a;
+    int rc = parse_scene_args(argc, argv, "compare", &a);
+    if (rc != 0) {
+        free(a.sets);
+        return rc;
     }
-    if (optind != argc - 1) {
-        free(sets);
-        return usage_error("'compare' needs exactly one scene file");
-    }
-    opt.scene = argv[optind];
-    opt.overrides = sets;
-    opt.n_overrides = n_sets;
+    cf_compare_options opt = {.progress = a.progress, .plot = 1, .headline = stdout};
+    opt.mesh_dir = a.mesh_dir;
+    opt.out_dir = a.output;
+    opt.threads = a.threads;
+    opt.scene = a.scene;
+    opt.overrides = a.sets;
+    opt.n_overrides = a.n_sets;
     cf_error err = {0};
     cf_compare_result res;
-    int rc = 0;
     if (cf_compare_run(&opt, &res, &err) != CF_OK)
         rc = fail(&err);
     else
         printf("\nreport: %s/compare.md%s\n", res.out_dir,
                res.plot_made ? " (plots: compare.png)" : "");
-    free(sets);
+    free(a.sets);
     return rc;
 }
 
