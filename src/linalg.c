@@ -2,6 +2,17 @@
 
 #include <string.h>
 
+void points_bbox(const double *x, int n, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; k++)
+        lo[k] = INFINITY, hi[k] = -INFINITY;
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], x[3 * i + k]);
+            hi[k] = fmax(hi[k], x[3 * i + k]);
+        }
+}
+
 void m3_mul(const double A[9], const double B[9], double out[9])
 {
     double C[9];

@@ -43,6 +43,9 @@ static inline void m3_tmulv(const double A[9], const double b[3], double out[3])
     out[0] = o0, out[1] = o1, out[2] = o2;
 }
 
+/* Bounding box of n points x[n][3]. */
+void points_bbox(const double *x, int n, double lo[3], double hi[3]);
+
 void m3_mul(const double A[9], const double B[9], double out[9]);
 void m3_mul_tn(const double A[9], const double B[9], double out[9]); /* A^T B */
 void m3_mul_nt(const double A[9], const double B[9], double out[9]); /* A B^T */

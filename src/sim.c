@@ -18,12 +18,8 @@
 /* Place a body's mesh: x' = position + scale R (x - bbox centre). */
 static void place_mesh(cf_mesh *m, const cf_body_def *b)
 {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i < m->n_nodes; i++)
-        for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], m->x[3 * i + k]);
-            hi[k] = fmax(hi[k], m->x[3 * i + k]);
-        }
+    double lo[3], hi[3];
+    points_bbox(m->x, m->n_nodes, lo, hi);
     double c[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])}, R[9];
     quat_to_mat(b->orientation, R);
     for (int i = 0; i < m->n_nodes; i++) {
@@ -333,13 +329,8 @@ static cf_status add_obstacles(cf_sim *sim, cf_error *err)
             cf_status st = load_obstacle_mesh(o, j, &srf, err);
             if (st != CF_OK)
                 return st;
-            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-            for (int i = 0; i < srf.n_verts; i++)
-                for (int k = 0; k < 3; k++) {
-                    lo[k] = fmin(lo[k], srf.v[3 * i + k]);
-                    hi[k] = fmax(hi[k], srf.v[3 * i + k]);
-                }
-            double diag[3];
+            double lo[3], hi[3], diag[3];
+            points_bbox(srf.v, srf.n_verts, lo, hi);
             v3_sub(hi, lo, diag);
             sim->obs.range[j] = 0.05 * v3_norm(diag);
             sim->obs.mesh[j] = cff_mesh_create(srf.v, srf.n_verts, srf.tri, srf.n_tris);
