@@ -112,7 +112,24 @@ static int add_hulls(cf_sim *sim, int g, cf_hull_set *hs)
     return 0;
 }
 
-int cf_hull_set_gather(cf_sim *sim, int fi, double pad, cf_hull_set *hs)
+int cf_body_boxes(cf_sim *sim, double **boxes)
+{
+    double *b = realloc(*boxes, (size_t)(sim->n_frag > 0 ? sim->n_frag : 1) * 6 * sizeof(double));
+    if (!b)
+        return -1;
+    *boxes = b;
+    for (int g = 0; g < sim->n_frag; g++) {
+        const cf_fragment *o = &sim->frag[g];
+        double *lo = &b[6 * g], *hi = lo + 3;
+        if (!sim->bullet || o->mode != CF_MODE_RIGID || o->body < 0 ||
+            cfb_get_aabb(sim->bullet, o->body, lo, hi))
+            for (int d = 0; d < 3; d++)
+                lo[d] = INFINITY, hi[d] = -INFINITY; /* overlaps nothing */
+    }
+    return 0;
+}
+
+int cf_hull_set_gather(cf_sim *sim, int fi, double pad, const double *boxes, cf_hull_set *hs)
 {
     const cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;
@@ -131,9 +148,7 @@ int cf_hull_set_gather(cf_sim *sim, int fi, double pad, cf_hull_set *hs)
     double size = 0;
     for (int g = 0; g < sim->n_frag; g++) {
         const cf_fragment *o = &sim->frag[g];
-        double blo[3], bhi[3];
-        if (o->mode != CF_MODE_RIGID || o->body < 0 ||
-            cfb_get_aabb(sim->bullet, o->body, blo, bhi) || !boxes_overlap(lo, hi, blo, bhi))
+        if (!boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
             continue;
         if (add_hulls(sim, g, hs))
             return -1;

@@ -29,9 +29,15 @@ typedef struct cf_node_impulses {
     double *point;     /* [n][3] last contact point, m */
 } cf_node_impulses;
 
-/* Hulls of every rigid Bullet fragment whose box overlaps fragment fi's
- * node box (grown by `pad` m).  Returns 0, or -1 out of memory. */
-int cf_hull_set_gather(cf_sim *sim, int fi, double pad, cf_hull_set *hs);
+/* The world box of every fragment's Bullet body, once per rigid step:
+ * (*boxes)[n_frag][6] = lo, hi (m); an empty box for fragments without a
+ * rigid body.  Grows *boxes as needed.  Returns 0, or -1 out of memory. */
+int cf_body_boxes(cf_sim *sim, double **boxes);
+
+/* Hulls of every rigid Bullet fragment whose box (from cf_body_boxes)
+ * overlaps fragment fi's node box grown by `pad` m.  Returns 0, or -1 out
+ * of memory. */
+int cf_hull_set_gather(cf_sim *sim, int fi, double pad, const double *boxes, cf_hull_set *hs);
 void cf_hull_set_free(cf_hull_set *hs);
 
 /* Push the predicted position p of a node at x out of every hull of hs

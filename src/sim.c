@@ -474,6 +474,7 @@ void cf_sim_destroy(cf_sim *sim)
         cff_mesh_destroy(sim->obs.mesh[j]);
     free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
     cf_hull_set_free(&sim->near);
+    free(sim->body_boxes);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
     cf_solid_free(&sim->solid);
@@ -863,10 +864,12 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
         n_sub = 1;
     double h = dt / (double)n_sub;
     int n = sim->n_frag;
+    int boxed = 0; /* the rigid bodies' boxes are taken once for every fragment */
     for (int fi = 0; fi < n; fi++) {
         if (sim->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
-        if (cf_hull_set_gather(sim, fi, contact_pad(sim, fi, dt), &sim->near))
+        if ((!boxed++ && cf_body_boxes(sim, &sim->body_boxes)) ||
+            cf_hull_set_gather(sim, fi, contact_pad(sim, fi, dt), sim->body_boxes, &sim->near))
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
         for (long k = 0; k < n_sub; k++) {
             if (cf_solver_step(sim, fi, sim->t + (double)k * h, h, 1) != CF_OK)

@@ -100,6 +100,7 @@ struct cf_sim {
     double last_progress;
     int *obstacle_body;      /* [n_obstacles] Bullet body of each obstacle */
     unsigned char *obstacle_moving; /* [n_obstacles] kinematic (restored on a re-step) */
+    double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
     cf_hull_set near;        /* hulls near the fragment being sub-cycled */
 };
 
