@@ -247,6 +247,30 @@ static void place_rigid(cf_solid *s, const cf_fragment *f, const double com[3], 
     }
 }
 
+/* Translate fragment f out of every obstacle its placed nodes overlap (a
+ * rigid pose from Bullet rests within the contact margin; a best rigid fit
+ * of deformed nodes can reach below the ground).  In fracture mode the PBD
+ * projection would otherwise push the overlap out at dt_fracture, and the
+ * bars would carry that push to the whole fragment as velocity: 2 mm over a
+ * 5 us step is a rebound at metres per second. */
+static void clear_obstacles(cf_sim *sim, const cf_fragment *f)
+{
+    cf_solid *s = &sim->solid;
+    for (int j = 0; j < sim->obs.n; j++) {
+        double deepest = 0, n[3] = {0, 0, 0};
+        for (int i = 0; i < f->nodes.n; i++) {
+            double nj[3];
+            double d = cf_obstacle_distance(&sim->obs, j, sim->t, &s->x[3 * f->nodes.v[i]], nj);
+            if (d < deepest) {
+                deepest = d;
+                memcpy(n, nj, sizeof n);
+            }
+        }
+        for (int i = 0; deepest < 0 && i < f->nodes.n; i++)
+            v3_axpy(-deepest, n, &s->x[3 * f->nodes.v[i]]);
+    }
+}
+
 cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
@@ -277,6 +301,7 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
         loss = ns.ke - (0.5 * ns.M * v3_dot(ns.v, ns.v) + 0.5 * v3_dot(w, ns.L));
         sim->flow.handoff += loss;
     }
+    clear_obstacles(sim, f);
     f->mode = CF_MODE_FRACTURE;
     f->steps = f->quiet = 0;
     f->t_enter = sim->t;
