@@ -42,10 +42,6 @@ return {
     dt_rigid = 2e-3, dt_fracture = 3e-6, criterion = "source",
     impact_threshold = 1.0,
     pbd = { k_stiffness = 0.9, iterations = 3, k_damping = 1.0 },
-    -- Hundreds of small fragments are in fracture mode at once, each a few
-    -- tets: per-fragment element loops are too short to share between
-    -- threads (on the shared 2-core test machine 2 threads ran 4x slower).
-    threads = 1,
   },
   output = { file = "out/bunny_hit_by_sphere.h5", frame_interval = 0.005 },
 }

@@ -508,6 +508,13 @@ static void write_headline(FILE *f, const cf_compare_options *opt, const cf_scen
     double ratio = r->wall[0] > 0 ? r->wall[1] / r->wall[0] : NAN;
     fprintf(f, "- wall time of the steps: bullet %.3f s, pbd %.3f s (pbd / bullet = %s)\n",
             r->wall[0], r->wall[1], num(a, 32, ratio));
+    if (!isnan(r->t_split[0]) && !isnan(r->t_split[1])) {
+        char b[32];
+        fprintf(f, "- after the first split (bullet at %.4g s, pbd at %.4g s): bullet %.3f s, "
+                   "pbd %.3f s (pbd / bullet = %s)\n",
+                r->t_split[0], r->t_split[1], r->wall_split[0], r->wall_split[1],
+                num(b, 32, r->wall_split[0] > 0 ? r->wall_split[1] / r->wall_split[0] : NAN));
+    }
     fprintf(f, "- fragments at the end: bullet %d, pbd %d\n", r->n_fragments[0],
             r->n_fragments[1]);
     fprintf(f, "- analytic reference: %s", ref_name(r->reference));
@@ -864,13 +871,21 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     double dt = sc[0].solver.dt_rigid, every = sc[0].output.frame_interval;
     double next = every, next_report = 0.1 * st.T;
     cf_error run_err = {0};
+    int n_bodies = cf_sim_fragments(st.sim[0], NULL, 0);
+    r->t_split[0] = r->t_split[1] = NAN;
     while (!cf_sim_done(st.sim[0]) || !cf_sim_done(st.sim[1])) {
         for (int b = 0; b < 2 && run_st == CF_OK; b++) {
             if (cf_sim_done(st.sim[b]))
                 continue;
             double t0 = now_s();
             run_st = cf_sim_advance(st.sim[b], &run_err);
-            r->wall[b] += now_s() - t0;
+            double w = now_s() - t0;
+            r->wall[b] += w;
+            /* after the split: from the step whose fragments outnumber the bodies */
+            if (isnan(r->t_split[b]) && cf_sim_fragments(st.sim[b], NULL, 0) > n_bodies)
+                r->t_split[b] = cf_sim_time(st.sim[b]);
+            if (!isnan(r->t_split[b]))
+                r->wall_split[b] += w;
             if (run_st != CF_OK)
                 fprintf(stderr, "cohfrac: %s run: error [%s]: %s\n", backend_name[b],
                         cf_status_name(run_st), run_err.msg);

@@ -64,7 +64,10 @@ static void element_stress(const cf_solid *s, const double F[9], cf_elasticity k
 int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int want_stress)
 {
     int inverted = 0;
-#pragma omp parallel for schedule(static) reduction(+ : inverted)
+    /* Threads only for fragments large enough to repay the fork and join:
+     * hundreds of few-tet fragments in fracture mode ran slower on 2
+     * threads than on 1. */
+#pragma omp parallel for schedule(static) reduction(+ : inverted) if (nt >= CF_TET4_PARALLEL_MIN)
     for (int i = 0; i < nt; i++) {
         int t = tets[i];
         double R[9], sig[9], P[9], g[4][3], F[9];

@@ -13,10 +13,13 @@
 /* Gradients of the 4 shape functions of tet t, [4][3], 1/m. */
 void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3]);
 
+/* Fragments of fewer tets than this are done on one thread. */
+#define CF_TET4_PARALLEL_MIN 4096
+
 /* For each tet of the list: internal nodal forces into s->tf ([4][3] per
  * tet, N), strain energy V (1/2 sigma : eps) into s->tw (J) and, when
  * `want_stress`, the world-frame Cauchy stress into s->sigma (Pa).  Parallel
- * over tets (OpenMP); each tet writes only its own slots, so the result does
+ * over tets (OpenMP) from CF_TET4_PARALLEL_MIN tets on; each tet writes only its own slots, so the result does
  * not depend on the thread count.  Returns the number of inverted tets
  * (det F <= 0). */
 int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int want_stress);

@@ -89,6 +89,9 @@ typedef struct cf_compare_result {
     int n_samples;
     double duration;                 /* s, simulated */
     double wall[2];                  /* s, wall time of cf_sim_advance calls */
+    double wall_split[2];            /* s, the same from the first step that split
+                                        the scene's bodies on (0 if none split) */
+    double t_split[2];               /* s, simulated time of that split (NaN: none) */
     int n_fragments[2];              /* alive at the end */
     double com_dist_final, com_dist_max;       /* m */
     double orient_final, orient_max;           /* rad */
