@@ -1,5 +1,6 @@
 # Thin wrapper around CMake.  `make run`: set up, build, prepare the bunny,
-# run the default scene.  `make test`: set up, build, run every test.
+# run the default scene (the bunny drop on the coarse bunny).  `make test`:
+# set up, build, run every test.
 BUILD     ?= build
 BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
 MESHES    := $(BUILD)/meshes

@@ -4,21 +4,18 @@
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
 #include "linalg.h"
+#include "report.h"
 
 #include <errno.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
-#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
-
-extern char **environ;
 
 static const char *const backend_name[2] = {"bullet", "pbd"};
 
@@ -407,59 +404,6 @@ static double unwrap_slope(const sample *s, int n, double *a)
 
 /* ---- files ---- */
 
-/* mkdir -p */
-static cf_status make_dirs(const char *path, cf_error *err)
-{
-    char d[1024];
-    if (snprintf(d, sizeof d, "%s", path) >= (int)sizeof d)
-        return cf_error_set(err, CF_ERR_OUTPUT, "output directory path too long: %s", path);
-    for (char *p = d + 1;; p++) {
-        if (*p == '/' || *p == 0) {
-            char c = *p;
-            *p = 0;
-            if (mkdir(d, 0777) != 0 && errno != EEXIST)
-                return cf_error_set(err, CF_ERR_OUTPUT, "cannot create directory %s: %s", d,
-                                    strerror(errno));
-            *p = c;
-            if (!c)
-                break;
-        }
-    }
-    struct stat sb;
-    if (stat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
-        return cf_error_set(err, CF_ERR_OUTPUT, "%s is not a directory", path);
-    return CF_OK;
-}
-
-typedef struct outfile {
-    FILE *f;
-    char tmp[1100], final[1100];
-} outfile;
-
-static cf_status out_open(outfile *o, const char *dir, const char *name, cf_error *err)
-{
-    snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
-    snprintf(o->tmp, sizeof o->tmp, "%s/%s.tmp", dir, name);
-    o->f = fopen(o->tmp, "w");
-    if (!o->f)
-        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s: %s", o->tmp, strerror(errno));
-    return CF_OK;
-}
-
-/* Close and move into place: the final name only ever holds a whole file. */
-static cf_status out_close(outfile *o, cf_error *err)
-{
-    int bad = ferror(o->f);
-    bad |= fclose(o->f) != 0;
-    o->f = NULL;
-    if (bad || rename(o->tmp, o->final) != 0) {
-        int e = errno;
-        remove(o->tmp);
-        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s: %s", o->final, strerror(e));
-    }
-    return CF_OK;
-}
-
 /* A number for the report: "—" for NaN. */
 static const char *num(char *buf, size_t n, double x)
 {
@@ -582,8 +526,8 @@ static void write_headline(FILE *f, const cf_compare_options *opt, const cf_scen
 static cf_status write_md(const char *dir, const char *headline, const state *st,
                           cf_error *err)
 {
-    outfile o;
-    cf_status rc = out_open(&o, dir, "compare.md", err);
+    cf_outfile o;
+    cf_status rc = cf_out_open(&o, dir, "compare.md", err);
     if (rc != CF_OK)
         return rc;
     fputs(headline, o.f);
@@ -621,15 +565,15 @@ static cf_status write_md(const char *dir, const char *headline, const state *st
                  "the end), `compare.png` (plots by tools/compare_plot.py, when "
                  "python3-matplotlib is installed).\n");
     free(order);
-    return out_close(&o, err);
+    return cf_out_close(&o, err);
 }
 
 static void csv_num(FILE *f, double x) { fprintf(f, isnan(x) ? ",nan" : ",%.10g", x); }
 
 static cf_status write_csv(const char *dir, const state *st, cf_error *err)
 {
-    outfile o;
-    cf_status rc = out_open(&o, dir, "compare.csv", err);
+    cf_outfile o;
+    cf_status rc = cf_out_open(&o, dir, "compare.csv", err);
     if (rc != CF_OK)
         return rc;
     fprintf(o.f, "time,com_dist,orient_diff,n_frag_bullet,n_frag_pbd,"
@@ -656,13 +600,13 @@ static cf_status write_csv(const char *dir, const state *st, cf_error *err)
         csv_num(o.f, st->ref.top ? st->smp[0].axis_angle[0] + st->ref.omega_p * s->t : NAN);
         fputc('\n', o.f);
     }
-    return out_close(&o, err);
+    return cf_out_close(&o, err);
 }
 
 static cf_status write_fragments_csv(const char *dir, const state *st, cf_error *err)
 {
-    outfile o;
-    cf_status rc = out_open(&o, dir, "fragments.csv", err);
+    cf_outfile o;
+    cf_status rc = cf_out_open(&o, dir, "fragments.csv", err);
     if (rc != CF_OK)
         return rc;
     const snap *sa = &st->s[0], *sb = &st->s[1];
@@ -693,67 +637,19 @@ static cf_status write_fragments_csv(const char *dir, const state *st, cf_error 
             csv_num(o.f, g ? g->w[k] : NAN);
         fputc('\n', o.f);
     }
-    return out_close(&o, err);
-}
-
-/* tools/compare_plot.py: the given path, ./tools/, or ../tools/ of the executable. */
-static int find_plot_script(const cf_compare_options *opt, char *out, size_t n)
-{
-    if (opt->plot_script) {
-        snprintf(out, n, "%s", opt->plot_script);
-        return access(out, R_OK) == 0;
-    }
-    snprintf(out, n, "tools/compare_plot.py");
-    if (access(out, R_OK) == 0)
-        return 1;
-    char exe[900];
-    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (len <= 0)
-        return 0;
-    exe[len] = 0;
-    char *slash = strrchr(exe, '/');
-    if (slash)
-        *slash = 0;
-    snprintf(out, n, "%s/../tools/compare_plot.py", exe);
-    return access(out, R_OK) == 0;
+    return cf_out_close(&o, err);
 }
 
 /* Make compare.png; returns 1 when it was written (warnings on stderr otherwise). */
 static int run_plot(const cf_compare_options *opt, const char *dir, const cf_compare_result *r)
 {
-    char script[1024], csv[1100], png[1100], title[300];
-    if (!find_plot_script(opt, script, sizeof script)) {
-        fprintf(stderr, "cohfrac: warning: tools/compare_plot.py not found: no compare.png "
-                        "(compare.md and compare.csv are written)\n");
-        return 0;
-    }
+    char csv[1100], png[1100], title[300];
     snprintf(csv, sizeof csv, "%s/compare.csv", dir);
     snprintf(png, sizeof png, "%s/compare.png", dir);
     snprintf(title, sizeof title, "%s (reference: %s%s)", r->scene_name, ref_name(r->reference),
              r->top ? ", symmetric top" : "");
-    const char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-    char *argv[] = {(char *)py, script, csv, png, title, NULL};
-    pid_t pid;
-    int rc = posix_spawnp(&pid, py, NULL, NULL, argv, environ);
-    int status = 0;
-    if (rc == 0 && waitpid(pid, &status, 0) < 0)
-        rc = errno;
-    if (rc != 0) {
-        fprintf(stderr, "cohfrac: warning: cannot run python3 (%s): no compare.png; install "
-                        "python3 and python3-matplotlib\n", strerror(rc));
-        return 0;
-    }
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && access(png, R_OK) == 0)
-        return 1;
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 3)
-        fprintf(stderr, "cohfrac: warning: matplotlib is missing (install the Debian package "
-                        "python3-matplotlib): no compare.png; compare.md and compare.csv are "
-                        "written\n");
-    else
-        fprintf(stderr, "cohfrac: warning: %s %s failed (status %d): no compare.png "
-                        "(needs python3-matplotlib)\n", py, script,
-                WIFEXITED(status) ? WEXITSTATUS(status) : -1);
-    return 0;
+    const char *args[] = {csv, png, title, NULL};
+    return cf_report_plot("compare_plot.py", opt->plot_script, args, "compare.md and compare.csv");
 }
 
 /* ---- the run ---- */
@@ -860,7 +756,7 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     else
         snprintf(r->out_dir, sizeof r->out_dir, "build/compare/%s", sc[0].name);
     /* fail on an unwritable directory before spending the run's time */
-    if ((rc = make_dirs(r->out_dir, err)) != CF_OK)
+    if ((rc = cf_report_mkdirs(r->out_dir, err)) != CF_OK)
         goto done;
 
     if ((rc = snap_take(st.sim[0], &st.s[0], err)) != CF_OK)

@@ -1,0 +1,122 @@
+/* Report files for the studies (see report.h). */
+#include "report.h"
+
+#include <errno.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char **environ;
+
+/* mkdir -p */
+cf_status cf_report_mkdirs(const char *path, cf_error *err)
+{
+    char d[1024];
+    if (snprintf(d, sizeof d, "%s", path) >= (int)sizeof d)
+        return cf_error_set(err, CF_ERR_OUTPUT, "output directory path too long: %s", path);
+    for (char *p = d + 1;; p++) {
+        if (*p == '/' || *p == 0) {
+            char c = *p;
+            *p = 0;
+            if (mkdir(d, 0777) != 0 && errno != EEXIST)
+                return cf_error_set(err, CF_ERR_OUTPUT, "cannot create directory %s: %s", d,
+                                    strerror(errno));
+            *p = c;
+            if (!c)
+                break;
+        }
+    }
+    struct stat sb;
+    if (stat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
+        return cf_error_set(err, CF_ERR_OUTPUT, "%s is not a directory", path);
+    return CF_OK;
+}
+
+cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error *err)
+{
+    snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
+    snprintf(o->tmp, sizeof o->tmp, "%s/%s.tmp", dir, name);
+    o->f = fopen(o->tmp, "w");
+    if (!o->f)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s: %s", o->tmp, strerror(errno));
+    return CF_OK;
+}
+
+/* Close and move into place: the final name only ever holds a whole file. */
+cf_status cf_out_close(cf_outfile *o, cf_error *err)
+{
+    int bad = ferror(o->f);
+    bad |= fclose(o->f) != 0;
+    o->f = NULL;
+    if (bad || rename(o->tmp, o->final) != 0) {
+        int e = errno;
+        remove(o->tmp);
+        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s: %s", o->final, strerror(e));
+    }
+    return CF_OK;
+}
+
+/* The script: the given path, ./tools/, or ../tools/ next to the executable. */
+static int find_script(const char *script, const char *given, char *out, size_t n)
+{
+    if (given) {
+        snprintf(out, n, "%s", given);
+        return access(out, R_OK) == 0;
+    }
+    snprintf(out, n, "tools/%s", script);
+    if (access(out, R_OK) == 0)
+        return 1;
+    char exe[900];
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (len <= 0)
+        return 0;
+    exe[len] = 0;
+    char *slash = strrchr(exe, '/');
+    if (slash)
+        *slash = 0;
+    snprintf(out, n, "%s/../tools/%s", exe, script);
+    return access(out, R_OK) == 0;
+}
+
+int cf_report_plot(const char *script, const char *script_path, const char *const *args,
+                   const char *others)
+{
+    char path[1024];
+    if (!find_script(script, script_path, path, sizeof path)) {
+        fprintf(stderr, "cohfrac: warning: tools/%s not found: no plot (%s are written)\n",
+                script, others);
+        return 0;
+    }
+    const char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+    char *argv[16];
+    int n = 0;
+    argv[n++] = (char *)py;
+    argv[n++] = path;
+    for (int i = 0; args[i] && n < 15; i++)
+        argv[n++] = (char *)args[i];
+    argv[n] = NULL;
+    pid_t pid;
+    int rc = posix_spawnp(&pid, py, NULL, NULL, argv, environ);
+    int status = 0;
+    if (rc == 0 && waitpid(pid, &status, 0) < 0)
+        rc = errno;
+    if (rc != 0) {
+        fprintf(stderr, "cohfrac: warning: cannot run python3 (%s): no plot; install python3 "
+                        "and python3-matplotlib\n", strerror(rc));
+        return 0;
+    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        return 1;
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 3)
+        fprintf(stderr, "cohfrac: warning: matplotlib is missing (install the Debian package "
+                        "python3-matplotlib): no plot; %s are written\n", others);
+    else
+        fprintf(stderr, "cohfrac: warning: %s %s failed (status %d): no plot (needs "
+                        "python3-matplotlib)\n", py, path,
+                WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    return 0;
+}

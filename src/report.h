@@ -1,0 +1,33 @@
+/* Report files for the studies (`compare`, `stability`): directories,
+ * whole-or-nothing text files, and the matplotlib plots made by the scripts
+ * in tools/ with Debian's python3. */
+#ifndef COHFRAC_REPORT_H
+#define COHFRAC_REPORT_H
+
+#include <stdio.h>
+
+#include "cohfrac/error.h"
+
+/* mkdir -p.  Errors: CF_ERR_OUTPUT (cannot create, or not a directory). */
+cf_status cf_report_mkdirs(const char *path, cf_error *err);
+
+/* A text file written to DIR/NAME.tmp and renamed to DIR/NAME on close, so
+ * the final name only ever holds a whole file. */
+typedef struct cf_outfile {
+    FILE *f;
+    char tmp[1100], final[1100];
+} cf_outfile;
+
+/* Errors: CF_ERR_OUTPUT. */
+cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error *err);
+cf_status cf_out_close(cf_outfile *o, cf_error *err);
+
+/* Run tools/<script> (or `script_path` when not NULL; else ./tools/, then
+ * ../tools/ next to the executable) with /usr/bin/python3 and the NULL-ended
+ * `args`.  Returns 1 when it exited with 0; otherwise warns on stderr (exit
+ * status 3 from the script means matplotlib is missing) that only `others`
+ * were written, and returns 0. */
+int cf_report_plot(const char *script, const char *script_path, const char *const *args,
+                   const char *others);
+
+#endif
