@@ -5,6 +5,7 @@
  *   cohfrac compare SCENE.lua [--set key.path=value]... [-o DIR] [-j N]
  *                   [-m MESH_DIR] [-q]
  *   cohfrac mesh SURFACE.{obj,off,stl} -o OUT [--target-tets N]
+ *   cohfrac stability [--quick] [-o DIR] [-q]
  *   cohfrac --help | --version
  *
  * Exit codes: 0 success, 1 usage, 2 bad input (mesh, surface, scene),
@@ -14,6 +15,7 @@
 #include "cohfrac/error.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
+#include "cohfrac/stability.h"
 #include "cohfrac/surface.h"
 
 #include <getopt.h>
@@ -45,6 +47,13 @@ static const char usage[] =
     "  cohfrac mesh SURFACE -o OUT [--target-tets N]\n"
     "                                      repair a closed surface (OBJ/OFF/STL), run tetgen,\n"
     "                                      write OUT.node/OUT.ele (cached)\n"
+    "  cohfrac stability [--quick] [-o DIR] [-q]\n"
+    "                                      stability map of fracture mode over E, dt/dt_cfl,\n"
+    "                                      constraints, impact speed and mesh quality; write\n"
+    "                                      stability.md, stability.csv, stability.png\n"
+    "      --quick                         the corners only (under a minute)\n"
+    "      -o, --output DIR                report directory (default build/stability)\n"
+    "      -q, --quiet                     no line per case\n"
     "  cohfrac --help | --version\n"
     "exit codes: 0 ok, 1 usage, 2 bad input, 3 diverged, 4 output failed, 5 external/memory\n";
 
@@ -84,6 +93,41 @@ static int cmd_mesh(int argc, char **argv)
     if (cf_mesh_prepare(&o, &err) != CF_OK)
         return fail(&err);
     return 0;
+}
+
+static int cmd_stability(int argc, char **argv)
+{
+    static const struct option lo[] = {{"quick", no_argument, 0, 'Q'},
+                                       {"output", required_argument, 0, 'o'},
+                                       {"quiet", no_argument, 0, 'q'},
+                                       {0, 0, 0, 0}};
+    cf_stability_options o = {.progress = 1, .plot = 1};
+    int c;
+    while ((c = getopt_long(argc, argv, "o:q", lo, NULL)) != -1) {
+        switch (c) {
+        case 'Q': o.quick = 1; break;
+        case 'o': o.out_dir = optarg; break;
+        case 'q': o.progress = 0; break;
+        default: return usage_error("bad option for 'stability'");
+        }
+    }
+    if (optind != argc)
+        return usage_error("'stability' takes no positional argument");
+    cf_error err = {0};
+    cf_stability_result res;
+    int rc = 0;
+    if (cf_stability_run(&o, &res, &err) != CF_OK) {
+        rc = fail(&err);
+    } else {
+        int unstable = 0;
+        for (int i = 0; i < res.n; i++)
+            unstable += !res.cases[i].stable;
+        printf("%d cases, %d stable, %d unstable\nreport: %s/stability.md%s\n", res.n,
+               res.n - unstable, unstable, res.out_dir,
+               res.plot_made ? " (heatmaps: stability.png)" : "");
+    }
+    cf_stability_free(&res);
+    return rc;
 }
 
 /* The options `run` and `compare` share: --set (repeatable), --mesh-dir,
@@ -215,5 +259,7 @@ int main(int argc, char **argv)
         return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(argv[1], "mesh"))
         return cmd_mesh(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "stability"))
+        return cmd_stability(argc - 1, argv + 1);
     return usage_error("unknown command");
 }

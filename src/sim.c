@@ -944,6 +944,10 @@ int cf_sim_done(const cf_sim *sim) { return sim->step >= sim->n_steps; }
 
 double cf_sim_time(const cf_sim *sim) { return sim->t; }
 
+double cf_sim_dt_fracture(const cf_sim *sim) { return sim->dt_fracture; }
+
+double cf_sim_dt_cfl(const cf_sim *sim) { return sim->solid.dt_cfl; }
+
 cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
 {
     const cf_scene *sc = sim->scene;

@@ -67,6 +67,11 @@ int cf_sim_done(const cf_sim *sim);
 /* Simulated time, s. */
 double cf_sim_time(const cf_sim *sim);
 
+/* The fracture-mode step (solver.dt_fracture, or cfl_fraction x dt_cfl)
+ * and the mesh's explicit stability limit dt_cfl (DESIGN §3.2), s. */
+double cf_sim_dt_fracture(const cf_sim *sim);
+double cf_sim_dt_cfl(const cf_sim *sim);
+
 /* The energy ledger and momenta now. */
 void cf_sim_ledger(const cf_sim *sim, cf_ledger *out);
 

@@ -1,0 +1,400 @@
+/* cohfrac — the stability map (see include/cohfrac/stability.h for the
+ * cases, the criteria and the files). */
+#include "cohfrac/stability.h"
+#include "cohfrac/mesh.h"
+#include "cohfrac/scene.h"
+#include "cohfrac/sim.h"
+#include "report.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define SIDE 0.1            /* m, the cube */
+#define CELLS 3
+#define SLIVER_SHIFT 0.45   /* of a cell, the largest move of an interior node */
+
+static const double E_AXIS[] = {0.6, 1e3, 1e6, 1e9, 7e10, 2e11};
+static const double DT_AXIS[] = {0.5, 1, 2, 10, 100, 1000};
+static const double SPEED_AXIS[] = {1, 10, 100};
+static const double E_QUICK[] = {0.6, 7e10};
+static const double DT_QUICK[] = {0.5, 10, 100};
+#define LEN(a) ((int)(sizeof(a) / sizeof(a)[0]))
+
+const char *cf_stability_mode_name(cf_stability_mode m)
+{
+    static const char *const names[] = {"none", "pbd_k0.9_it3", "pbd_k1_it10", "xpbd"};
+    return m >= 0 && m < CF_STAB_N_MODES ? names[m] : "?";
+}
+
+static const char *const scene_text =
+    "-- Written by `cohfrac stability`: the base case (see cohfrac/stability.h).\n"
+    "return {\n"
+    "  name = 'stability', duration = 1, gravity = {0, 0, 0},\n"
+    "  material = {E = 1e6, nu = 0.25, rho = 2400, G_I = 1, sigma_max = 1,\n"
+    "              friction = 0.5, restitution = 0},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"
+    "                     tets_per_cell = 6},\n"
+    "             position = {0, 0, 0.05}, velocity = {0, 0, -10}}},\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {mode = 'fracture', criterion = 'none', cfl_fraction = 1, threads = 1,\n"
+    "            guard = {max_energy_growth = 0.1, max_inverted_fraction = 0.01}},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+/* The grid of the regular cube with its interior nodes moved at random (a
+ * fixed seed) by up to SLIVER_SHIFT of a cell per axis; a draw that inverts
+ * a tet is drawn again.  Writes DIR/sliver_cube.{node,ele}; *quality gets
+ * the smallest 6 sqrt(2) V / l_max^3 over the tets (1 for a regular tet). */
+static cf_status write_sliver_mesh(const char *dir, char *base, size_t n, double *quality,
+                                   cf_error *err)
+{
+    const double size[3] = {SIDE, SIDE, SIDE};
+    const int cells[3] = {CELLS, CELLS, CELLS};
+    cf_mesh m = {0};
+    cf_status st = cf_mesh_box(size, cells, 6, &m, err);
+    if (st != CF_OK)
+        return st;
+    double *x0 = malloc((size_t)m.n_nodes * 3 * sizeof(double));
+    if (!x0) {
+        cf_mesh_free(&m);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    memcpy(x0, m.x, (size_t)m.n_nodes * 3 * sizeof(double));
+    uint64_t seed = 0x9e3779b97f4a7c15ull;
+    double h = SIDE / CELLS, q = 0;
+    for (int draw = 0; draw < 1000 && q <= 0; draw++) {
+        for (int a = 0; a < m.n_nodes; a++)
+            for (int k = 0; k < 3; k++) {
+                double *xa = &m.x[3 * a + k];
+                *xa = x0[3 * a + k];
+                int interior = 1;
+                for (int c = 0; c < 3; c++)
+                    interior &= fabs(fabs(x0[3 * a + c]) - 0.5 * SIDE) > 1e-9;
+                seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+                double u = (double)(seed >> 11) / 9007199254740992.0; /* [0, 1) */
+                if (interior)
+                    *xa += SLIVER_SHIFT * h * (2 * u - 1);
+            }
+        q = INFINITY;
+        for (int t = 0; t < m.n_tets; t++) {
+            const double *p[4];
+            for (int j = 0; j < 4; j++)
+                p[j] = &m.x[3 * m.tets[4 * t + j]];
+            double e[3][3], lmax = 0;
+            for (int j = 0; j < 3; j++)
+                for (int k = 0; k < 3; k++)
+                    e[j][k] = p[j + 1][k] - p[0][k];
+            double vol = (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                          e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                          e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6;
+            for (int i = 0; i < 4; i++)
+                for (int j = i + 1; j < 4; j++) {
+                    double d2 = 0;
+                    for (int k = 0; k < 3; k++)
+                        d2 += (p[i][k] - p[j][k]) * (p[i][k] - p[j][k]);
+                    lmax = fmax(lmax, sqrt(d2));
+                }
+            q = fmin(q, 6 * sqrt(2.0) * vol / (lmax * lmax * lmax));
+        }
+    }
+    free(x0);
+    *quality = q;
+    snprintf(base, n, "%s/sliver_cube", dir);
+    st = q > 0 ? cf_mesh_write_tetgen(&m, base, err)
+               : cf_error_set(err, CF_ERR_MESH_INVERTED, "no valid sliver mesh drawn");
+    cf_mesh_free(&m);
+    return st;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The case's --set overrides; `dt` > 0 also fixes dt_rigid and the duration. */
+static int case_overrides(const cf_stability_case *c, const char *sliver, double dt,
+                          char ov[][160])
+{
+    int n = 0;
+    snprintf(ov[n++], 160, "material.E=%.17g", c->E);
+    snprintf(ov[n++], 160, "solver.cfl_fraction=%.17g", c->dt_ratio);
+    snprintf(ov[n++], 160, "bodies[1].velocity={0,0,%.17g}", -c->speed);
+    if (c->sliver)
+        snprintf(ov[n++], 160, "bodies[1].mesh=\"%s\"", sliver);
+    const char *cons = c->mode == CF_STAB_NONE ? "none" : c->mode == CF_STAB_XPBD ? "xpbd" : "pbd";
+    snprintf(ov[n++], 160, "solver.constraints=\"%s\"", cons);
+    if (c->mode == CF_STAB_PBD_STIFF) {
+        snprintf(ov[n++], 160, "solver.pbd.k_stiffness=1");
+        snprintf(ov[n++], 160, "solver.pbd.iterations=10");
+    }
+    if (dt > 0) {
+        snprintf(ov[n++], 160, "solver.dt_rigid=%.17g", dt);
+        snprintf(ov[n++], 160, "solver.dt_fracture=%.17g", dt);
+        snprintf(ov[n++], 160, "duration=%.17g", CF_STABILITY_STEPS * dt);
+    }
+    return n;
+}
+
+static cf_status make_sim(const char *scene, const cf_stability_case *c, const char *sliver,
+                          double dt, cf_scene *sc, cf_sim **sim, cf_error *err)
+{
+    char ov[12][160];
+    const char *ovp[12];
+    int n = case_overrides(c, sliver, dt, ov);
+    for (int i = 0; i < n; i++)
+        ovp[i] = ov[i];
+    cf_status st = cf_scene_load(scene, ovp, n, NULL, sc, err);
+    if (st != CF_OK)
+        return st;
+    cf_run_options opt = {0, 1, NULL};
+    st = cf_sim_create(sc, &opt, sim, err);
+    if (st != CF_OK)
+        cf_scene_free(sc);
+    return st;
+}
+
+/* Which criterion the engine's divergence guard reported. */
+static const char *guard_reason(const char *msg)
+{
+    if (strstr(msg, "not finite"))
+        return "nan";
+    if (strstr(msg, "inverted"))
+        return "inverted";
+    if (strstr(msg, "energy grew"))
+        return "energy";
+    return "error";
+}
+
+/* One case: dt from the mesh's dt_cfl, then CF_STABILITY_STEPS steps. */
+static cf_status run_case(const char *scene, const char *sliver, cf_stability_case *c,
+                          cf_error *err)
+{
+    double t0 = now_s();
+    cf_scene sc;
+    cf_sim *sim = NULL;
+    cf_status st = make_sim(scene, c, sliver, 0, &sc, &sim, err);
+    if (st != CF_OK)
+        return st;
+    c->dt = cf_sim_dt_fracture(sim);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+    if ((st = make_sim(scene, c, sliver, c->dt, &sc, &sim, err)) != CF_OK)
+        return st;
+    cf_fragment_state f0, f;
+    cf_sim_fragments(sim, &f0, 1);
+    double reach = 2 * c->speed * CF_STABILITY_STEPS * c->dt + 2 * SIDE;
+    c->stable = 1, c->reason = "", c->fail_step = 0, c->energy_ratio = 1;
+    for (long step = 1; !cf_sim_done(sim); step++) {
+        cf_error e = {0};
+        st = cf_sim_advance(sim, &e);
+        cf_ledger l;
+        cf_sim_ledger(sim, &l);
+        if (l.initial > 0 && isfinite(l.kinetic + l.strain))
+            c->energy_ratio = fmax(c->energy_ratio, (l.kinetic + l.strain) / l.initial);
+        const char *why = NULL;
+        if (st == CF_ERR_DIVERGED)
+            why = guard_reason(e.msg);
+        else if (st != CF_OK)
+            why = "error";
+        else if (cf_sim_fragments(sim, &f, 1) >= 1) {
+            double d2 = 0;
+            for (int k = 0; k < 3; k++)
+                d2 += (f.com[k] - f0.com[k]) * (f.com[k] - f0.com[k]);
+            if (!(sqrt(d2) <= reach) || f.com[2] < -SIDE)
+                why = "escaped";
+        }
+        if (why) {
+            c->stable = 0, c->reason = why, c->fail_step = step;
+            break;
+        }
+    }
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+    c->wall = now_s() - t0;
+    return CF_OK;
+}
+
+/* The cases of the map, in file order. */
+static int build_cases(int quick, cf_stability_case *out)
+{
+    int n = 0;
+    cf_stability_case base = {.slice = "E x dt", .speed = 10};
+    for (int m = 0; m < CF_STAB_N_MODES; m++) {
+        const double *ea = quick ? E_QUICK : E_AXIS, *da = quick ? DT_QUICK : DT_AXIS;
+        int ne = quick ? LEN(E_QUICK) : LEN(E_AXIS), nd = quick ? LEN(DT_QUICK) : LEN(DT_AXIS);
+        for (int i = 0; i < ne; i++)
+            for (int j = 0; j < nd; j++) {
+                cf_stability_case c = base;
+                c.mode = (cf_stability_mode)m, c.E = ea[i], c.dt_ratio = da[j];
+                if (out)
+                    out[n] = c;
+                n++;
+            }
+    }
+    if (quick)
+        return n;
+    for (int m = 0; m < CF_STAB_N_MODES; m++)
+        for (int i = 0; i < LEN(SPEED_AXIS); i++)
+            for (int j = 0; j < LEN(DT_AXIS); j++) {
+                cf_stability_case c = {.slice = "speed x dt", .E = 7e10, .speed = SPEED_AXIS[i],
+                                       .dt_ratio = DT_AXIS[j], .mode = (cf_stability_mode)m};
+                if (out)
+                    out[n] = c;
+                n++;
+            }
+    for (int m = 0; m < CF_STAB_N_MODES; m++)
+        for (int s = 0; s < 2; s++)
+            for (int j = 0; j < LEN(DT_AXIS); j++) {
+                cf_stability_case c = {.slice = "mesh x dt", .E = 7e10, .speed = 10,
+                                       .sliver = s, .dt_ratio = DT_AXIS[j],
+                                       .mode = (cf_stability_mode)m};
+                if (out)
+                    out[n] = c;
+                n++;
+            }
+    return n;
+}
+
+static cf_status write_csv(const cf_stability_result *r, cf_error *err)
+{
+    cf_outfile o;
+    cf_status st = cf_out_open(&o, r->out_dir, "stability.csv", err);
+    if (st != CF_OK)
+        return st;
+    fprintf(o.f, "slice,constraints,E_Pa,dt_over_dt_cfl,speed_m_s,mesh,dt_s,stable,reason,"
+                 "first_failing_step,max_energy_ratio,wall_s\n");
+    for (int i = 0; i < r->n; i++) {
+        const cf_stability_case *c = &r->cases[i];
+        fprintf(o.f, "%s,%s,%.6g,%g,%g,%s,%.6g,%d,%s,%ld,%.6g,%.4f\n", c->slice,
+                cf_stability_mode_name(c->mode), c->E, c->dt_ratio, c->speed,
+                c->sliver ? "sliver" : "regular", c->dt, c->stable, c->reason, c->fail_step,
+                c->energy_ratio, c->wall);
+    }
+    return cf_out_close(&o, err);
+}
+
+/* The stiffest E of the E x dt slice at which `mode` is stable at dt_ratio
+ * (NaN when none). */
+static double stiffest_stable(const cf_stability_result *r, cf_stability_mode mode,
+                              double dt_ratio)
+{
+    double best = NAN;
+    for (int i = 0; i < r->n; i++) {
+        const cf_stability_case *c = &r->cases[i];
+        if (!strcmp(c->slice, "E x dt") && c->mode == mode && c->dt_ratio == dt_ratio &&
+            c->stable && !(c->E <= best))
+            best = c->E;
+    }
+    return best;
+}
+
+static cf_status write_md(const cf_stability_result *r, int quick, double quality, cf_error *err)
+{
+    cf_outfile o;
+    cf_status st = cf_out_open(&o, r->out_dir, "stability.md", err);
+    if (st != CF_OK)
+        return st;
+    FILE *f = o.f;
+    fprintf(f, "# Stability map%s\n\n", quick ? " (--quick)" : "");
+    fprintf(f, "Each case: a %.1f m cube (rho 2400 kg/m^3, nu 0.25, %d^3 cells of 6 Tet4) "
+               "touching a rigid plane moves into it at the impact speed; fracture mode only, "
+               "no gravity, no cohesive insertion, friction 0.5, restitution 0; %d steps of "
+               "dt = (dt/dt_cfl) dt_cfl.\n\n", SIDE, CELLS, CF_STABILITY_STEPS);
+    fprintf(f, "Unstable at the first step where: **nan** a node is not finite or faster "
+               "than 1e5 m/s; **energy** kinetic + strain > 1.1 x the initial kinetic energy "
+               "(no work input); **inverted** more than 1%% of the tets have det F <= 0; "
+               "**escaped** the centre of mass is farther than 2 v T + 0.2 m from its start "
+               "or 0.1 m below the plane.  Cells give `stable`, or the criterion and the first "
+               "failing step.\n\n");
+    if (!quick)
+        fprintf(f, "Sliver mesh: interior nodes moved at random by up to %.0f%% of a cell; "
+                   "smallest tet quality 6 sqrt(2) V / l_max^3 = %.3f (1 for a regular tet, "
+                   "0.5 in the regular cube mesh).\n\n", 100 * SLIVER_SHIFT, quality);
+    fprintf(f, "Stiffest E stable at 100 dt_cfl (E x dt slice, 10 m/s):");
+    for (int m = 0; m < CF_STAB_N_MODES; m++) {
+        double e = stiffest_stable(r, (cf_stability_mode)m, 100);
+        if (isnan(e))
+            fprintf(f, "%s %s: none", m ? ";" : "", cf_stability_mode_name((cf_stability_mode)m));
+        else
+            fprintf(f, "%s %s: %.3g Pa", m ? ";" : "", cf_stability_mode_name((cf_stability_mode)m), e);
+    }
+    fprintf(f, ".\n");
+    const char *slice = "";
+    for (int i = 0; i < r->n; i++) {
+        const cf_stability_case *c = &r->cases[i];
+        if (strcmp(c->slice, slice)) {
+            slice = c->slice;
+            fprintf(f, "\n## %s\n\n| constraints | E (Pa) | speed (m/s) | mesh | dt/dt_cfl | "
+                       "dt (s) | result | max energy ratio |\n|---|---|---|---|---|---|---|---|\n",
+                    slice);
+        }
+        char res[64];
+        if (c->stable)
+            snprintf(res, sizeof res, "stable");
+        else
+            snprintf(res, sizeof res, "**%s** at step %ld", c->reason, c->fail_step);
+        fprintf(f, "| %s | %.3g | %g | %s | %g | %.3g | %s | %.3g |\n",
+                cf_stability_mode_name(c->mode), c->E, c->speed, c->sliver ? "sliver" : "regular",
+                c->dt_ratio, c->dt, res, c->energy_ratio);
+    }
+    fprintf(f, "\nFiles: `stability.csv` (every case), `stability.png` (heatmaps by "
+               "tools/stability_plot.py).\n");
+    return cf_out_close(&o, err);
+}
+
+cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result *r,
+                           cf_error *err)
+{
+    memset(r, 0, sizeof *r);
+    snprintf(r->out_dir, sizeof r->out_dir, "%s", opt->out_dir ? opt->out_dir : "build/stability");
+    cf_status st = cf_report_mkdirs(r->out_dir, err);
+    if (st != CF_OK)
+        return st;
+    char scene[1100], sliver[1100] = "";
+    snprintf(scene, sizeof scene, "%s/stability_scene.lua", r->out_dir);
+    FILE *sf = fopen(scene, "w");
+    if (!sf || fputs(scene_text, sf) < 0 || fclose(sf) != 0)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s", scene);
+    double quality = NAN;
+    if (!opt->quick && (st = write_sliver_mesh(r->out_dir, sliver, sizeof sliver, &quality, err)))
+        return st;
+    r->n = build_cases(opt->quick, NULL);
+    r->cases = calloc((size_t)r->n, sizeof *r->cases);
+    if (!r->cases)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    build_cases(opt->quick, r->cases);
+    for (int i = 0; i < r->n; i++) {
+        cf_stability_case *c = &r->cases[i];
+        if ((st = run_case(scene, sliver, c, err)) != CF_OK)
+            return st;
+        if (opt->progress)
+            fprintf(stderr, "stability %3d/%d  %-12s E %-8.3g dt/dt_cfl %-6g v %-4g %-7s  %s%s\n",
+                    i + 1, r->n, cf_stability_mode_name(c->mode), c->E, c->dt_ratio, c->speed,
+                    c->sliver ? "sliver" : "regular", c->stable ? "stable" : "unstable: ",
+                    c->reason);
+    }
+    if ((st = write_csv(r, err)) != CF_OK || (st = write_md(r, opt->quick, quality, err)) != CF_OK)
+        return st;
+    if (opt->plot) {
+        char csv[1100], png[1100];
+        snprintf(csv, sizeof csv, "%s/stability.csv", r->out_dir);
+        snprintf(png, sizeof png, "%s/stability.png", r->out_dir);
+        const char *args[] = {csv, png, NULL};
+        r->plot_made = cf_report_plot("stability_plot.py", opt->plot_script, args,
+                                      "stability.md and stability.csv");
+    }
+    return CF_OK;
+}
+
+void cf_stability_free(cf_stability_result *r)
+{
+    free(r->cases);
+    r->cases = NULL;
+    r->n = 0;
+}
