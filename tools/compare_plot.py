@@ -15,14 +15,9 @@ import math
 import os
 import sys
 
-try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    sys.stderr.write("compare_plot.py: matplotlib is missing "
-                     "(install the Debian package python3-matplotlib)\n")
-    sys.exit(3)
+from mpl_agg import pyplot
+
+plt = pyplot("compare_plot.py")
 
 COLOURS = {"bullet": "tab:blue", "pbd": "tab:orange", "ref": "black"}
 

@@ -13,15 +13,10 @@ import csv
 import os
 import sys
 
-try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import ListedColormap
-except ImportError:
-    sys.stderr.write("stability_plot.py: matplotlib is missing "
-                     "(install the Debian package python3-matplotlib)\n")
-    sys.exit(3)
+from mpl_agg import pyplot
+
+plt = pyplot("stability_plot.py")
+from matplotlib.colors import ListedColormap  # noqa: E402
 
 ROWS = {"E x dt": ("E_Pa", "E (Pa)"), "speed x dt": ("speed_m_s", "impact speed (m/s)"),
         "mesh x dt": ("mesh", "mesh")}
