@@ -4,6 +4,7 @@
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
 #include "linalg.h"
+#include "clock.h"
 #include "report.h"
 
 #include <errno.h>
@@ -14,7 +15,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
-#include <time.h>
 #include <unistd.h>
 
 static const char *const backend_name[2] = {"bullet", "pbd"};
@@ -61,13 +61,6 @@ typedef struct totals {
 } totals;
 
 /* ---- small helpers ---- */
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double v3_dist(const double a[3], const double b[3])
 {
@@ -773,9 +766,9 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
         for (int b = 0; b < 2 && run_st == CF_OK; b++) {
             if (cf_sim_done(st.sim[b]))
                 continue;
-            double t0 = now_s();
+            double t0 = cf_wall_time();
             run_st = cf_sim_advance(st.sim[b], &run_err);
-            double w = now_s() - t0;
+            double w = cf_wall_time() - t0;
             r->wall[b] += w;
             /* after the split: from the step whose fragments outnumber the bodies */
             if (isnan(r->t_split[b]) && cf_sim_fragments(st.sim[b], NULL, 0) > n_bodies)

@@ -6,15 +6,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-double cf_wall_time(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static int ensure_scratch(cf_fragment *f)
 {
     if (cf_node_impulses_reserve(&f->push, f->nodes.n))

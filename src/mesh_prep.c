@@ -26,6 +26,7 @@
  */
 #define _XOPEN_SOURCE 700 /* POSIX 2008 + realpath */
 
+#include "clock.h"
 #include "file_text.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/surface.h"
@@ -42,7 +43,6 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 extern char **environ;
@@ -54,13 +54,6 @@ extern char **environ;
 #define BASE_OPTS "pYq2.0"
 #define TOL 0.05
 #define MAX_A_RUNS 8
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static char *str_cat(const char *a, const char *b)
 {
@@ -189,7 +182,7 @@ static cf_status run_tetgen(const char *dir, const char *opts, cf_mesh *m, doubl
     posix_spawn_file_actions_adddup2(&fa, 1, 2);
     char *argv[] = {(char *)prog, flag, in, NULL};
     pid_t pid;
-    double t0 = now_s();
+    double t0 = cf_wall_time();
     int rc = posix_spawnp(&pid, prog, &fa, NULL, argv, environ);
     posix_spawn_file_actions_destroy(&fa);
     if (rc != 0)
@@ -202,7 +195,7 @@ static cf_status run_tetgen(const char *dir, const char *opts, cf_mesh *m, doubl
         if (errno != EINTR)
             return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for %s failed (%s)", prog,
                                 strerror(errno));
-    *secs = now_s() - t0;
+    *secs = cf_wall_time() - t0;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         char tail[600];
         cf_file_log_tail(logp, tail, sizeof tail);
@@ -349,7 +342,7 @@ static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int 
         cf_status st = copy_surface(full, out, err);
         if (st != CF_OK)
             return st;
-        double t0 = now_s();
+        double t0 = cf_wall_time();
         int got = cf_surface_decimate(out, tris);
         if (got < 0) {
             cf_surface_free(out);
@@ -362,7 +355,7 @@ static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int 
             fprintf(stderr,
                     "  decimated to %d triangles, %d vertices (asked %d) in %.2f s; volume "
                     "%.9g; %d intersecting pairs\n",
-                    got, out->n_verts, tris, now_s() - t0, cf_surface_volume(out), n);
+                    got, out->n_verts, tris, cf_wall_time() - t0, cf_surface_volume(out), n);
         if (n == 0 && closed == 1)
             return CF_OK;
         cf_surface_free(out);
@@ -521,7 +514,7 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
     if (o->target_tets < 0)
         return cf_error_set(err, CF_ERR_USAGE, "--target-tets must be >= 0 (got %d)",
                             o->target_tets);
-    double t_start = now_s();
+    double t_start = cf_wall_time();
     char key[PATH_MAX + 512];
     cf_status st = stamp_key(o, key, sizeof key, err);
     if (st != CF_OK)
@@ -588,7 +581,7 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
     if (o->verbose)
         fprintf(stderr, "cohfrac mesh: wrote %s.node/.ele: %d nodes, %d tets (tetgen -%s) in "
                         "%.1f s\n",
-                o->output, best.m.n_nodes, best.m.n_tets, best.opts, now_s() - t_start);
+                o->output, best.m.n_nodes, best.m.n_tets, best.opts, cf_wall_time() - t_start);
 out:
     if (dir[0])
         remove_tree(dir);

@@ -4,6 +4,7 @@
 #define COHFRAC_SIM_PRIVATE_H
 
 #include "cf_bullet.h"
+#include "clock.h"
 #include "cohesive_ppr.h"
 #include "contact.h"
 #include "decompose.h"
@@ -103,8 +104,6 @@ struct cf_sim {
     double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
     cf_hull_set near;        /* hulls near the fragment being sub-cycled */
 };
-
-double cf_wall_time(void);
 
 /* One step of the in-house solver on fragment f (source Table 6.2): with
  * `fracture` set, stresses every check_interval steps, cohesive insertion,

@@ -4,6 +4,7 @@
 #include "cohfrac/mesh.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
+#include "clock.h"
 #include "report.h"
 
 #include <math.h>
@@ -11,7 +12,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define SIDE 0.1            /* m, the cube */
 #define CELLS 3
@@ -110,13 +110,6 @@ static cf_status write_sliver_mesh(const char *dir, char *base, size_t n, double
     return st;
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* The case's --set overrides; `dt` > 0 also fixes dt_rigid and the duration. */
 static int case_overrides(const cf_stability_case *c, const char *sliver, double dt,
                           char ov[][160])
@@ -175,7 +168,7 @@ static const char *guard_reason(const char *msg)
 static cf_status run_case(const char *scene, const char *sliver, cf_stability_case *c,
                           cf_error *err)
 {
-    double t0 = now_s();
+    double t0 = cf_wall_time();
     cf_scene sc;
     cf_sim *sim = NULL;
     cf_status st = make_sim(scene, c, sliver, 0, &sc, &sim, err);
@@ -216,7 +209,7 @@ static cf_status run_case(const char *scene, const char *sliver, cf_stability_ca
     }
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
-    c->wall = now_s() - t0;
+    c->wall = cf_wall_time() - t0;
     return CF_OK;
 }
 
