@@ -5,6 +5,7 @@
 #include "cohfrac/sim.h"
 #include "linalg.h"
 #include "clock.h"
+#include "file_text.h"
 #include "report.h"
 
 #include <errno.h>
@@ -749,7 +750,7 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     else
         snprintf(r->out_dir, sizeof r->out_dir, "build/compare/%s", sc[0].name);
     /* fail on an unwritable directory before spending the run's time */
-    if ((rc = cf_report_mkdirs(r->out_dir, err)) != CF_OK)
+    if ((rc = cf_mkdirs(r->out_dir, "report directory", err)) != CF_OK)
         goto done;
 
     if ((rc = snap_take(st.sim[0], &st.s[0], err)) != CF_OK)

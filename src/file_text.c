@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
 
 char *cf_file_read(const char *path, size_t *len)
 {
@@ -59,4 +61,28 @@ void cf_file_log_tail(const char *path, char *out, size_t max)
     char *nl = from > 0 ? strchr(out, '\n') : NULL;
     if (nl)
         memmove(out, nl + 1, strlen(nl + 1) + 1);
+}
+
+cf_status cf_mkdirs(const char *path, const char *what, cf_error *err)
+{
+    char d[4096];
+    if (snprintf(d, sizeof d, "%s", path) >= (int)sizeof d)
+        return cf_error_set(err, CF_ERR_OUTPUT, "%s name too long: %s", what, path);
+    for (char *p = d + 1;; p++) {
+        if (*p == '/' || *p == '\0') {
+            char c = *p;
+            *p = '\0';
+            struct stat sb;
+            if (mkdir(d, 0777) != 0 && errno != EEXIST)
+                return cf_error_set(err, CF_ERR_OUTPUT, "cannot create %s %s (%s)", what, d,
+                                    strerror(errno));
+            if (stat(d, &sb) != 0 || !S_ISDIR(sb.st_mode))
+                return cf_error_set(err, CF_ERR_OUTPUT,
+                                    "%s is not a directory; give another %s", d, what);
+            *p = c;
+            if (!c)
+                break;
+        }
+    }
+    return CF_OK;
 }

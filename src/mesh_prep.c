@@ -73,28 +73,13 @@ static cf_status make_parent_dirs(const char *path, cf_error *err)
     if (!d)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     char *slash = strrchr(d, '/');
-    if (!slash || slash == d) {
-        free(d);
-        return CF_OK;
-    }
-    *slash = '\0';
-    for (char *p = d + 1;; p++) {
-        if (*p == '/' || *p == '\0') {
-            char c = *p;
-            *p = '\0';
-            if (mkdir(d, 0777) != 0 && errno != EEXIST) {
-                cf_status st = cf_error_set(err, CF_ERR_OUTPUT,
-                                            "cannot create directory %s (%s)", d, strerror(errno));
-                free(d);
-                return st;
-            }
-            *p = c;
-            if (!c)
-                break;
-        }
+    cf_status st = CF_OK;
+    if (slash && slash != d) {
+        *slash = '\0';
+        st = cf_mkdirs(d, "mesh output directory", err);
     }
     free(d);
-    return CF_OK;
+    return st;
 }
 
 /* Remove the temporary directory and the files in it (all ours). */

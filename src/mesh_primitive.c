@@ -218,31 +218,6 @@ static uint64_t fnv1a(const char *s)
     return h;
 }
 
-/* mkdir -p */
-static cf_status make_dirs(const char *dir, cf_error *err)
-{
-    char d[PATH_MAX];
-    if (snprintf(d, sizeof d, "%s", dir) >= (int)sizeof d)
-        return cf_error_set(err, CF_ERR_OUTPUT, "cache directory name too long: %s", dir);
-    for (char *p = d + 1;; p++) {
-        if (*p == '/' || *p == '\0') {
-            char c = *p;
-            *p = '\0';
-            struct stat st;
-            if (mkdir(d, 0777) != 0 && errno != EEXIST)
-                return cf_error_set(err, CF_ERR_OUTPUT, "cannot create directory %s (%s)", d,
-                                    strerror(errno));
-            if (stat(d, &st) != 0 || !S_ISDIR(st.st_mode))
-                return cf_error_set(err, CF_ERR_OUTPUT,
-                                    "%s is not a directory; give another mesh cache directory", d);
-            *p = c;
-            if (!c)
-                break;
-        }
-    }
-    return CF_OK;
-}
-
 static cf_status write_text(const char *path, const char *text, cf_error *err)
 {
     FILE *f = fopen(path, "w");
@@ -370,7 +345,7 @@ cf_status cf_mesh_primitive(const cf_primitive *p, const char *cache_dir, cf_mes
     }
     struct stat sb;
     if (stat(path, &sb) != 0) {
-        st = make_dirs(cache_dir, err);
+        st = cf_mkdirs(cache_dir, "mesh cache directory", err);
         if (st == CF_OK)
             st = mesh_with_gmsh(script, path, geo_path, err);
     }

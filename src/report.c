@@ -12,30 +12,6 @@
 
 extern char **environ;
 
-/* mkdir -p */
-cf_status cf_report_mkdirs(const char *path, cf_error *err)
-{
-    char d[1024];
-    if (snprintf(d, sizeof d, "%s", path) >= (int)sizeof d)
-        return cf_error_set(err, CF_ERR_OUTPUT, "output directory path too long: %s", path);
-    for (char *p = d + 1;; p++) {
-        if (*p == '/' || *p == 0) {
-            char c = *p;
-            *p = 0;
-            if (mkdir(d, 0777) != 0 && errno != EEXIST)
-                return cf_error_set(err, CF_ERR_OUTPUT, "cannot create directory %s: %s", d,
-                                    strerror(errno));
-            *p = c;
-            if (!c)
-                break;
-        }
-    }
-    struct stat sb;
-    if (stat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
-        return cf_error_set(err, CF_ERR_OUTPUT, "%s is not a directory", path);
-    return CF_OK;
-}
-
 cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error *err)
 {
     snprintf(o->final, sizeof o->final, "%s/%s", dir, name);

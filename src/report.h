@@ -1,5 +1,5 @@
-/* Report files for the studies (`compare`, `stability`): directories,
- * whole-or-nothing text files, and the matplotlib plots made by the scripts
+/* Report files for the studies (`compare`, `stability`; their directories
+ * come from cf_mkdirs in file_text.h): whole-or-nothing text files, and the matplotlib plots made by the scripts
  * in tools/ with Debian's python3. */
 #ifndef COHFRAC_REPORT_H
 #define COHFRAC_REPORT_H
@@ -7,9 +7,6 @@
 #include <stdio.h>
 
 #include "cohfrac/error.h"
-
-/* mkdir -p.  Errors: CF_ERR_OUTPUT (cannot create, or not a directory). */
-cf_status cf_report_mkdirs(const char *path, cf_error *err);
 
 /* A text file written to DIR/NAME.tmp and renamed to DIR/NAME on close, so
  * the final name only ever holds a whole file. */

@@ -5,6 +5,7 @@
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
 #include "clock.h"
+#include "file_text.h"
 #include "report.h"
 
 #include <math.h>
@@ -346,7 +347,7 @@ cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result 
 {
     memset(r, 0, sizeof *r);
     snprintf(r->out_dir, sizeof r->out_dir, "%s", opt->out_dir ? opt->out_dir : "build/stability");
-    cf_status st = cf_report_mkdirs(r->out_dir, err);
+    cf_status st = cf_mkdirs(r->out_dir, "report directory", err);
     if (st != CF_OK)
         return st;
     char scene[1100], sliver[1100] = "";
