@@ -6,6 +6,7 @@
 #include "cohfrac/sim.h"
 #include "clock.h"
 #include "file_text.h"
+#include "linalg.h"
 #include "report.h"
 
 #include <math.h>
@@ -46,6 +47,24 @@ static const char *const scene_text =
     "  output = {file = ''},\n"
     "}\n";
 
+/* 6 sqrt(2) V / l_max^3 of a tet: 1 for a regular tet, 0 for a flat one,
+ * negative when inverted. */
+static double tet_quality(const double *x, const int *v)
+{
+    double e[3][3], c[3], lmax = 0;
+    for (int j = 0; j < 3; j++)
+        v3_sub(&x[3 * v[j + 1]], &x[3 * v[0]], e[j]);
+    v3_cross(e[1], e[2], c);
+    double vol = v3_dot(e[0], c) / 6;
+    for (int i = 0; i < 4; i++)
+        for (int j = i + 1; j < 4; j++) {
+            double d[3];
+            v3_sub(&x[3 * v[i]], &x[3 * v[j]], d);
+            lmax = fmax(lmax, v3_norm(d));
+        }
+    return 6 * sqrt(2.0) * vol / (lmax * lmax * lmax);
+}
+
 /* The grid of the regular cube with its interior nodes moved at random (a
  * fixed seed) by up to SLIVER_SHIFT of a cell per axis; a draw that inverts
  * a tet is drawn again.  Writes DIR/sliver_cube.{node,ele}; *quality gets
@@ -81,26 +100,8 @@ static cf_status write_sliver_mesh(const char *dir, char *base, size_t n, double
                     *xa += SLIVER_SHIFT * h * (2 * u - 1);
             }
         q = INFINITY;
-        for (int t = 0; t < m.n_tets; t++) {
-            const double *p[4];
-            for (int j = 0; j < 4; j++)
-                p[j] = &m.x[3 * m.tets[4 * t + j]];
-            double e[3][3], lmax = 0;
-            for (int j = 0; j < 3; j++)
-                for (int k = 0; k < 3; k++)
-                    e[j][k] = p[j + 1][k] - p[0][k];
-            double vol = (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-                          e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                          e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6;
-            for (int i = 0; i < 4; i++)
-                for (int j = i + 1; j < 4; j++) {
-                    double d2 = 0;
-                    for (int k = 0; k < 3; k++)
-                        d2 += (p[i][k] - p[j][k]) * (p[i][k] - p[j][k]);
-                    lmax = fmax(lmax, sqrt(d2));
-                }
-            q = fmin(q, 6 * sqrt(2.0) * vol / (lmax * lmax * lmax));
-        }
+        for (int t = 0; t < m.n_tets; t++)
+            q = fmin(q, tet_quality(m.x, &m.tets[4 * t]));
     }
     free(x0);
     *quality = q;
