@@ -5,6 +5,9 @@
  *   cohfrac compare SCENE.lua [--set key.path=value]... [-o DIR] [-j N]
  *                   [-m MESH_DIR] [-q]
  *   cohfrac mesh SURFACE.{obj,off,stl} -o OUT [--target-tets N]
+ *   cohfrac study SCENE.lua --vary key.path=v1,v2,... [--vary ...]
+ *                 [--reference key.path=value]... [--set key.path=value]...
+ *                 [-o DIR] [-j JOBS] [-t THREADS] [-m MESH_DIR] [--tolerance F] [-q]
  *   cohfrac stability [--quick] [-o DIR] [-q]
  *   cohfrac --help | --version
  *
@@ -16,6 +19,7 @@
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
 #include "cohfrac/stability.h"
+#include "cohfrac/study.h"
 #include "cohfrac/surface.h"
 
 #include <getopt.h>
@@ -47,6 +51,20 @@ static const char usage[] =
     "  cohfrac mesh SURFACE -o OUT [--target-tets N]\n"
     "                                      repair a closed surface (OBJ/OFF/STL), run tetgen,\n"
     "                                      write OUT.node/OUT.ele (cached)\n"
+    "  cohfrac study SCENE.lua --vary KEY.PATH=V1,V2,... [options]\n"
+    "                                      run every combination of the varied settings and\n"
+    "                                      a reference; error against run time: study.md,\n"
+    "                                      study.csv, study.png (runs cached in OUT/runs/)\n"
+    "      -V, --vary KEY.PATH=V1,V2,...   a varied key and its Lua values, repeatable\n"
+    "      -r, --reference KEY.PATH=VALUE  the reference's overrides, repeatable (default:\n"
+    "                                      solver.constraints=\"none\" solver.cfl_fraction=0.5)\n"
+    "      -s, --set KEY.PATH=VALUE        override for every case, repeatable\n"
+    "      -o, --output DIR                report directory (default build/studies/<scene name>)\n"
+    "      -j, --jobs N                    cases run at a time (default 1)\n"
+    "      -t, --threads N                 threads per case (default cores / jobs)\n"
+    "      -m, --mesh-dir DIR              as for 'run'\n"
+    "          --tolerance F               trajectory error of the verdict (default 0.05)\n"
+    "      -q, --quiet                     no line per finished case\n"
     "  cohfrac stability [--quick] [-o DIR] [-q]\n"
     "                                      stability map of fracture mode over E, dt/dt_cfl,\n"
     "                                      constraints, impact speed and mesh quality; write\n"
@@ -241,6 +259,77 @@ static int cmd_compare(int argc, char **argv)
     return rc;
 }
 
+static int cmd_study(int argc, char **argv)
+{
+    static const struct option lo[] = {{"vary", required_argument, 0, 'V'},
+                                       {"reference", required_argument, 0, 'r'},
+                                       {"set", required_argument, 0, 's'},
+                                       {"output", required_argument, 0, 'o'},
+                                       {"jobs", required_argument, 0, 'j'},
+                                       {"threads", required_argument, 0, 't'},
+                                       {"mesh-dir", required_argument, 0, 'm'},
+                                       {"tolerance", required_argument, 0, 'T'},
+                                       {"quiet", no_argument, 0, 'q'},
+                                       {0, 0, 0, 0}};
+    const char **vary = calloc((size_t)argc, sizeof *vary);
+    const char **ref = calloc((size_t)argc, sizeof *ref);
+    const char **sets = calloc((size_t)argc, sizeof *sets);
+    const char *env = getenv("COHFRAC_MESH_DIR");
+    cf_study_options o = {.progress = 1, .plot = 1, .jobs = 1};
+    o.mesh_dir = env ? env : "build/meshes";
+    int c, rc = 0;
+    while (rc == 0 && (c = getopt_long(argc, argv, "V:r:s:o:j:t:m:q", lo, NULL)) != -1) {
+        switch (c) {
+        case 'V': vary[o.n_vary++] = optarg; break;
+        case 'r': ref[o.n_reference++] = optarg; break;
+        case 's': sets[o.n_overrides++] = optarg; break;
+        case 'o': o.out_dir = optarg; break;
+        case 'j': o.jobs = atoi(optarg); break;
+        case 't': o.threads = atoi(optarg); break;
+        case 'm': o.mesh_dir = optarg; break;
+        case 'T': o.tolerance = atof(optarg); break;
+        case 'q': o.progress = 0; break;
+        default: rc = usage_error("bad option for 'study'");
+        }
+    }
+    if (rc == 0 && optind != argc - 1)
+        rc = usage_error("'study' needs exactly one scene file");
+    else if (rc == 0 && (o.jobs < 1 || o.threads < 0 || o.tolerance < 0))
+        rc = usage_error("'study': --jobs must be >= 1, --threads and --tolerance >= 0");
+    /* The command line, for the report's "regenerate with". */
+    size_t len = 0;
+    for (int i = 0; i < argc; i++)
+        len += strlen(argv[i]) + 8;
+    char *cmd = malloc(len + 16);
+    if (rc == 0 && cmd) {
+        strcpy(cmd, "cohfrac study");
+        for (int i = 1; i < argc; i++)
+            strcat(strcat(strcat(cmd, strchr(argv[i], ' ') || strchr(argv[i], '"') ? " '" : " "),
+                          argv[i]),
+                   strchr(argv[i], ' ') || strchr(argv[i], '"') ? "'" : "");
+        o.scene = argv[optind];
+        o.vary = vary, o.overrides = sets, o.command = cmd;
+        o.reference = o.n_reference ? ref : NULL;
+        cf_error err = {0};
+        cf_study_result res;
+        if (cf_study_run(&o, &res, &err) != CF_OK) {
+            rc = fail(&err);
+        } else {
+            printf("%d cases; report: %s/study.md%s\n", res.n_cases, res.out_dir,
+                   res.plot_made ? " (plot: study.png)" : "");
+            if (res.best >= 0)
+                printf("cheapest within %g%% trajectory error: case %d, %s: %.2f s (speed-up "
+                       "%.3g)\n",
+                       100 * (o.tolerance > 0 ? o.tolerance : 0.05), res.best,
+                       res.cases[res.best].label, res.cases[res.best].wall,
+                       res.cases[res.best].speedup);
+        }
+        cf_study_free(&res);
+    }
+    free(vary), free(ref), free(sets), free(cmd);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2)
@@ -259,6 +348,8 @@ int main(int argc, char **argv)
         return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(argv[1], "mesh"))
         return cmd_mesh(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "study"))
+        return cmd_study(argc - 1, argv + 1);
     if (!strcmp(argv[1], "stability"))
         return cmd_stability(argc - 1, argv + 1);
     return usage_error("unknown command");

@@ -19,6 +19,7 @@
  * parameter or of the script gives a new file.  The .geo is kept beside it.
  */
 #include "file_text.h"
+#include "hash.h"
 #include "cohfrac/mesh.h"
 
 #include <errno.h>
@@ -210,14 +211,6 @@ static char *geo_script(const cf_primitive *p)
     return g;
 }
 
-static uint64_t fnv1a(const char *s)
-{
-    uint64_t h = 14695981039346656037ULL;
-    for (; *s; s++)
-        h = (h ^ (unsigned char)*s) * 1099511628211ULL;
-    return h;
-}
-
 static cf_status write_text(const char *path, const char *text, cf_error *err)
 {
     FILE *f = fopen(path, "w");
@@ -335,7 +328,7 @@ cf_status cf_mesh_primitive(const cf_primitive *p, const char *cache_dir, cf_mes
     if (!script)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     char path[PATH_MAX], geo_path[PATH_MAX];
-    unsigned long long h = (unsigned long long)fnv1a(script);
+    unsigned long long h = (unsigned long long)cf_fnv1a(CF_FNV1A_SEED, script, strlen(script));
     int n1 = snprintf(path, sizeof path, "%s/%s_%016llx.msh", cache_dir, type, h);
     int n2 = snprintf(geo_path, sizeof geo_path, "%s/%s_%016llx.geo", cache_dir, type, h);
     if (n1 >= (int)sizeof path - 32 || n2 >= (int)sizeof geo_path) {

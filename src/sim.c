@@ -5,6 +5,7 @@
  * sub-cycled at dt_fracture; a fracture-mode fragment quiet for quiet_steps
  * steps is split into its components and handed back to rigid mode. */
 #include "sim.h"
+#include "hash.h"
 
 #include "cohfrac/surface.h"
 #include "linalg.h"
@@ -655,6 +656,7 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
         {"angular_momentum_z", l.angular_momentum[2]},
         {"fragment_count", n},
         {"cohesive_elements", sim->solid.n_coh},
+        {"crack_area", cf_solid_crack_area(&sim->solid)},
         {"fragments_in_fracture_mode", n_fracture},
         {"handoff_momentum_error_max", sim->max_momentum_error},
     };
@@ -992,31 +994,21 @@ cf_status cf_sim_run(cf_sim *sim, cf_error *err)
     return st;
 }
 
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *b = data;
-    for (size_t i = 0; i < n; i++) {
-        h ^= b[i];
-        h *= 1099511628211ull;
-    }
-    return h;
-}
-
 uint64_t cf_sim_state_hash(const cf_sim *sim)
 {
     const cf_solid *s = &sim->solid;
-    uint64_t h = 14695981039346656037ull;
-    h = fnv1a(h, s->x, (size_t)s->n_nodes * 3 * sizeof(double));
-    h = fnv1a(h, s->v, (size_t)s->n_nodes * 3 * sizeof(double));
-    h = fnv1a(h, s->tet_frag, (size_t)s->n_tets * sizeof(int));
+    uint64_t h = CF_FNV1A_SEED;
+    h = cf_fnv1a(h, s->x, (size_t)s->n_nodes * 3 * sizeof(double));
+    h = cf_fnv1a(h, s->v, (size_t)s->n_nodes * 3 * sizeof(double));
+    h = cf_fnv1a(h, s->tet_frag, (size_t)s->n_tets * sizeof(int));
     for (int fi = 0; fi < sim->n_frag; fi++) {
         const cf_fragment *f = &sim->frag[fi];
         int mode = f->mode;
-        h = fnv1a(h, &mode, sizeof mode);
+        h = cf_fnv1a(h, &mode, sizeof mode);
         if (f->body >= 0) {
             cfb_state st;
             cfb_get_state(sim->bullet, f->body, &st);
-            h = fnv1a(h, &st, sizeof st);
+            h = cf_fnv1a(h, &st, sizeof st);
         }
     }
     return h;

@@ -98,6 +98,20 @@ static double tri_area(const double *a, const double *b, const double *c)
     return 0.5 * v3_norm(n);
 }
 
+double cf_solid_crack_area(const cf_solid *s)
+{
+    double area = 0;
+    for (int i = 0; i < s->n_coh; i++) {
+        const cf_cohesive *c = &s->coh[i];
+        if (!(c->failed[0] && c->failed[1] && c->failed[2]))
+            continue;
+        const int *tn = &s->tet[4 * c->tet[0]];
+        area += tri_area(&s->X[3 * tn[c->slot[0][0]]], &s->X[3 * tn[c->slot[0][1]]],
+                         &s->X[3 * tn[c->slot[0][2]]]);
+    }
+    return area;
+}
+
 cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat,
                         const int *tet_body, cf_error *err)
 {

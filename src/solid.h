@@ -73,6 +73,10 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
                         const int *tet_body, cf_error *err);
 void cf_solid_free(cf_solid *s);
 
+/* Crack area, m^2: the rest area of every facet whose cohesive element has
+ * failed completely (all three node pairs), one side counted. */
+double cf_solid_crack_area(const cf_solid *s);
+
 /* Append a copy of node n (same X, x, v, p; mass 0).  Returns the new index
  * or -1 when out of memory. */
 int cf_solid_copy_node(cf_solid *s, int n);

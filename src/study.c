@@ -1,0 +1,882 @@
+/* cohfrac study: error against run time over a grid of settings
+ * (include/cohfrac/study.h). */
+#define _GNU_SOURCE
+#include "cohfrac/study.h"
+
+#include "clock.h"
+#include "cohfrac/scene.h"
+#include "file_text.h"
+#include "hash.h"
+#include "report.h"
+#include "trajectory.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <math.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/utsname.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#ifndef COHFRAC_VERSION
+#define COHFRAC_VERSION "0.0.0"
+#endif
+
+extern char **environ;
+
+static const char *const default_reference[] = {"solver.constraints=\"none\"",
+                                                "solver.cfl_fraction=0.5"};
+
+/* One --vary axis: the key and its values (Lua expressions). */
+typedef struct axis {
+    char *key;
+    char **values;
+    int n;
+} axis;
+
+/* A case while it is set up and run. */
+typedef struct job {
+    const char **sets;  /* its overrides after the common ones */
+    int n_sets;
+    char *text;         /* the resolved scene */
+    char lua[1200], h5[1200], log[1200], meta[1200];
+    pid_t pid;
+    double t_start;
+} job;
+
+/* Split "key=v1,v2" at the commas outside {}, (), [] and quotes. */
+static cf_status parse_axis(const char *spec, axis *a, cf_error *err)
+{
+    memset(a, 0, sizeof *a);
+    const char *eq = strchr(spec, '=');
+    if (!eq || eq == spec || !eq[1])
+        return cf_error_set(err, CF_ERR_USAGE,
+                            "--vary '%s': expected KEY.PATH=V1,V2,... (Lua values)", spec);
+    a->key = strndup(spec, (size_t)(eq - spec));
+    a->values = calloc(strlen(eq), sizeof *a->values);
+    if (!a->key || !a->values)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    int depth = 0;
+    char quote = 0;
+    const char *start = eq + 1;
+    for (const char *c = start;; c++) {
+        if (quote) {
+            if (*c == '\\' && c[1])
+                c++;
+            else if (*c == quote)
+                quote = 0;
+            else if (!*c)
+                return cf_error_set(err, CF_ERR_USAGE, "--vary '%s': unclosed quote", spec);
+            continue;
+        }
+        if (*c == '"' || *c == '\'')
+            quote = *c;
+        else if (*c == '{' || *c == '(' || *c == '[')
+            depth++;
+        else if (*c == '}' || *c == ')' || *c == ']')
+            depth--;
+        else if ((*c == ',' && depth == 0) || !*c) {
+            if (c == start)
+                return cf_error_set(err, CF_ERR_USAGE, "--vary '%s': empty value", spec);
+            a->values[a->n++] = strndup(start, (size_t)(c - start));
+            start = c + 1;
+            if (!*c)
+                break;
+        }
+    }
+    return CF_OK;
+}
+
+static void free_axis(axis *a)
+{
+    for (int i = 0; i < a->n; i++)
+        free(a->values[i]);
+    free(a->values), free(a->key);
+}
+
+static char *format(const char *fmt, const char *a, const char *b)
+{
+    size_t n = strlen(fmt) + strlen(a) + strlen(b) + 1;
+    char *s = malloc(n);
+    if (s)
+        snprintf(s, n, fmt, a, b);
+    return s;
+}
+
+/* Load the case's scene (common overrides, its own, no output file) and
+ * hash the resolved text; the scene's name into `name` (128 bytes). */
+static cf_status resolve_case(const cf_study_options *o, job *j, cf_study_case *c, char *name,
+                              cf_error *err)
+{
+    int n = o->n_overrides + j->n_sets + 1;
+    const char **all = malloc((size_t)n * sizeof *all);
+    if (!all)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < o->n_overrides; i++)
+        all[i] = o->overrides[i];
+    for (int i = 0; i < j->n_sets; i++)
+        all[o->n_overrides + i] = j->sets[i];
+    all[n - 1] = "output.file=\"\"";
+    cf_scene sc;
+    cf_error e2 = {0};
+    cf_status st = cf_scene_load(o->scene, all, n, o->mesh_dir, &sc, &e2);
+    free(all);
+    if (st != CF_OK)
+        return cf_error_set(err, st, "case '%s': %s", c->label, e2.msg);
+    uint64_t h = cf_fnv1a(CF_FNV1A_SEED, sc.resolved, strlen(sc.resolved));
+    h = cf_fnv1a(h, COHFRAC_VERSION, strlen(COHFRAC_VERSION));
+    snprintf(c->hash, sizeof c->hash, "%016" PRIx64, h);
+    snprintf(name, 128, "%s", sc.name);
+    j->text = strdup(sc.resolved);
+    cf_scene_free(&sc);
+    return j->text ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+}
+
+/* Name the case's files under `runs` and write runs/<hash>.lua. */
+static cf_status write_case(job *j, const cf_study_case *c, const char *runs, cf_error *err)
+{
+    snprintf(j->lua, sizeof j->lua, "%s/%s.lua", runs, c->hash);
+    snprintf(j->h5, sizeof j->h5, "%s/%s.h5", runs, c->hash);
+    snprintf(j->log, sizeof j->log, "%s/%s.log", runs, c->hash);
+    snprintf(j->meta, sizeof j->meta, "%s/%s.meta", runs, c->hash);
+    char fname[32];
+    snprintf(fname, sizeof fname, "%s.lua", c->hash);
+    cf_outfile f;
+    cf_status st = cf_out_open(&f, runs, fname, err);
+    if (st != CF_OK)
+        return st;
+    fprintf(f.f, "-- %s (resolved by cohfrac %s)\n%s", c->label, COHFRAC_VERSION, j->text);
+    return cf_out_close(&f, err);
+}
+
+/* A cached case: runs/<hash>.meta holds "exit wall cpu peak_rss". */
+static int read_meta(const job *j, cf_study_case *c)
+{
+    FILE *f = fopen(j->meta, "r");
+    if (!f)
+        return 0;
+    int ok = fscanf(f, "%d %lf %lf %lf", &c->exit_code, &c->wall, &c->cpu, &c->peak_rss) == 4;
+    fclose(f);
+    return ok;
+}
+
+static cf_status start_case(const cf_study_options *o, job *j, int threads, cf_error *err)
+{
+    char th[16];
+    snprintf(th, sizeof th, "%d", threads);
+    const char *argv[] = {o->exe, "run", j->lua, "-q", "-j", th, "-m", o->mesh_dir,
+                          "-o", j->h5, NULL};
+    unlink(j->meta);
+    unlink(j->h5);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 1, j->log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    j->t_start = cf_wall_time();
+    int rc = posix_spawn(&j->pid, o->exe, &fa, NULL, (char *const *)argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL, "cannot run '%s' (%s)", o->exe, strerror(rc));
+    return CF_OK;
+}
+
+/* Wait for any running case; record its figures and write its .meta. */
+static cf_status reap_case(job *jobs, cf_study_case *cases, int n, int *done, cf_error *err)
+{
+    int status;
+    struct rusage ru;
+    pid_t pid;
+    while ((pid = wait4(-1, &status, 0, &ru)) < 0)
+        if (errno != EINTR)
+            return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for a case failed (%s)",
+                                strerror(errno));
+    for (int i = 0; i < n; i++) {
+        if (jobs[i].pid != pid)
+            continue;
+        cf_study_case *c = &cases[i];
+        c->wall = cf_wall_time() - jobs[i].t_start;
+        c->cpu = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec +
+                 1e-6 * ru.ru_stime.tv_usec;
+        c->peak_rss = 1024.0 * (double)ru.ru_maxrss;
+        c->exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        jobs[i].pid = 0;
+        *done = i;
+        char dir[1200], *slash;
+        snprintf(dir, sizeof dir, "%s", jobs[i].meta);
+        slash = strrchr(dir, '/');
+        *slash = 0;
+        char fname[32];
+        snprintf(fname, sizeof fname, "%s.meta", c->hash);
+        cf_outfile f;
+        cf_status st = cf_out_open(&f, dir, fname, err);
+        if (st == CF_OK) {
+            fprintf(f.f, "%d %.6f %.6f %.0f\n", c->exit_code, c->wall, c->cpu, c->peak_rss);
+            st = cf_out_close(&f, err);
+        }
+        return st;
+    }
+    *done = -1;
+    return CF_OK;
+}
+
+/* ---- Metrics ---------------------------------------------------------- */
+
+/* Per frame of a trajectory: the mass and mass moment of the fragments
+ * alive in it summed over every fragment's subtree (itself and its
+ * descendants): S[j] = sum m x, M[j] = sum m. */
+static void subtree_sums(const cf_trajectory *t, int k, double *S, double *M)
+{
+    memset(S, 0, 3 * (size_t)t->N * sizeof *S);
+    memset(M, 0, (size_t)t->N * sizeof *M);
+    const double *x = &t->pos[3 * (size_t)k * t->N];
+    for (int j = 0; j < t->N; j++) {
+        if (isnan(x[3 * j]))
+            continue;
+        for (int a = j; a >= 0; a = t->parent[a]) {
+            for (int d = 0; d < 3; d++)
+                S[3 * a + d] += t->mass[j] * x[3 * j + d];
+            M[a] += t->mass[j];
+        }
+    }
+}
+
+static int by_mass_desc(const void *a, const void *b, void *mass)
+{
+    double ma = ((const double *)mass)[*(const int *)a];
+    double mb = ((const double *)mass)[*(const int *)b];
+    return ma < mb ? 1 : ma > mb ? -1 : *(const int *)a - *(const int *)b;
+}
+
+/* The children of fragment `p` (all roots for p = -1), heaviest first. */
+static int children(const cf_trajectory *t, int p, int *out)
+{
+    int n = 0;
+    for (int j = 0; j < t->N; j++)
+        if (t->parent[j] == p)
+            out[n++] = j;
+    qsort_r(out, (size_t)n, sizeof *out, by_mass_desc, t->mass);
+    return n;
+}
+
+/* partner[j] of each fragment of `v` in `r` (-1 unmatched): roots in order,
+ * then the children of matched pairs, heaviest with heaviest. */
+static int match_fragments(const cf_trajectory *v, const cf_trajectory *r, int *partner)
+{
+    int *cv = malloc(((size_t)v->N + 1) * sizeof *cv);
+    int *cr = malloc(((size_t)r->N + 1) * sizeof *cr);
+    int *queue = malloc(((size_t)v->N + 1) * sizeof *queue);
+    if (!cv || !cr || !queue) {
+        free(cv), free(cr), free(queue);
+        return -1;
+    }
+    for (int j = 0; j < v->N; j++)
+        partner[j] = -1;
+    int head = 0, tail = 0;
+    int nv = children(v, -1, cv), nr = children(r, -1, cr);
+    /* Initial bodies keep their scene order (ids 0..n-1). */
+    for (int i = 0; i < nv && i < nr; i++)
+        partner[i] = i, queue[tail++] = i;
+    while (head < tail) {
+        int a = queue[head++];
+        nv = children(v, a, cv);
+        nr = children(r, partner[a], cr);
+        for (int i = 0; i < nv && i < nr; i++)
+            partner[cv[i]] = cr[i], queue[tail++] = cv[i];
+    }
+    free(cv), free(cr), free(queue);
+    return 0;
+}
+
+/* The reference frame nearest in time to t (-1 when t is past its end by
+ * more than half a frame). */
+static int nearest_frame(const cf_trajectory *r, double t)
+{
+    int best = -1;
+    double bd = INFINITY;
+    for (int k = 0; k < r->T; k++)
+        if (fabs(r->time[k] - t) < bd)
+            bd = fabs(r->time[k] - t), best = k;
+    double half = r->T > 1 ? 0.5 * (r->time[1] - r->time[0]) : 0;
+    return best >= 0 && bd <= half * (1 + 1e-9) + 1e-12 ? best : -1;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The masses of the fragments alive in the last frame, ascending, and
+ * their sum; NULL when out of memory or without frames. */
+static double *final_masses(const cf_trajectory *t, int *n, double *total)
+{
+    double *m = malloc(((size_t)t->N + 1) * sizeof *m);
+    *n = 0, *total = 0;
+    if (!m || t->T == 0) {
+        free(m);
+        return NULL;
+    }
+    const double *x = &t->pos[3 * (size_t)(t->T - 1) * t->N];
+    for (int j = 0; j < t->N; j++)
+        if (!isnan(x[3 * j]))
+            m[(*n)++] = t->mass[j], *total += t->mass[j];
+    qsort(m, (size_t)*n, sizeof *m, cmp_double);
+    return m;
+}
+
+/* Kolmogorov-Smirnov distance of the last frames' fragment mass
+ * distributions, each weighted by mass: sup over m of |F_a(m) - F_b(m)|,
+ * F(m) the fraction of the mass in fragments of mass <= m. */
+static double mass_ks(const cf_trajectory *a, const cf_trajectory *b)
+{
+    int n[2], i[2] = {0, 0};
+    double tot[2], F[2] = {0, 0}, d = 0;
+    double *m[2] = {final_masses(a, &n[0], &tot[0]), final_masses(b, &n[1], &tot[1])};
+    if (!m[0] || !m[1] || tot[0] <= 0 || tot[1] <= 0) {
+        free(m[0]), free(m[1]);
+        return NAN;
+    }
+    while (i[0] < n[0] || i[1] < n[1]) {
+        double next = INFINITY;
+        for (int s = 0; s < 2; s++)
+            if (i[s] < n[s])
+                next = fmin(next, m[s][i[s]]);
+        for (int s = 0; s < 2; s++)
+            while (i[s] < n[s] && m[s][i[s]] <= next)
+                F[s] += m[s][i[s]++] / tot[s];
+        d = fmax(d, fabs(F[0] - F[1]));
+    }
+    free(m[0]), free(m[1]);
+    return d;
+}
+
+/* Mass-weighted RMS distance over the frames between the fragments of `v`
+ * and their partners in `r` (study.h); NaN when no frame pairs up. */
+static double trajectory_error(const cf_trajectory *v, const cf_trajectory *r)
+{
+    int *partner = malloc(((size_t)v->N + 1) * sizeof *partner);
+    double *S = malloc((3 * (size_t)r->N + 1) * sizeof *S);
+    double *M = malloc(((size_t)r->N + 1) * sizeof *M);
+    double sum = 0;
+    int frames = 0;
+    if (partner && S && M && match_fragments(v, r, partner) == 0) {
+        for (int k = 0; k < v->T; k++) {
+            int kr = nearest_frame(r, v->time[k]);
+            if (kr < 0)
+                continue;
+            subtree_sums(r, kr, S, M);
+            const double *x = &v->pos[3 * (size_t)k * v->N];
+            double e2 = 0, mass = 0;
+            for (int f = 0; f < v->N; f++) {
+                if (isnan(x[3 * f]))
+                    continue;
+                int a = f;
+                while (a >= 0 && partner[a] < 0)
+                    a = v->parent[a];
+                int p = a >= 0 ? partner[a] : -1;
+                while (p >= 0 && M[p] <= 0) /* not born yet in the reference */
+                    p = r->parent[p];
+                if (p < 0)
+                    continue;
+                double d2 = 0;
+                for (int d = 0; d < 3; d++) {
+                    double dx = x[3 * f + d] - S[3 * p + d] / M[p];
+                    d2 += dx * dx;
+                }
+                e2 += v->mass[f] * d2;
+                mass += v->mass[f];
+            }
+            if (mass > 0)
+                sum += e2 / mass, frames++;
+        }
+    }
+    free(partner), free(S), free(M);
+    return frames ? sqrt(sum / frames) : NAN;
+}
+
+/* D of study.h: RMS over the frames of the distance the initial bodies'
+ * centres of mass travel, mass-weighted over the bodies. */
+static double travel(const cf_trajectory *r)
+{
+    double *S = malloc((3 * (size_t)r->N + 1) * sizeof *S);
+    double *M = malloc(((size_t)r->N + 1) * sizeof *M);
+    double *X0 = malloc((3 * (size_t)r->N + 1) * sizeof *X0);
+    double sum = 0;
+    int frames = 0;
+    for (int k = 0; S && M && X0 && k < r->T; k++) {
+        subtree_sums(r, k, S, M);
+        double e2 = 0, mass = 0;
+        for (int j = 0; j < r->N; j++) {
+            if (r->parent[j] >= 0 || M[j] <= 0)
+                continue;
+            double d2 = 0;
+            for (int d = 0; d < 3; d++) {
+                double X = S[3 * j + d] / M[j];
+                if (k == 0)
+                    X0[3 * j + d] = X;
+                d2 += (X - X0[3 * j + d]) * (X - X0[3 * j + d]);
+            }
+            e2 += M[j] * d2, mass += M[j];
+        }
+        if (mass > 0)
+            sum += e2 / mass, frames++;
+    }
+    free(S), free(M), free(X0);
+    return frames ? sqrt(sum / frames) : NAN;
+}
+
+/* |a - b| / max(|b|, floor), for the final momenta. */
+static double rel_diff3(const double *a, const double *b, double floor)
+{
+    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    double nd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    double nb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    return nd / fmax(nb, floor);
+}
+
+/* Fill the case's metrics from its output and the reference's. */
+static void measure(cf_study_case *c, const cf_trajectory *v, const cf_trajectory *r, double D)
+{
+    c->t_end = v->T ? v->time[v->T - 1] : 0;
+    c->n_fragments = 0;
+    for (int j = 0; v->T && j < v->N; j++)
+        c->n_fragments += !isnan(v->pos[3 * ((size_t)(v->T - 1) * v->N + j)]);
+    c->traj_rms = trajectory_error(v, r);
+    c->traj_rel = D > 0 ? c->traj_rms / D : NAN;
+    c->mass_ks = mass_ks(v, r);
+    c->crack_area = v->last[CF_OBS_CRACK_AREA];
+    c->dissipated = v->last[CF_OBS_DISSIPATED];
+    /* L about the origin is near 0 for motion along a line through it: scale
+     * it by the reference's |P| times the distance travelled. */
+    const double *P = &r->last[CF_OBS_PX];
+    double p_ref = sqrt(P[0] * P[0] + P[1] * P[1] + P[2] * P[2]);
+    c->p_err = rel_diff3(&v->last[CF_OBS_PX], P, 1e-300);
+    c->l_err = rel_diff3(&v->last[CF_OBS_LX], &r->last[CF_OBS_LX], fmax(p_ref * D, 1e-300));
+    double in = v->first[CF_OBS_KINETIC] + v->first[CF_OBS_STRAIN] +
+                fabs(v->last[CF_OBS_WORK_GRAVITY]) + fabs(v->last[CF_OBS_WORK_BOUNDARY]) +
+                fabs(v->last[CF_OBS_WORK_OBSTACLES]);
+    c->residual_rel = in > 0 ? fabs(v->last[CF_OBS_RESIDUAL]) / in : NAN;
+}
+
+cf_status cf_study_measure(const char *case_h5, const char *reference_h5, cf_study_case *c,
+                           double *travel_out, cf_error *err)
+{
+    cf_trajectory v, r;
+    cf_status st = cf_trajectory_read(reference_h5, &r, err);
+    if (st != CF_OK)
+        return st;
+    st = cf_trajectory_read(case_h5, &v, err);
+    if (st == CF_OK) {
+        double D = travel(&r);
+        measure(c, &v, &r, D);
+        if (travel_out)
+            *travel_out = D;
+        cf_trajectory_free(&v);
+    }
+    cf_trajectory_free(&r);
+    return st;
+}
+
+/* Pareto front over (wall, traj_rel) of the finished variants, and the
+ * cheapest one within the tolerance. */
+static int pareto(cf_study_case *c, int n, double tol)
+{
+    int best = -1;
+    for (int i = 1; i < n; i++) {
+        c[i].pareto = 0;
+        if (c[i].exit_code != 0 || !isfinite(c[i].traj_rel))
+            continue;
+        int dominated = 0;
+        for (int j = 1; j < n && !dominated; j++)
+            dominated = j != i && c[j].exit_code == 0 && isfinite(c[j].traj_rel) &&
+                        c[j].wall <= c[i].wall && c[j].traj_rel <= c[i].traj_rel &&
+                        (c[j].wall < c[i].wall || c[j].traj_rel < c[i].traj_rel);
+        c[i].pareto = !dominated;
+        if (c[i].traj_rel <= tol && (best < 0 || c[i].wall < c[best].wall))
+            best = i;
+    }
+    return best;
+}
+
+/* ---- Report ------------------------------------------------------------ */
+
+/* "CPU model, N cores, Linux release, Debian version" for the report. */
+static void machine(char *out, size_t max)
+{
+    char cpu[256] = "unknown CPU", deb[64] = "?";
+    char *info = cf_file_read("/proc/cpuinfo", NULL);
+    const char *m = info ? strstr(info, "model name") : NULL;
+    if (m && (m = strchr(m, ':')))
+        sscanf(m + 1, " %255[^\n]", cpu);
+    free(info);
+    char *d = cf_file_read("/etc/debian_version", NULL);
+    if (d)
+        sscanf(d, "%63s", deb);
+    free(d);
+    struct utsname u;
+    if (uname(&u) != 0)
+        snprintf(u.release, sizeof u.release, "?");
+    snprintf(out, max, "%s, %ld cores, Linux %s, Debian %s", cpu, sysconf(_SC_NPROCESSORS_ONLN),
+             u.release, deb);
+}
+
+static void csv_quoted(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"')
+            fputc('"', f); /* a quote is doubled */
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+static const char *status_word(int code)
+{
+    return code == 0 ? "ok" : code == 3 ? "diverged" : code >= 128 ? "killed" : "failed";
+}
+
+static cf_status write_csv(const char *dir, const cf_study_case *c, int n, const axis *ax,
+                           int n_ax, char ***values, int best, cf_error *err)
+{
+    cf_outfile f;
+    cf_status st = cf_out_open(&f, dir, "study.csv", err);
+    if (st != CF_OK)
+        return st;
+    fputs("case,label", f.f);
+    for (int a = 0; a < n_ax; a++)
+        fputc(',', f.f), csv_quoted(f.f, ax[a].key);
+    fputs(",hash,exit_code,status,cached,t_end,wall,cpu,peak_rss_mib,n_fragments,traj_rms,"
+          "traj_rel,mass_ks,crack_area,dissipated,p_err,l_err,residual_rel,speedup,pareto,best\n",
+          f.f);
+    for (int i = 0; i < n; i++) {
+        fprintf(f.f, "%d,", i);
+        csv_quoted(f.f, c[i].label);
+        for (int a = 0; a < n_ax; a++)
+            fputc(',', f.f), csv_quoted(f.f, i ? values[i][a] : "");
+        fprintf(f.f,
+                ",%s,%d,%s,%d,%.9g,%.4f,%.4f,%.2f,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,"
+                "%.4g,%d,%d\n",
+                c[i].hash, c[i].exit_code, status_word(c[i].exit_code), c[i].cached, c[i].t_end,
+                c[i].wall, c[i].cpu, c[i].peak_rss / 1048576.0, c[i].n_fragments, c[i].traj_rms,
+                c[i].traj_rel, c[i].mass_ks, c[i].crack_area, c[i].dissipated, c[i].p_err,
+                c[i].l_err, c[i].residual_rel, c[i].speedup, c[i].pareto, i == best);
+    }
+    return cf_out_close(&f, err);
+}
+
+static cf_status write_md(const cf_study_options *o, const cf_study_result *res,
+                          const char *const *ref, int n_ref, const axis *ax, int n_ax,
+                          char ***values, int threads, cf_error *err)
+{
+    cf_outfile f;
+    cf_status st = cf_out_open(&f, res->out_dir, "study.md", err);
+    if (st != CF_OK)
+        return st;
+    FILE *m = f.f;
+    const cf_study_case *c = res->cases, *r = &c[0];
+    char mach[512], date[32];
+    machine(mach, sizeof mach);
+    time_t now = time(NULL);
+    strftime(date, sizeof date, "%Y-%m-%d", gmtime(&now));
+    fprintf(m, "<!-- cohfrac study, %s, %s; regenerate with: %s -->\n", date, mach,
+            o->command ? o->command : "cohfrac study");
+    fprintf(m, "# Study: %s\n\n", res->scene_name);
+    fprintf(m, "Scene `%s`", o->scene);
+    for (int i = 0; i < o->n_overrides; i++)
+        fprintf(m, "%s `%s`", i ? "," : " with", o->overrides[i]);
+    fprintf(m, ". Machine: %s; cohfrac %s; %s. %d cases, %d at a time with %d thread%s "
+               "each; %d reused from the cache.\n\n",
+            mach, COHFRAC_VERSION, date, res->n_cases, o->jobs, threads, threads > 1 ? "s" : "",
+            res->n_cached);
+    fputs("**Reference**:", m);
+    for (int i = 0; i < n_ref; i++)
+        fprintf(m, "%s `%s`", i ? "," : "", ref[i]);
+    fprintf(m, "; %s, reached t = %.4g s in %.1f s of wall time, %d fragments; the "
+               "initial bodies' centres of mass travel D = %.4g m (RMS over the frames).\n\n",
+            status_word(r->exit_code), r->t_end, r->wall, r->n_fragments, res->travel);
+    if (r->exit_code != 0)
+        fprintf(m, "**The reference did not finish (%s, exit %d; see runs/%s.log)**: the "
+                   "errors below cover only the frames it reached, and no verdict is given.\n\n",
+                status_word(r->exit_code), r->exit_code, r->hash);
+    fputs("Metrics against the reference: *traj rel* the mass-weighted RMS distance between "
+          "matched fragments' centres of mass over time (*traj RMS*, m) divided by D; *mass "
+          "KS* the Kolmogorov-Smirnov distance of the final fragment-mass distributions; "
+          "*P err*, *L err* the relative difference of the final linear and angular momentum; "
+          "*residual* the case's own energy-ledger residual over its initial energy plus work "
+          "input; wall time and peak resident memory of the run's process "
+          "(include/cohfrac/study.h gives the exact definitions).\n\n",
+          m);
+    fputs("| case |", m);
+    for (int a = 0; a < n_ax; a++)
+        fprintf(m, " %s |", ax[a].key);
+    fputs(" status | wall (s) | speed-up | peak RSS (MiB) | fragments | traj RMS (m) | traj rel "
+          "| mass KS | crack area (m^2) | dissipated (J) | P err | L err | residual | Pareto |\n|",
+          m);
+    for (int a = 0; a < n_ax + 15; a++)
+        fputs("---|", m);
+    fputc('\n', m);
+    for (int i = 0; i < res->n_cases; i++) {
+        if (i)
+            fprintf(m, "| %d |", i);
+        else
+            fputs("| reference |", m);
+        for (int a = 0; a < n_ax; a++)
+            fprintf(m, " %s |", i ? values[i][a] : "");
+        fprintf(m,
+                " %s%s | %.2f | %.3g | %.0f | %d | %.3g | %s%.3g%s | %.3g | %.4g | %.4g | %.2g | "
+                "%.2g | %.2g | %s |\n",
+                status_word(c[i].exit_code), c[i].cached ? " (cached)" : "", c[i].wall,
+                c[i].speedup, c[i].peak_rss / 1048576.0, c[i].n_fragments, c[i].traj_rms,
+                i == res->best ? "**" : "", c[i].traj_rel, i == res->best ? "**" : "",
+                c[i].mass_ks, c[i].crack_area, c[i].dissipated, c[i].p_err, c[i].l_err,
+                c[i].residual_rel, c[i].pareto ? "yes" : "");
+    }
+    fputs("\n**Pareto front** (no other finished case is both faster and closer to the "
+          "reference), fastest first:\n\n",
+          m);
+    double last = -1;
+    for (int k = 0; k < res->n_cases; k++) { /* by wall time, ascending */
+        int next = -1;
+        for (int i = 1; i < res->n_cases; i++)
+            if (c[i].pareto && c[i].wall > last && (next < 0 || c[i].wall < c[next].wall))
+                next = i;
+        if (next < 0)
+            break;
+        fprintf(m, "- case %d, `%s`: %.2f s (speed-up %.3g), traj rel %.3g, %d fragments\n",
+                next, c[next].label, c[next].wall, c[next].speedup, c[next].traj_rel,
+                c[next].n_fragments);
+        last = c[next].wall;
+    }
+    double tol = o->tolerance > 0 ? o->tolerance : 0.05;
+    if (r->exit_code != 0)
+        fputs("\n**Verdict**: none (the reference did not finish).\n", m);
+    else if (res->best >= 0)
+        fprintf(m, "\n**Verdict**: the cheapest setting within %.3g%% trajectory error of the "
+                   "reference is case %d, `%s`: %.2f s against the reference's %.2f s "
+                   "(speed-up %.3g), traj rel %.3g.\n",
+                100 * tol, res->best, c[res->best].label, c[res->best].wall, r->wall,
+                c[res->best].speedup, c[res->best].traj_rel);
+    else
+        fprintf(m, "\n**Verdict**: no finished case is within %.3g%% trajectory error of the "
+                   "reference.\n",
+                100 * tol);
+    return cf_out_close(&f, err);
+}
+
+/* ---- The study ----------------------------------------------------------- */
+
+/* Start every case not cached, `jobs` at a time, and wait for them all. */
+static cf_status run_cases(const cf_study_options *o, job *jobs, cf_study_case *c, int n,
+                           int threads, cf_error *err)
+{
+    int running = 0, finished = 0, to_run = 0;
+    cf_status st = CF_OK;
+    for (int i = 0; i < n; i++)
+        to_run += !c[i].cached;
+    for (int i = 0; i <= n && st == CF_OK; i++) {
+        while (running > 0 && (running >= o->jobs || i == n)) {
+            int k;
+            st = reap_case(jobs, c, n, &k, err);
+            if (st != CF_OK || k < 0)
+                break;
+            running--, finished++;
+            if (o->progress)
+                fprintf(stderr, "[%d/%d] %s: %s, %.1f s\n", finished, to_run, c[k].label,
+                        status_word(c[k].exit_code), c[k].wall);
+        }
+        if (i < n && !c[i].cached && st == CF_OK) {
+            st = start_case(o, &jobs[i], threads, err);
+            running += st == CF_OK;
+        }
+    }
+    while (running > 0) { /* after an error: do not leave children behind */
+        int status;
+        if (wait(&status) < 0 && errno != EINTR)
+            break;
+        running--;
+    }
+    return st;
+}
+
+cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_error *err)
+{
+    cf_study_options o = *opt;
+    char exe[4096];
+    memset(res, 0, sizeof *res);
+    res->best = -1;
+    if (!o.mesh_dir)
+        o.mesh_dir = "build/meshes";
+    if (o.jobs < 1)
+        o.jobs = 1;
+    if (!(o.tolerance > 0))
+        o.tolerance = 0.05;
+    if (!o.exe) {
+        ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+        if (len <= 0)
+            return cf_error_set(err, CF_ERR_EXTERNAL, "cannot find this program's path (%s)",
+                                strerror(errno));
+        exe[len] = 0;
+        o.exe = exe;
+    }
+    int threads = o.threads > 0 ? o.threads : (int)sysconf(_SC_NPROCESSORS_ONLN) / o.jobs;
+    threads = threads < 1 ? 1 : threads;
+    const char *const *ref = o.reference ? o.reference : default_reference;
+    int n_ref = o.reference ? o.n_reference : 2;
+    for (int i = 0; i < n_ref; i++)
+        if (!strchr(ref[i], '='))
+            return cf_error_set(err, CF_ERR_USAGE, "--reference '%s': expected KEY.PATH=VALUE",
+                                ref[i]);
+
+    cf_status st = CF_OK;
+    axis *ax = calloc((size_t)o.n_vary + 1, sizeof *ax);
+    long n = 1;
+    for (int a = 0; a < o.n_vary && st == CF_OK; a++) {
+        st = ax ? parse_axis(o.vary[a], &ax[a], err) : cf_error_set(err, CF_ERR_NOMEM, "oom");
+        n *= ax ? ax[a].n : 1;
+        if (n > 10000)
+            st = cf_error_set(err, CF_ERR_USAGE, "--vary: %ld cases or more; at most 10000", n);
+    }
+    n += 1; /* the reference */
+    job *jobs = st == CF_OK ? calloc((size_t)n, sizeof *jobs) : NULL;
+    char ***values = st == CF_OK ? calloc((size_t)n, sizeof *values) : NULL;
+    res->cases = st == CF_OK ? calloc((size_t)n, sizeof *res->cases) : NULL;
+    if (st == CF_OK && (!jobs || !values || !res->cases))
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    if (st == CF_OK)
+        res->n_cases = (int)n;
+    cf_study_case *c = res->cases;
+
+    /* Every case's overrides and label; the last axis varies fastest. */
+    for (int i = 0; i < n && st == CF_OK; i++) {
+        jobs[i].sets = calloc((size_t)o.n_vary + (size_t)n_ref + 1, sizeof(char *));
+        values[i] = calloc((size_t)o.n_vary + 1, sizeof(char *));
+        if (!jobs[i].sets || !values[i]) {
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+            break;
+        }
+        if (i == 0) {
+            memcpy(jobs[0].sets, ref, (size_t)n_ref * sizeof *ref);
+            jobs[0].n_sets = n_ref;
+            snprintf(c[0].label, sizeof c[0].label, "reference");
+            continue;
+        }
+        long idx = i - 1;
+        size_t len = 0;
+        for (int a = o.n_vary - 1; a >= 0; a--) {
+            values[i][a] = ax[a].values[idx % ax[a].n];
+            idx /= ax[a].n;
+        }
+        for (int a = 0; a < o.n_vary; a++) {
+            char *s = format("%s=%s", ax[a].key, values[i][a]);
+            if (!s) {
+                st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+                break;
+            }
+            jobs[i].sets[jobs[i].n_sets++] = s;
+            len += (size_t)snprintf(c[i].label + len, len < sizeof c[i].label ?
+                                    sizeof c[i].label - len : 0, "%s%s", a ? " " : "", s);
+        }
+    }
+    for (int i = 0; i < n && st == CF_OK; i++)
+        st = resolve_case(&o, &jobs[i], &c[i], res->scene_name, err);
+
+    /* Files: OUT/runs/<hash>.*; a case with a .meta and an output is cached. */
+    char runs[1100];
+    if (st == CF_OK) {
+        if (o.out_dir)
+            snprintf(res->out_dir, sizeof res->out_dir, "%s", o.out_dir);
+        else
+            snprintf(res->out_dir, sizeof res->out_dir, "build/studies/%s", res->scene_name);
+        snprintf(runs, sizeof runs, "%s/runs", res->out_dir);
+        st = cf_mkdirs(runs, "study directory", err);
+    }
+    for (int i = 0; i < n && st == CF_OK; i++) {
+        st = write_case(&jobs[i], &c[i], runs, err);
+        struct stat sb;
+        c[i].cached = st == CF_OK && read_meta(&jobs[i], &c[i]) && stat(jobs[i].h5, &sb) == 0;
+        for (int k = 0; k < i && c[i].cached; k++) /* the same scene twice: run it once */
+            c[i].cached = strcmp(c[k].hash, c[i].hash) != 0 || c[k].cached;
+        res->n_cached += c[i].cached;
+    }
+    if (st == CF_OK && o.progress)
+        fprintf(stderr, "study %s: %d cases (%d cached), %d at a time, %d thread%s each\n",
+                res->scene_name, res->n_cases, res->n_cached, o.jobs, threads,
+                threads > 1 ? "s" : "");
+    if (st == CF_OK)
+        st = run_cases(&o, jobs, c, res->n_cases, threads, err);
+
+    /* Metrics against the reference. */
+    cf_trajectory rt = {0};
+    if (st == CF_OK) {
+        cf_error e2;
+        if (cf_trajectory_read(jobs[0].h5, &rt, &e2) != CF_OK) {
+            char tail[600];
+            cf_file_log_tail(jobs[0].log, tail, sizeof tail);
+            st = cf_error_set(err, CF_ERR_EXTERNAL,
+                              "the reference run (exit %d) left no readable output: %s; "
+                              "its log %s ends:\n%s",
+                              c[0].exit_code, e2.msg, jobs[0].log, tail);
+        }
+    }
+    if (st == CF_OK) {
+        res->travel = travel(&rt);
+        for (int i = 0; i < n; i++) {
+            cf_trajectory vt;
+            cf_error e2;
+            c[i].traj_rms = c[i].traj_rel = c[i].mass_ks = NAN;
+            c[i].crack_area = c[i].dissipated = c[i].p_err = c[i].l_err = NAN;
+            c[i].residual_rel = NAN;
+            if (cf_trajectory_read(jobs[i].h5, &vt, &e2) == CF_OK) {
+                measure(&c[i], &vt, &rt, res->travel);
+                cf_trajectory_free(&vt);
+            } else if (o.progress) {
+                fprintf(stderr, "case %d (%s): %s\n", i, c[i].label, e2.msg);
+            }
+            c[i].speedup = c[i].wall > 0 ? c[0].wall / c[i].wall : NAN;
+        }
+        res->best = pareto(c, res->n_cases, o.tolerance);
+        if (c[0].exit_code != 0)
+            res->best = -1;
+        cf_trajectory_free(&rt);
+        st = write_csv(res->out_dir, c, res->n_cases, ax, o.n_vary, values, res->best, err);
+    }
+    if (st == CF_OK)
+        st = write_md(&o, res, ref, n_ref, ax, o.n_vary, values, threads, err);
+    if (st == CF_OK && o.plot) {
+        char csv[1100], png[1100], tol[32];
+        snprintf(csv, sizeof csv, "%s/study.csv", res->out_dir);
+        snprintf(png, sizeof png, "%s/study.png", res->out_dir);
+        snprintf(tol, sizeof tol, "%g", o.tolerance);
+        const char *args[] = {csv, png, tol, res->scene_name, NULL};
+        res->plot_made = cf_report_plot("study_plot.py", o.plot_script, args,
+                                        "study.md and study.csv");
+    }
+
+    for (int i = 0; jobs && i < n; i++) {
+        for (int k = 0; i > 0 && jobs[i].sets && k < jobs[i].n_sets; k++)
+            free((char *)jobs[i].sets[k]); /* the reference's are the caller's */
+        free(jobs[i].sets), free(jobs[i].text);
+        if (values)
+            free(values[i]);
+    }
+    for (int a = 0; ax && a < o.n_vary; a++)
+        free_axis(&ax[a]);
+    free(jobs), free(values), free(ax);
+    return st;
+}
+
+void cf_study_free(cf_study_result *res)
+{
+    free(res->cases);
+    memset(res, 0, sizeof *res);
+    res->best = -1;
+}
