@@ -6,6 +6,9 @@
 #include <btBulletDynamicsCommon.h>
 #include <LinearMath/btConvexHullComputer.h>
 
+#include <LinearMath/btAlignedAllocator.h>
+#include <malloc.h>
+
 #include <cmath>
 #include <cstdarg>
 #include <cstddef>
@@ -458,6 +461,36 @@ struct DepthCallback : public btCollisionWorld::ContactResultCallback {
 }  // namespace
 
 extern "C" {
+
+/* Bullet's allocations go through these two, so that the run summary can
+ * say how much memory the Bullet world takes.  malloc_usable_size keeps
+ * the count right for blocks allocated before the hook was set. */
+static long long bullet_bytes;
+
+static void *counted_alloc(size_t n)
+{
+    void *p = malloc(n);
+    if (p)
+        __atomic_add_fetch(&bullet_bytes, (long long)malloc_usable_size(p), __ATOMIC_RELAXED);
+    return p;
+}
+
+static void counted_free(void *p)
+{
+    if (!p)
+        return;
+    __atomic_sub_fetch(&bullet_bytes, (long long)malloc_usable_size(p), __ATOMIC_RELAXED);
+    free(p);
+}
+
+static const bool hook_set = (btAlignedAllocSetCustom(counted_alloc, counted_free), true);
+
+unsigned long long cfb_allocated_bytes(void)
+{
+    (void)hook_set;
+    long long n = __atomic_load_n(&bullet_bytes, __ATOMIC_RELAXED);
+    return n > 0 ? (unsigned long long)n : 0;
+}
 
 cfb_world *cfb_world_create(const double gravity[3])
 {

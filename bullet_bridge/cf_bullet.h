@@ -25,6 +25,11 @@ typedef struct cfb_state {
     double w[3];     /* rad/s, world frame */
 } cfb_state;
 
+/* Bytes Bullet's allocator holds now (btAlignedAlloc, which every Bullet
+ * object and array goes through), counted by the bridge's allocator hook
+ * for the whole process. */
+unsigned long long cfb_allocated_bytes(void);
+
 /* Create a world with gravity (m/s^2).  NULL on failure. */
 cfb_world *cfb_world_create(const double gravity[3]);
 void cfb_world_destroy(cfb_world *w);

@@ -336,6 +336,18 @@ cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt)
     return NULL;
 }
 
+size_t cff_mesh_bytes(const cff_mesh *m)
+{
+    if (!m)
+        return 0;
+    const Model &b = m->bvh;
+    size_t fcl = (size_t)b.num_vertices * sizeof(fcl::Vector3d) +
+                 (size_t)b.num_tris * (sizeof(fcl::Triangle) + sizeof(unsigned int)) +
+                 (size_t)b.getNumBVs() * sizeof(fcl::BVNode<fcl::OBBRSSd>);
+    return sizeof *m + fcl + m->v.capacity() * sizeof(V3) + m->t.capacity() * sizeof(int) +
+           (m->face_n.capacity() + m->edge_n.capacity() + m->vert_n.capacity()) * sizeof(V3);
+}
+
 void cff_mesh_destroy(cff_mesh *m)
 {
     try {

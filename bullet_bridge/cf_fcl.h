@@ -6,6 +6,8 @@
 #ifndef COHFRAC_FCL_BRIDGE_H
 #define COHFRAC_FCL_BRIDGE_H
 
+#include <stddef.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -19,6 +21,10 @@ typedef struct cff_mesh cff_mesh;
  * range, a triangle of zero area (repeated or collinear corners). */
 cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt);
 void cff_mesh_destroy(cff_mesh *m);
+
+/* Bytes the mesh holds: FCL's hierarchy (vertices, triangles, bounding
+ * volume nodes, primitive indices) and the copies and normals kept here. */
+size_t cff_mesh_bytes(const cff_mesh *m);
 
 /* Closest point of the mesh to p, looked for within max_dist (m, >= 0,
  * inclusive up to round-off; INFINITY for no bound).  Returns 1 and fills q

@@ -1254,6 +1254,15 @@ done:
 
 /* ---- close ------------------------------------------------------------- */
 
+unsigned long long cf_h5_memory(const cf_h5 *h)
+{
+    size_t max = 0, min_clean = 0, cur = 0;
+    int entries = 0;
+    if (!h || H5Fget_mdc_size(h->file, &max, &min_clean, &cur, &entries) < 0)
+        return 0;
+    return cur;
+}
+
 cf_status cf_h5_close(cf_h5 *h, cf_error *err)
 {
     if (!h)

@@ -173,7 +173,7 @@ static cf_status select_crack_plane(cf_sim *sim, cf_error *err)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     cf_solid *s = &sim->solid;
-    if (!set->has_crack_plane)
+    if (!set->has_crack_plane || !s->facet)
         return CF_OK;
     s->candidate = malloc((size_t)s->n_facets);
     if (!s->candidate)
@@ -397,6 +397,7 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
     sim->scene = scene;
     sim->opt = *opt;
     sim->wall_start = cf_wall_time();
+    sim->bullet_base = cfb_allocated_bytes();
     int threads = opt->threads > 0 ? opt->threads : scene->solver.threads;
     if (threads > 0)
         omp_set_num_threads(threads);
@@ -409,6 +410,8 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
         st = cf_solid_init(&sim->solid, &all, &scene->material, body, err);
         if (st == CF_OK)
             memcpy(sim->solid.bc, bc, (size_t)all.n_nodes * sizeof(int));
+        if (st == CF_OK && scene->solver.criterion != CF_CRITERION_NONE)
+            st = cf_solid_init_facets(&sim->solid, err);
         cf_mesh_free(&all);
     }
     free(bc);
@@ -630,6 +633,8 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     }
     cf_status st = cf_h5_write_frame(sim->h5, sim->step, sim->t, fr, n, err);
     free(fr);
+    unsigned long long mem = cf_h5_memory(sim->h5);
+    sim->output_peak = mem > sim->output_peak ? mem : sim->output_peak;
     cf_ledger l;
     cf_sim_ledger(sim, &l);
     const struct {
@@ -1044,6 +1049,57 @@ static void print_hull_summary(const cf_sim *sim, FILE *out, double wall)
     free(e);
 }
 
+void cf_sim_memory(const cf_sim *sim, cf_memory *m)
+{
+    const cf_solid *s = &sim->solid;
+    const unsigned long long D = sizeof(double), I = sizeof(int);
+    unsigned long long cn = (unsigned long long)s->cap_nodes, nt = (unsigned long long)s->n_tets;
+    memset(m, 0, sizeof *m);
+    m->solid = cn * (16 * D + 2 * I) + nt * (36 * D + 9 * I) +
+               ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I;
+    if (s->facet)
+        m->fracture = nt * 20 * I + (unsigned long long)s->n_facets * (1 + (s->candidate != NULL));
+    m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
+    m->fragments = (unsigned long long)sim->cap_frag * sizeof(cf_fragment);
+    for (int i = 0; i < sim->n_frag; i++) {
+        const cf_fragment *f = &sim->frag[i];
+        m->fragments += (unsigned long long)f->nt * I + (unsigned long long)f->nodes.cap * I +
+                        (unsigned long long)f->coh.cap * I +
+                        (unsigned long long)f->bars.n * (2 * I + 3 * D) +
+                        (unsigned long long)f->scratch_cap * (I + 4 * D + I + 6 * D);
+        if (f->hulls.n_hulls)
+            m->fragments += (unsigned long long)f->hulls.start[f->hulls.n_hulls] * 3 * D +
+                            ((unsigned long long)f->hulls.n_hulls + 1) * I;
+    }
+    unsigned long long b = cfb_allocated_bytes();
+    m->bullet = b > sim->bullet_base ? b - sim->bullet_base : 0;
+    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
+        m->collision += cff_mesh_bytes(sim->obs.mesh[j]);
+    m->output = sim->output_peak;
+}
+
+static void print_memory(const cf_sim *sim, FILE *out)
+{
+    cf_memory m;
+    cf_sim_memory(sim, &m);
+    const struct {
+        const char *name;
+        unsigned long long bytes;
+    } part[] = {{"solid", m.solid},       {"fracture state", m.fracture},
+                {"cohesive", m.cohesive}, {"fragments", m.fragments},
+                {"Bullet world", m.bullet}, {"FCL meshes", m.collision},
+                {"HDF5 output", m.output}};
+    fprintf(out, "memory (MiB)      ");
+    for (size_t i = 0; i < sizeof part / sizeof part[0]; i++) {
+        fprintf(out, "%s%s ", i ? " | " : "", part[i].name);
+        if (part[i].bytes)
+            fprintf(out, "%.3g", part[i].bytes / 1048576.0);
+        else
+            fputs("none", out);
+    }
+    fputc('\n', out);
+}
+
 void cf_sim_print_summary(const cf_sim *sim, FILE *out)
 {
     const cf_scene *sc = sim->scene;
@@ -1070,6 +1126,7 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
                  "handoff_loss %.4g J\n",
             sim->n_handoffs, sim->max_momentum_error, sim->total_handoff_loss);
     print_hull_summary(sim, out, wall);
+    print_memory(sim, out);
     double staged = p->rigid + p->stress + p->insertion + p->forces + p->pbd + p->handoff + p->output;
     cf_ledger l;
     cf_sim_ledger(sim, &l);

@@ -103,6 +103,8 @@ struct cf_sim {
     unsigned char *obstacle_moving; /* [n_obstacles] kinematic (restored on a re-step) */
     double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
     cf_hull_set near;        /* hulls near the fragment being sub-cycled */
+    unsigned long long bullet_base; /* Bullet allocator bytes when the run was created */
+    unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
 };
 
 /* One step of the in-house solver on fragment f (source Table 6.2): with

@@ -98,6 +98,16 @@ static double tri_area(const double *a, const double *b, const double *c)
     return 0.5 * v3_norm(n);
 }
 
+cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
+{
+    if (s->facet)
+        return CF_OK;
+    if (build_facets(s))
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
+                            s->n_tets);
+    return CF_OK;
+}
+
 double cf_solid_crack_area(const cf_solid *s)
 {
     double area = 0;
@@ -175,9 +185,10 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
         if (h / c_d < s->dt_cfl)
             s->dt_cfl = h / c_d;
     }
-    if (build_facets(s) || build_vertex_tets(s)) {
+    if (build_vertex_tets(s)) {
         cf_solid_free(s);
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets", nt);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for the node-to-tet map of %d tets",
+                            nt);
     }
     for (int t = 0; t < nt; t++) /* lumped mass: rho V / 4 to each node */
         for (int j = 0; j < 4; j++)

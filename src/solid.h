@@ -73,6 +73,11 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
                         const int *tet_body, cf_error *err);
 void cf_solid_free(cf_solid *s);
 
+/* The facets (interior and boundary faces), each tet face's facet and the
+ * crack flags: the fracture state, built only for a scene that may insert
+ * cohesive elements (criterion other than "none").  Errors: CF_ERR_NOMEM. */
+cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
+
 /* Crack area, m^2: the rest area of every facet whose cohesive element has
  * failed completely (all three node pairs), one side counted. */
 double cf_solid_crack_area(const cf_solid *s);

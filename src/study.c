@@ -771,6 +771,8 @@ cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_err
         }
         long idx = i - 1;
         size_t len = 0;
+        if (o.n_vary == 0)
+            snprintf(c[i].label, sizeof c[i].label, "the scene as written");
         for (int a = o.n_vary - 1; a >= 0; a--) {
             values[i][a] = ax[a].values[idx % ax[a].n];
             idx /= ax[a].n;

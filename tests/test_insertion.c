@@ -21,6 +21,7 @@ static void init(cf_solid *s, cf_mesh *m)
 {
     int *body = calloc((size_t)m->n_tets, sizeof(int));
     assert_int_equal(cf_solid_init(s, m, &mat, body, NULL), CF_OK);
+    assert_int_equal(cf_solid_init_facets(s, NULL), CF_OK);
     free(body);
     for (int i = 0; i < s->n_nodes; i++) /* a non-uniform velocity field */
         for (int k = 0; k < 3; k++)

@@ -124,6 +124,10 @@ cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double t
 /* Append one hand-off record. */
 cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err);
 
+/* Bytes of HDF5's metadata cache for the file now (H5Fget_mdc_size), for
+ * the run summary's memory accounting; 0 for NULL. */
+unsigned long long cf_h5_memory(const cf_h5 *h);
+
 /* Flush, write /xdmf/polyvertex and the XDMF sidecar, close.  The handle is
  * freed even when an error is returned.  Safe on NULL. */
 cf_status cf_h5_close(cf_h5 *h, cf_error *err);

@@ -5,7 +5,7 @@
  * output file is empty); cf_sim_run advances it to the scene's duration,
  * writing frames to the HDF5 file; cf_sim_print_summary prints the closing
  * summary (wall time, time per stage, steps per mode, fragments, cohesive
- * elements, hand-off momentum error and loss). */
+ * elements, hand-off momentum error and loss, memory per subsystem). */
 #ifndef COHFRAC_SIM_H
 #define COHFRAC_SIM_H
 
@@ -118,6 +118,27 @@ double cf_sim_fragment_support(cf_sim *sim, int id, const double d[3]);
  * count (the element loops write per-element results and sum them in a
  * fixed order). */
 uint64_t cf_sim_state_hash(const cf_sim *sim);
+
+/* Memory each subsystem of the run holds now, bytes; 0 for one the scene
+ * does not use (nothing of it is allocated). */
+typedef struct cf_memory {
+    unsigned long long solid;     /* Tet4 nodes and elements: positions, velocities,
+                                     lumped masses, rest shapes, stresses, node-to-tet map */
+    unsigned long long fracture;  /* facets, crack flags, crack-plane candidates: only
+                                     when solver.criterion is not "none" */
+    unsigned long long cohesive;  /* the cohesive elements' array (its capacity) */
+    unsigned long long fragments; /* fragment records, their tet and node lists, PBD bars,
+                                     convex hulls, contact scratch */
+    unsigned long long bullet;    /* held by Bullet's allocator beyond what it held when
+                                     this run was created (world, bodies, shapes); counted
+                                     for the process, so exact with one run at a time */
+    unsigned long long collision; /* FCL hierarchies of mesh obstacles */
+    unsigned long long output;    /* HDF5 metadata cache of the output file, the
+                                     largest seen at a frame (the file is closed at
+                                     the end of cf_sim_run) */
+} cf_memory;
+
+void cf_sim_memory(const cf_sim *sim, cf_memory *m);
 
 void cf_sim_print_summary(const cf_sim *sim, FILE *out);
 void cf_sim_destroy(cf_sim *sim);

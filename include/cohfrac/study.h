@@ -3,7 +3,8 @@
  *
  * cf_study_run loads the scene once per case (the --set overrides, then the
  * case's own), so a bad key or value is reported before anything runs.
- * The cases are the reference and every combination of the --vary values.
+ * The cases are the reference and every combination of the --vary values
+ * (without --vary: the reference and the scene as written).
  * Each runs as a separate `cohfrac run` process on the resolved scene
  * (`jobs` at a time), writing its HDF5 output under OUT/runs/<hash>.h5,
  * where <hash> is the FNV-1a hash of the resolved scene text (output file
