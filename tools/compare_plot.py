@@ -15,7 +15,7 @@ import math
 import os
 import sys
 
-from mpl_agg import pyplot
+from mpl_agg import pyplot, save_png
 
 plt = pyplot("compare_plot.py")
 
@@ -107,10 +107,7 @@ def main(argv):
     finish(ax, "momentum drift", "relative", logged)
 
     fig.suptitle(title)
-    fig.tight_layout()
-    tmp = png_path + ".tmp"
-    fig.savefig(tmp, format="png", dpi=110)
-    os.replace(tmp, png_path)
+    save_png(fig, png_path)
     return 0
 
 

@@ -10,10 +10,9 @@ python3-matplotlib (Agg backend).  The PNG is written to OUT.png.tmp and
 renamed.  Exit 3 when matplotlib is missing, 2 on a bad CSV.
 """
 import csv
-import os
 import sys
 
-from mpl_agg import pyplot
+from mpl_agg import pyplot, save_png
 
 plt = pyplot("stability_plot.py")
 from matplotlib.colors import ListedColormap  # noqa: E402
@@ -64,10 +63,7 @@ def main():
                 ax.set_ylabel(label, fontsize=8)
     fig.suptitle("fracture-mode stability (green stable, red: criterion + first failing step)",
                  fontsize=10)
-    fig.tight_layout()
-    tmp = sys.argv[2] + ".tmp"
-    fig.savefig(tmp, dpi=110, format="png")
-    os.replace(tmp, sys.argv[2])
+    save_png(fig, sys.argv[2])
     return 0
 
 

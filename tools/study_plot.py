@@ -14,10 +14,9 @@ renamed.  Exit 3 when matplotlib is missing, 2 on a bad CSV.
 """
 import csv
 import math
-import os
 import sys
 
-from mpl_agg import pyplot
+from mpl_agg import pyplot, save_png
 
 plt = pyplot("study_plot.py")
 
@@ -90,10 +89,7 @@ def main():
     axes[0].legend(fontsize=7, loc="best")
     fig.suptitle(f"{sys.argv[4]}: error against run time "
                  f"(case numbers as in study.md)", fontsize=10)
-    fig.tight_layout()
-    tmp = sys.argv[2] + ".tmp"
-    fig.savefig(tmp, dpi=110, format="png")
-    os.replace(tmp, sys.argv[2])
+    save_png(fig, sys.argv[2])
     return 0
 
 
