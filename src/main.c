@@ -259,6 +259,24 @@ static int cmd_compare(int argc, char **argv)
     return rc;
 }
 
+/* `prefix` and the arguments as one shell command line (arguments with a
+ * space or a quote in single quotes), for a report's "regenerate with". */
+static char *command_line(const char *prefix, int argc, char **argv)
+{
+    size_t len = strlen(prefix) + 1;
+    for (int i = 0; i < argc; i++)
+        len += strlen(argv[i]) + 3;
+    char *cmd = malloc(len);
+    if (!cmd)
+        return NULL;
+    char *end = cmd + sprintf(cmd, "%s", prefix);
+    for (int i = 0; i < argc; i++) {
+        int quote = strpbrk(argv[i], " \"") != NULL;
+        end += sprintf(end, quote ? " '%s'" : " %s", argv[i]);
+    }
+    return cmd;
+}
+
 static int cmd_study(int argc, char **argv)
 {
     static const struct option lo[] = {{"vary", required_argument, 0, 'V'},
@@ -296,17 +314,8 @@ static int cmd_study(int argc, char **argv)
         rc = usage_error("'study' needs exactly one scene file");
     else if (rc == 0 && (o.jobs < 1 || o.threads < 0 || o.tolerance < 0))
         rc = usage_error("'study': --jobs must be >= 1, --threads and --tolerance >= 0");
-    /* The command line, for the report's "regenerate with". */
-    size_t len = 0;
-    for (int i = 0; i < argc; i++)
-        len += strlen(argv[i]) + 8;
-    char *cmd = malloc(len + 16);
-    if (rc == 0 && cmd) {
-        strcpy(cmd, "cohfrac study");
-        for (int i = 1; i < argc; i++)
-            strcat(strcat(strcat(cmd, strchr(argv[i], ' ') || strchr(argv[i], '"') ? " '" : " "),
-                          argv[i]),
-                   strchr(argv[i], ' ') || strchr(argv[i], '"') ? "'" : "");
+    char *cmd = rc == 0 ? command_line("cohfrac study", argc - 1, argv + 1) : NULL;
+    if (rc == 0) {
         o.scene = argv[optind];
         o.vary = vary, o.overrides = sets, o.command = cmd;
         o.reference = o.n_reference ? ref : NULL;
