@@ -39,7 +39,10 @@
  *                   mass distributions (fraction of the mass in fragments of
  *                   mass <= m), 0 same, 1 disjoint
  *   crack_area [m^2], dissipated [J]: the last sample of the observables
- *                   crack_area and energy_cohesive_dissipated
+ *                   crack_area (facets whose cohesive element failed
+ *                   completely; fragments that part at insertion and return
+ *                   to rigid mode before their cohesive elements fail leave
+ *                   it at 0) and energy_cohesive_dissipated
  *   p_err, l_err [-] |P - P_ref| / |P_ref| at the last frame, and the same
  *                   for the angular momentum L about the origin, divided by
  *                   max(|L_ref|, |P_ref| D) (L_ref vanishes for motion
