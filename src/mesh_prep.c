@@ -28,15 +28,14 @@
 
 #include "clock.h"
 #include "file_text.h"
+#include "process.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/surface.h"
 
 #include <dirent.h>
 #include <errno.h>
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,8 +43,6 @@
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-extern char **environ;
 
 /* Bump when the pipeline changes in a way that changes its output, so old
  * cached meshes are rebuilt. */
@@ -160,26 +157,19 @@ static cf_status run_tetgen(const char *dir, const char *opts, cf_mesh *m, doubl
     const char *prog = getenv("COHFRAC_TETGEN");
     if (!prog || !*prog)
         prog = "tetgen";
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&fa, 1, logp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
     char *argv[] = {(char *)prog, flag, in, NULL};
     pid_t pid;
     double t0 = cf_wall_time();
-    int rc = posix_spawnp(&pid, prog, &fa, NULL, argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
+    int rc = cf_spawn(argv, logp, &pid);
     if (rc != 0)
         return cf_error_set(err, CF_ERR_EXTERNAL,
                             "cannot run '%s' (%s): install TetGen (Debian: apt install tetgen) "
                             "or point COHFRAC_TETGEN at the program",
                             prog, strerror(rc));
     int status;
-    while (waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR)
-            return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for %s failed (%s)", prog,
-                                strerror(errno));
+    if (cf_wait(pid, &status, NULL) < 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for %s failed (%s)", prog,
+                            strerror(errno));
     *secs = cf_wall_time() - t0;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         char tail[600];

@@ -20,13 +20,12 @@
  */
 #include "file_text.h"
 #include "hash.h"
+#include "process.h"
 #include "cohfrac/mesh.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,8 +34,6 @@
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-extern char **environ;
 
 static const char axis[3] = {'x', 'y', 'z'};
 
@@ -234,24 +231,17 @@ static cf_status run_gmsh(const char *geo, const char *msh, const char *logp, cf
     char *argv[] = {(char *)prog, "-3", "-format", "msh41", "-o", (char *)msh, (char *)geo, NULL};
     char cmd[3 * PATH_MAX];
     snprintf(cmd, sizeof cmd, "%s -3 -format msh41 -o %s %s", prog, msh, geo);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&fa, 1, logp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
     pid_t pid;
-    int rc = posix_spawnp(&pid, prog, &fa, NULL, argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
+    int rc = cf_spawn(argv, logp, &pid);
     if (rc != 0)
         return cf_error_set(err, CF_ERR_EXTERNAL,
                             "cannot run '%s' (%s): install Gmsh (Debian: apt install gmsh) or "
                             "point COHFRAC_GMSH at the program; command: %s",
                             prog, strerror(rc), cmd);
     int status;
-    while (waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR)
-            return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for %s failed (%s)", prog,
-                                strerror(errno));
+    if (cf_wait(pid, &status, NULL) < 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for %s failed (%s)", prog,
+                            strerror(errno));
     if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
         return cf_error_set(err, CF_ERR_EXTERNAL,
                             "'%s' not found: install Gmsh (Debian: apt install gmsh) or point "

@@ -1,16 +1,15 @@
 /* Report files for the studies (see report.h). */
 #include "report.h"
 
+#include "process.h"
+
 #include <errno.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-extern char **environ;
 
 cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error *err)
 {
@@ -76,9 +75,9 @@ int cf_report_plot(const char *script, const char *script_path, const char *cons
         argv[n++] = (char *)args[i];
     argv[n] = NULL;
     pid_t pid;
-    int rc = posix_spawnp(&pid, py, NULL, NULL, argv, environ);
+    int rc = cf_spawn(argv, NULL, &pid);
     int status = 0;
-    if (rc == 0 && waitpid(pid, &status, 0) < 0)
+    if (rc == 0 && cf_wait(pid, &status, NULL) < 0)
         rc = errno;
     if (rc != 0) {
         fprintf(stderr, "cohfrac: warning: cannot run python3 (%s): no plot; install python3 "
