@@ -7,18 +7,18 @@
 #include "cohfrac/scene.h"
 #include "file_text.h"
 #include "hash.h"
+#include "linalg.h"
+#include "process.h"
 #include "report.h"
 #include "trajectory.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <inttypes.h>
 #include <math.h>
-#include <spawn.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/utsname.h>
 #include <sys/wait.h>
@@ -28,8 +28,6 @@
 #ifndef COHFRAC_VERSION
 #define COHFRAC_VERSION "0.0.0"
 #endif
-
-extern char **environ;
 
 static const char *const default_reference[] = {"solver.constraints=\"none\"",
                                                 "solver.cfl_fraction=0.5"};
@@ -46,6 +44,7 @@ typedef struct job {
     const char **sets;  /* its overrides after the common ones */
     int n_sets;
     char *text;         /* the resolved scene */
+    int same_as;        /* an earlier case with the same resolved scene, -1 none */
     char lua[1200], h5[1200], log[1200], meta[1200];
     pid_t pid;
     double t_start;
@@ -139,6 +138,23 @@ static cf_status resolve_case(const cf_study_options *o, job *j, cf_study_case *
     return j->text ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
 }
 
+/* Write runs/<hash>.<ext>, whole or not at all, from a printf format. */
+static cf_status write_run_file(const char *runs, const char *hash, const char *ext,
+                                cf_error *err, const char *fmt, ...)
+{
+    char fname[32];
+    snprintf(fname, sizeof fname, "%s.%s", hash, ext);
+    cf_outfile f;
+    cf_status st = cf_out_open(&f, runs, fname, err);
+    if (st != CF_OK)
+        return st;
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(f.f, fmt, ap);
+    va_end(ap);
+    return cf_out_close(&f, err);
+}
+
 /* Name the case's files under `runs` and write runs/<hash>.lua. */
 static cf_status write_case(job *j, const cf_study_case *c, const char *runs, cf_error *err)
 {
@@ -146,14 +162,8 @@ static cf_status write_case(job *j, const cf_study_case *c, const char *runs, cf
     snprintf(j->h5, sizeof j->h5, "%s/%s.h5", runs, c->hash);
     snprintf(j->log, sizeof j->log, "%s/%s.log", runs, c->hash);
     snprintf(j->meta, sizeof j->meta, "%s/%s.meta", runs, c->hash);
-    char fname[32];
-    snprintf(fname, sizeof fname, "%s.lua", c->hash);
-    cf_outfile f;
-    cf_status st = cf_out_open(&f, runs, fname, err);
-    if (st != CF_OK)
-        return st;
-    fprintf(f.f, "-- %s (resolved by cohfrac %s)\n%s", c->label, COHFRAC_VERSION, j->text);
-    return cf_out_close(&f, err);
+    return write_run_file(runs, c->hash, "lua", err, "-- %s (resolved by cohfrac %s)\n%s",
+                          c->label, COHFRAC_VERSION, j->text);
 }
 
 /* A cached case: runs/<hash>.meta holds "exit wall cpu peak_rss". */
@@ -175,29 +185,23 @@ static cf_status start_case(const cf_study_options *o, job *j, int threads, cf_e
                           "-o", j->h5, NULL};
     unlink(j->meta);
     unlink(j->h5);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&fa, 1, j->log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
     j->t_start = cf_wall_time();
-    int rc = posix_spawn(&j->pid, o->exe, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
+    int rc = cf_spawn((char *const *)argv, j->log, &j->pid);
     if (rc != 0)
         return cf_error_set(err, CF_ERR_EXTERNAL, "cannot run '%s' (%s)", o->exe, strerror(rc));
     return CF_OK;
 }
 
 /* Wait for any running case; record its figures and write its .meta. */
-static cf_status reap_case(job *jobs, cf_study_case *cases, int n, int *done, cf_error *err)
+static cf_status reap_case(job *jobs, cf_study_case *cases, int n, const char *runs, int *done,
+                           cf_error *err)
 {
     int status;
     struct rusage ru;
-    pid_t pid;
-    while ((pid = wait4(-1, &status, 0, &ru)) < 0)
-        if (errno != EINTR)
-            return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for a case failed (%s)",
-                                strerror(errno));
+    pid_t pid = cf_wait(-1, &status, &ru);
+    if (pid < 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL, "waiting for a case failed (%s)",
+                            strerror(errno));
     for (int i = 0; i < n; i++) {
         if (jobs[i].pid != pid)
             continue;
@@ -209,19 +213,8 @@ static cf_status reap_case(job *jobs, cf_study_case *cases, int n, int *done, cf
         c->exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
         jobs[i].pid = 0;
         *done = i;
-        char dir[1200], *slash;
-        snprintf(dir, sizeof dir, "%s", jobs[i].meta);
-        slash = strrchr(dir, '/');
-        *slash = 0;
-        char fname[32];
-        snprintf(fname, sizeof fname, "%s.meta", c->hash);
-        cf_outfile f;
-        cf_status st = cf_out_open(&f, dir, fname, err);
-        if (st == CF_OK) {
-            fprintf(f.f, "%d %.6f %.6f %.0f\n", c->exit_code, c->wall, c->cpu, c->peak_rss);
-            st = cf_out_close(&f, err);
-        }
-        return st;
+        return write_run_file(runs, c->hash, "meta", err, "%d %.6f %.6f %.0f\n", c->exit_code,
+                              c->wall, c->cpu, c->peak_rss);
     }
     *done = -1;
     return CF_OK;
@@ -386,12 +379,10 @@ static double trajectory_error(const cf_trajectory *v, const cf_trajectory *r)
                     p = r->parent[p];
                 if (p < 0)
                     continue;
-                double d2 = 0;
-                for (int d = 0; d < 3; d++) {
-                    double dx = x[3 * f + d] - S[3 * p + d] / M[p];
-                    d2 += dx * dx;
-                }
-                e2 += v->mass[f] * d2;
+                double y[3] = {0, 0, 0}, dx[3];
+                v3_axpy(1 / M[p], &S[3 * p], y); /* the partners' centre of mass */
+                v3_sub(&x[3 * f], y, dx);
+                e2 += v->mass[f] * v3_dot(dx, dx);
                 mass += v->mass[f];
             }
             if (mass > 0)
@@ -436,10 +427,9 @@ static double travel(const cf_trajectory *r)
 /* |a - b| / max(|b|, floor), for the final momenta. */
 static double rel_diff3(const double *a, const double *b, double floor)
 {
-    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-    double nd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    double nb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-    return nd / fmax(nb, floor);
+    double d[3];
+    v3_sub(a, b, d);
+    return v3_norm(d) / fmax(v3_norm(b), floor);
 }
 
 /* Fill the case's metrics from its output and the reference's. */
@@ -457,9 +447,8 @@ static void measure(cf_study_case *c, const cf_trajectory *v, const cf_trajector
     /* L about the origin is near 0 for motion along a line through it: scale
      * it by the reference's |P| times the distance travelled. */
     const double *P = &r->last[CF_OBS_PX];
-    double p_ref = sqrt(P[0] * P[0] + P[1] * P[1] + P[2] * P[2]);
     c->p_err = rel_diff3(&v->last[CF_OBS_PX], P, 1e-300);
-    c->l_err = rel_diff3(&v->last[CF_OBS_LX], &r->last[CF_OBS_LX], fmax(p_ref * D, 1e-300));
+    c->l_err = rel_diff3(&v->last[CF_OBS_LX], &r->last[CF_OBS_LX], fmax(v3_norm(P) * D, 1e-300));
     double in = v->first[CF_OBS_KINETIC] + v->first[CF_OBS_STRAIN] +
                 fabs(v->last[CF_OBS_WORK_GRAVITY]) + fabs(v->last[CF_OBS_WORK_BOUNDARY]) +
                 fabs(v->last[CF_OBS_WORK_OBSTACLES]);
@@ -676,16 +665,16 @@ static cf_status write_md(const cf_study_options *o, const cf_study_result *res,
 
 /* Start every case not cached, `jobs` at a time, and wait for them all. */
 static cf_status run_cases(const cf_study_options *o, job *jobs, cf_study_case *c, int n,
-                           int threads, cf_error *err)
+                           const char *runs, int threads, cf_error *err)
 {
     int running = 0, finished = 0, to_run = 0;
     cf_status st = CF_OK;
     for (int i = 0; i < n; i++)
-        to_run += !c[i].cached;
+        to_run += !c[i].cached && jobs[i].same_as < 0;
     for (int i = 0; i <= n && st == CF_OK; i++) {
         while (running > 0 && (running >= o->jobs || i == n)) {
             int k;
-            st = reap_case(jobs, c, n, &k, err);
+            st = reap_case(jobs, c, n, runs, &k, err);
             if (st != CF_OK || k < 0)
                 break;
             running--, finished++;
@@ -693,14 +682,14 @@ static cf_status run_cases(const cf_study_options *o, job *jobs, cf_study_case *
                 fprintf(stderr, "[%d/%d] %s: %s, %.1f s\n", finished, to_run, c[k].label,
                         status_word(c[k].exit_code), c[k].wall);
         }
-        if (i < n && !c[i].cached && st == CF_OK) {
+        if (i < n && !c[i].cached && jobs[i].same_as < 0 && st == CF_OK) {
             st = start_case(o, &jobs[i], threads, err);
             running += st == CF_OK;
         }
     }
     while (running > 0) { /* after an error: do not leave children behind */
         int status;
-        if (wait(&status) < 0 && errno != EINTR)
+        if (cf_wait(-1, &status, NULL) < 0)
             break;
         running--;
     }
@@ -740,7 +729,8 @@ cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_err
     axis *ax = calloc((size_t)o.n_vary + 1, sizeof *ax);
     long n = 1;
     for (int a = 0; a < o.n_vary && st == CF_OK; a++) {
-        st = ax ? parse_axis(o.vary[a], &ax[a], err) : cf_error_set(err, CF_ERR_NOMEM, "oom");
+        st = ax ? parse_axis(o.vary[a], &ax[a], err)
+                : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
         n *= ax ? ax[a].n : 1;
         if (n > 10000)
             st = cf_error_set(err, CF_ERR_USAGE, "--vary: %ld cases or more; at most 10000", n);
@@ -802,19 +792,28 @@ cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_err
         st = cf_mkdirs(runs, "study directory", err);
     }
     for (int i = 0; i < n && st == CF_OK; i++) {
+        jobs[i].same_as = -1; /* the same scene twice: run it once */
+        for (int k = 0; k < i && jobs[i].same_as < 0; k++)
+            if (!strcmp(c[k].hash, c[i].hash))
+                jobs[i].same_as = k;
         st = write_case(&jobs[i], &c[i], runs, err);
         struct stat sb;
         c[i].cached = st == CF_OK && read_meta(&jobs[i], &c[i]) && stat(jobs[i].h5, &sb) == 0;
-        for (int k = 0; k < i && c[i].cached; k++) /* the same scene twice: run it once */
-            c[i].cached = strcmp(c[k].hash, c[i].hash) != 0 || c[k].cached;
-        res->n_cached += c[i].cached;
+        res->n_cached += c[i].cached && jobs[i].same_as < 0;
     }
     if (st == CF_OK && o.progress)
         fprintf(stderr, "study %s: %d cases (%d cached), %d at a time, %d thread%s each\n",
                 res->scene_name, res->n_cases, res->n_cached, o.jobs, threads,
                 threads > 1 ? "s" : "");
     if (st == CF_OK)
-        st = run_cases(&o, jobs, c, res->n_cases, threads, err);
+        st = run_cases(&o, jobs, c, res->n_cases, runs, threads, err);
+    for (int i = 0; i < n && st == CF_OK; i++) {
+        const cf_study_case *k = jobs[i].same_as >= 0 ? &c[jobs[i].same_as] : NULL;
+        if (k) {
+            c[i].exit_code = k->exit_code, c[i].cached = k->cached;
+            c[i].wall = k->wall, c[i].cpu = k->cpu, c[i].peak_rss = k->peak_rss;
+        }
+    }
 
     /* Metrics against the reference. */
     cf_trajectory rt = {0};

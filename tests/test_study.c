@@ -87,6 +87,29 @@ static void test_free_fall_error_is_closed_form(void **state)
     cf_study_free(&r);
 }
 
+/* A case whose resolved scene is the reference's runs once and gets the
+ * reference's figures: zero error, the same process figures. */
+static void test_case_equal_to_reference_runs_once(void **state)
+{
+    (void)state;
+    const char *vary[] = {"solver.dt_fracture=1e-4", "solver.constraints=\"none\""};
+    const char *ref[] = {"solver.dt_fracture=1e-4", "solver.constraints=\"none\""};
+    cf_study_options o = {.scene = SCENE, .vary = vary, .n_vary = 2, .reference = ref,
+                          .n_reference = 2, .out_dir = tmpdir("study_same"),
+                          .mesh_dir = COHFRAC_MESH_DIR, .exe = COHFRAC_EXE, .jobs = 2};
+    cf_study_result r;
+    cf_error err = {0};
+    if (cf_study_run(&o, &r, &err) != CF_OK)
+        fail_msg("study: %s", err.msg);
+    assert_int_equal(r.n_cases, 2);
+    assert_string_equal(r.cases[0].hash, r.cases[1].hash);
+    assert_int_equal(r.cases[1].exit_code, 0);
+    assert_near(r.cases[1].traj_rms, 0, 0);
+    assert_near(r.cases[1].wall, r.cases[0].wall, 0);
+    assert_int_equal(r.n_cached, 0);
+    cf_study_free(&r);
+}
+
 /* A file with one body of mass 3 kg at the origin moving along +x at 1 m/s,
  * which splits at t = 0.5 s into pieces of the given masses (kg, heaviest
  * at +y when `swap` is 0) placed so that their centre of mass stays on the
@@ -187,6 +210,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_free_fall_error_is_closed_form),
+        cmocka_unit_test(test_case_equal_to_reference_runs_once),
         cmocka_unit_test(test_matching_by_family_tree_and_mass),
         cmocka_unit_test(test_bad_vary_and_bad_key),
     };
