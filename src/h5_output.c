@@ -20,6 +20,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "cohfrac/h5_output.h"
+#include "h5_quiet.h"
 
 #include <hdf5.h>
 
@@ -169,29 +170,6 @@ static cf_status h5_fail(cf_error *err, const char *path, const char *fmt, ...)
 static cf_status no_memory(cf_error *err, const char *path)
 {
     return cf_error_set(err, CF_ERR_NOMEM, "output file '%s': out of memory", path);
-}
-
-/* HDF5 prints its error stack to stderr by default; the engine reports its
- * own message instead.  The caller's setting is put back after each call. */
-typedef struct quiet_state {
-    H5E_auto2_t fn;
-    void *data;
-} quiet_state;
-
-static void quiet_begin(quiet_state *q)
-{
-    q->fn = NULL;
-    q->data = NULL;
-    if (H5Eget_auto2(H5E_DEFAULT, &q->fn, &q->data) < 0) {
-        q->fn = NULL;
-        q->data = NULL;
-    }
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-}
-
-static void quiet_end(const quiet_state *q)
-{
-    H5Eset_auto2(H5E_DEFAULT, q->fn, q->data);
 }
 
 /* ---- small HDF5 helpers ------------------------------------------------ */

@@ -1,7 +1,7 @@
 /* Reading a run's HDF5 output back: see trajectory.h. */
 #include "trajectory.h"
 
-#include <hdf5.h>
+#include "h5_quiet.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -65,14 +65,12 @@ static void read_observable(hid_t file, const char *name, double *first, double 
 cf_status cf_trajectory_read(const char *path, cf_trajectory *t, cf_error *err)
 {
     memset(t, 0, sizeof *t);
-    H5E_auto2_t fn;
-    void *fn_data;
-    H5Eget_auto2(H5E_DEFAULT, &fn, &fn_data);
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* our own messages only */
+    quiet_state q;
+    quiet_begin(&q);
     cf_status st = CF_OK;
     hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (file < 0) {
-        H5Eset_auto2(H5E_DEFAULT, fn, fn_data);
+        quiet_end(&q);
         return cf_error_set(err, CF_ERR_FILE_OPEN,
                             "%s: cannot open as HDF5 (missing, or not a cohfrac output)", path);
     }
@@ -110,7 +108,7 @@ cf_status cf_trajectory_read(const char *path, cf_trajectory *t, cf_error *err)
     }
     free(step);
     H5Fclose(file);
-    H5Eset_auto2(H5E_DEFAULT, fn, fn_data);
+    quiet_end(&q);
     if (st != CF_OK)
         cf_trajectory_free(t);
     return st;

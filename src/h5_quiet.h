@@ -1,0 +1,31 @@
+/* HDF5 prints its error stack to stderr by default; the engine reports its
+ * own messages instead (the writer h5_output.c, the reader trajectory.c).
+ * quiet_begin turns the printing off, quiet_end puts the caller's setting
+ * back. */
+#ifndef COHFRAC_H5_QUIET_H
+#define COHFRAC_H5_QUIET_H
+
+#include <hdf5.h>
+
+typedef struct quiet_state {
+    H5E_auto2_t fn;
+    void *data;
+} quiet_state;
+
+static inline void quiet_begin(quiet_state *q)
+{
+    q->fn = NULL;
+    q->data = NULL;
+    if (H5Eget_auto2(H5E_DEFAULT, &q->fn, &q->data) < 0) {
+        q->fn = NULL;
+        q->data = NULL;
+    }
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+static inline void quiet_end(const quiet_state *q)
+{
+    H5Eset_auto2(H5E_DEFAULT, q->fn, q->data);
+}
+
+#endif
