@@ -1,4 +1,4 @@
-// cohfrac — point queries against static triangle meshes, behind the C
+// cohfrac — point queries against triangle meshes, behind the C
 // header cf_fcl.h.  FCL builds and owns the bounding-volume hierarchy
 // (BVHModel<OBBRSS>) and runs the branch-and-bound distance traversal; the
 // leaf test (exact closest point on one triangle) and the sign (angle-weighted
@@ -17,6 +17,7 @@
 // every entry point catches everything: no exception leaves this file.
 #include "cf_fcl.h"
 
+#include <fcl/math/bv/utility.h>  // fit(), used by BVHModel::refitTree
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/math/bv/OBBRSS.h>
@@ -126,7 +127,8 @@ struct cff_mesh {
     std::vector<V3> v;            // vertices
     std::vector<int> t;           // [nt][3]
     std::vector<V3> face_n;       // unit normal per triangle
-    std::vector<V3> edge_n;       // [nt][3]: edge k joins corners k and k+1
+    std::vector<int> edge_of;     // [nt][3]: edge k (corners k, k+1) -> unique edge
+    std::vector<V3> edge_n;       // per unique edge; zero when undefined
     std::vector<V3> vert_n;       // per vertex; zero when undefined
     V3 center;                    // of the vertices' bounding box
     double size;                  // its diagonal
@@ -173,6 +175,47 @@ V3 unit_or_zero(const V3 &s)
     return n > 0 ? V3(s / n) : V3::Zero();
 }
 
+// Bounding box, face normals and pseudo-normals from the current vertices.
+// Edge: sum of the normals of the triangles sharing it (each sees it under
+// the angle pi).  Vertex: normals weighted by the triangle's angle at the
+// vertex.  A triangle of zero area (repeated or collinear corners) has no
+// normal: it keeps its previous one (zero on the first call).  Returns the
+// first such triangle, or -1.
+int compute_normals(cff_mesh *m)
+{
+    const size_t nv = m->v.size(), nt = m->face_n.size();
+    V3 lo = m->v[0], hi = m->v[0];
+    for (size_t i = 1; i < nv; ++i) {
+        lo = lo.cwiseMin(m->v[i]);
+        hi = hi.cwiseMax(m->v[i]);
+    }
+    m->center = 0.5 * (lo + hi);
+    m->size = (hi - lo).norm();
+    int bad = -1;
+    for (size_t t = 0; t < nt; ++t) {
+        const int *ti = &m->t[3 * t];
+        const V3 &a = m->v[ti[0]], &b = m->v[ti[1]], &c = m->v[ti[2]];
+        const V3 cr = (b - a).cross(c - a);
+        if (cr.norm() > 1e-12 * (b - a).norm() * (c - a).norm()) m->face_n[t] = cr.normalized();
+        else if (bad < 0) bad = static_cast<int>(t);
+    }
+    std::fill(m->edge_n.begin(), m->edge_n.end(), V3::Zero());
+    std::fill(m->vert_n.begin(), m->vert_n.end(), V3::Zero());
+    for (size_t t = 0; t < nt; ++t) {
+        const int *ti = &m->t[3 * t];
+        for (int k = 0; k < 3; ++k) {
+            const int i = ti[k], j = ti[(k + 1) % 3], h = ti[(k + 2) % 3];
+            m->edge_n[m->edge_of[3 * t + k]] += m->face_n[t];
+            const V3 e1 = m->v[j] - m->v[i], e2 = m->v[h] - m->v[i];
+            const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+            m->vert_n[i] += angle * m->face_n[t];
+        }
+    }
+    for (V3 &e : m->edge_n) e = unit_or_zero(e);
+    for (V3 &n : m->vert_n) n = unit_or_zero(n);
+    return bad;
+}
+
 cff_mesh *create(const double *verts, int nv, const int *tris, int nt)
 {
     if (!verts || nv < 3 || !tris || nt < 1) {
@@ -200,53 +243,25 @@ cff_mesh *create(const double *verts, int nv, const int *tris, int nt)
     m->v.resize(static_cast<size_t>(nv));
     for (int i = 0; i < nv; ++i) m->v[i] = V3(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
     m->t.assign(tris, tris + 3 * static_cast<size_t>(nt));
-    V3 lo = m->v[0], hi = m->v[0];
-    for (int i = 1; i < nv; ++i) {
-        lo = lo.cwiseMin(m->v[i]);
-        hi = hi.cwiseMax(m->v[i]);
-    }
-    m->center = 0.5 * (lo + hi);
-    m->size = (hi - lo).norm();
-    m->face_n.resize(static_cast<size_t>(nt));
+    // Each triangle edge's unique edge, for the edge pseudo-normals.
+    std::map<std::pair<int, int>, int> edge_index;
+    m->edge_of.resize(3 * static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t) {
-        const V3 &a = m->v[tris[3 * t]], &b = m->v[tris[3 * t + 1]], &c = m->v[tris[3 * t + 2]];
-        const V3 cr = (b - a).cross(c - a);
-        // Zero area (repeated or collinear corners) has no normal.
-        if (!(cr.norm() > 1e-12 * (b - a).norm() * (c - a).norm())) {
-            set_error("triangle %d is degenerate (zero area)", t);
-            return NULL;
-        }
-        m->face_n[t] = cr.normalized();
-    }
-
-    // Pseudo-normals.  Edge: sum of the normals of the triangles sharing it
-    // (each sees it under the angle pi).  Vertex: normals weighted by the
-    // triangle's angle at the vertex.
-    std::map<std::pair<int, int>, V3> edge_sum;
-    m->vert_n.assign(static_cast<size_t>(nv), V3::Zero());
-    for (int t = 0; t < nt; ++t) {
-        const int *ti = &m->t[3 * static_cast<size_t>(t)];
         for (int k = 0; k < 3; ++k) {
-            const int i = ti[k], j = ti[(k + 1) % 3], h = ti[(k + 2) % 3];
+            const int i = tris[3 * t + k], j = tris[3 * t + (k + 1) % 3];
             const std::pair<int, int> key(std::min(i, j), std::max(i, j));
-            std::map<std::pair<int, int>, V3>::iterator it = edge_sum.find(key);
-            if (it == edge_sum.end()) edge_sum[key] = m->face_n[t];
-            else it->second += m->face_n[t];
-            const V3 e1 = m->v[j] - m->v[i], e2 = m->v[h] - m->v[i];
-            const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
-            m->vert_n[i] += angle * m->face_n[t];
+            const int next = static_cast<int>(edge_index.size());
+            m->edge_of[3 * t + k] = edge_index.insert(std::make_pair(key, next)).first->second;
         }
     }
-    m->edge_n.resize(3 * static_cast<size_t>(nt));
-    for (int t = 0; t < nt; ++t) {
-        const int *ti = &m->t[3 * static_cast<size_t>(t)];
-        for (int k = 0; k < 3; ++k) {
-            const int i = ti[k], j = ti[(k + 1) % 3];
-            m->edge_n[3 * t + k] =
-                unit_or_zero(edge_sum[std::pair<int, int>(std::min(i, j), std::max(i, j))]);
-        }
+    m->edge_n.resize(edge_index.size());
+    m->face_n.assign(static_cast<size_t>(nt), V3::Zero());
+    m->vert_n.resize(static_cast<size_t>(nv));
+    int bad = compute_normals(m.get());
+    if (bad >= 0) {
+        set_error("triangle %d is degenerate (zero area)", bad);
+        return NULL;
     }
-    for (int i = 0; i < nv; ++i) m->vert_n[i] = unit_or_zero(m->vert_n[i]);
 
     std::vector<fcl::Triangle> ftris(static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t)
@@ -260,7 +275,7 @@ cff_mesh *create(const double *verts, int nv, const int *tris, int nt)
 }
 
 int closest(const cff_mesh *m, const double p[3], double max_dist, double q[3], double n[3],
-            double *d)
+            double *d, int *tri_out, double bary[3])
 {
     if (!m || !p || !q || !n || !d) {
         set_error("cff_mesh_closest: NULL argument");
@@ -305,7 +320,7 @@ int closest(const cff_mesh *m, const double p[3], double max_dist, double q[3], 
     } else if (nz == 1) {
         // Coordinate k ~ 0: the edge opposite corner k joins corners k+1, k+2.
         const int k = z[0] ? 0 : (z[1] ? 1 : 2);
-        const V3 &en = m->edge_n[3 * static_cast<size_t>(tri) + (k + 1) % 3];
+        const V3 &en = m->edge_n[m->edge_of[3 * static_cast<size_t>(tri) + (k + 1) % 3]];
         if (en.squaredNorm() > 0) normal = en;
     }
     const V3 diff = point - qq;
@@ -315,7 +330,39 @@ int closest(const cff_mesh *m, const double p[3], double max_dist, double q[3], 
         n[i] = normal[i];
     }
     *d = diff.dot(normal) < 0 ? -dist : dist;
+    if (tri_out) *tri_out = tri;
+    if (bary)
+        for (int i = 0; i < 3; ++i) bary[i] = l[i];
     return 1;
+}
+
+int update(cff_mesh *m, const double *verts)
+{
+    if (!m || !verts) {
+        set_error("cff_mesh_update: NULL argument");
+        return -1;
+    }
+    const size_t nv = m->v.size();
+    for (size_t i = 0; i < 3 * nv; ++i) {
+        if (!std::isfinite(verts[i])) {
+            set_error("mesh vertex %zu is non-finite", i / 3);
+            return -1;
+        }
+    }
+    if (m->bvh.beginUpdateModel() != fcl::BVH_OK) {
+        set_error("FCL could not begin updating the hierarchy");
+        return -1;
+    }
+    for (size_t i = 0; i < nv; ++i) {
+        m->v[i] = V3(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
+        m->bvh.updateVertex(m->v[i]);
+    }
+    if (m->bvh.endUpdateModel(true, true) != fcl::BVH_OK) {
+        set_error("FCL could not refit the hierarchy");
+        return -1;
+    }
+    compute_normals(m);
+    return 0;
 }
 
 }  // namespace
@@ -345,7 +392,9 @@ size_t cff_mesh_bytes(const cff_mesh *m)
                  (size_t)b.num_tris * (sizeof(fcl::Triangle) + sizeof(unsigned int)) +
                  (size_t)b.getNumBVs() * sizeof(fcl::BVNode<fcl::OBBRSSd>);
     return sizeof *m + fcl + m->v.capacity() * sizeof(V3) + m->t.capacity() * sizeof(int) +
-           (m->face_n.capacity() + m->edge_n.capacity() + m->vert_n.capacity()) * sizeof(V3);
+           m->edge_of.capacity() * sizeof(int) +
+           (m->face_n.capacity() + m->edge_n.capacity() + m->vert_n.capacity()) * sizeof(V3) +
+           (b.prev_vertices ? (size_t)b.num_vertices * sizeof(fcl::Vector3d) : 0);
 }
 
 void cff_mesh_destroy(cff_mesh *m)
@@ -359,8 +408,28 @@ void cff_mesh_destroy(cff_mesh *m)
 int cff_mesh_closest(const cff_mesh *m, const double p[3], double max_dist, double q[3],
                      double n[3], double *d)
 {
+    return cff_mesh_closest_tri(m, p, max_dist, q, n, d, NULL, NULL);
+}
+
+int cff_mesh_closest_tri(const cff_mesh *m, const double p[3], double max_dist, double q[3],
+                         double n[3], double *d, int *tri, double bary[3])
+{
     try {
-        return closest(m, p, max_dist, q, n, d);
+        return closest(m, p, max_dist, q, n, d, tri, bary);
+    } catch (const std::exception &e) {
+        set_error("FCL: %s", e.what());
+    } catch (...) {
+        set_error("FCL: unknown exception");
+    }
+    return -1;
+}
+
+int cff_mesh_update(cff_mesh *m, const double *verts)
+{
+    try {
+        return update(m, verts);
+    } catch (const std::bad_alloc &) {
+        set_error("out of memory");
     } catch (const std::exception &e) {
         set_error("FCL: %s", e.what());
     } catch (...) {

@@ -1,8 +1,9 @@
 /* cohfrac — C face of FCL (the Flexible Collision Library) for point queries
- * against static triangle meshes (mesh obstacles seen by fracture-mode
- * nodes, DESIGN §5).  The implementation is C++; no C++ type or exception
- * crosses this header.  Units SI (m).  Functions are thread-safe on a
- * built mesh (queries do not modify it). */
+ * against triangle meshes: mesh obstacles seen by fracture-mode nodes
+ * (DESIGN §5), and the deforming surfaces of fracture-mode fragments of
+ * other bodies (contact_bodies.c).  The implementation is C++; no C++ type
+ * or exception crosses this header.  Units SI (m).  Queries are thread-safe on a
+ * built mesh (they do not modify it); cff_mesh_update is not. */
 #ifndef COHFRAC_FCL_BRIDGE_H
 #define COHFRAC_FCL_BRIDGE_H
 
@@ -37,6 +38,20 @@ size_t cff_mesh_bytes(const cff_mesh *m);
  * non-finite p, negative or NaN max_dist). */
 int cff_mesh_closest(const cff_mesh *m, const double p[3], double max_dist, double q[3],
                      double n[3], double *d);
+
+/* As cff_mesh_closest, and also the triangle q lies on (*tri, 0-based, in
+ * the order given to cff_mesh_create) and q's barycentric coordinates on it
+ * (bary[3], q = bary[0] a + bary[1] b + bary[2] c for its corners in order).
+ * tri and bary may be NULL. */
+int cff_mesh_closest_tri(const cff_mesh *m, const double p[3], double max_dist, double q[3],
+                         double n[3], double *d, int *tri, double bary[3]);
+
+/* Move every vertex to verts [nv][3] (nv as at creation; the triangles
+ * stay) and refit the hierarchy to them, for a deforming surface.  A
+ * triangle that has become degenerate keeps its last normal.  Returns 0, or
+ * -1 on error (NULL argument, a non-finite vertex; the mesh is then
+ * unchanged). */
+int cff_mesh_update(cff_mesh *m, const double *verts);
 
 /* Message of the last failed call (per thread). */
 const char *cff_last_error(void);

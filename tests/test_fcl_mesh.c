@@ -1,7 +1,9 @@
-/* Point queries against static triangle meshes (cf_fcl.h): closest point,
+/* Point queries against triangle meshes (cf_fcl.h): closest point,
  * pseudo-normal and signed distance in the face, edge and vertex regions of
  * a cube, a non-convex prism checked against brute force, max_dist
- * rejection, concurrent queries and bad input. */
+ * rejection, a moved and sheared mesh after cff_mesh_update, the triangle
+ * and barycentric coordinates of the closest point, concurrent queries and
+ * bad input. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -433,12 +435,54 @@ static void test_bad_input(void **state)
     cff_mesh_destroy(m);
 }
 
+/* The cube moved by (2, 0, 0) and stretched to 3 units along z, refitted:
+ * queries see the new surface only, and the triangle and barycentric
+ * coordinates reproduce the closest point. */
+static void test_update(void **state)
+{
+    (void)state;
+    cff_mesh *m = make_cube();
+    double v[8][3];
+    cube_verts(v);
+    for (int i = 0; i < 8; ++i)
+        v[i][0] += 2, v[i][2] *= 3;
+    assert_int_equal(cff_mesh_update(m, &v[0][0]), 0);
+    /* Above the old top face, now inside the stretched cube, 0.3 m behind
+     * its nearest face x = 1.5. */
+    const double p[3] = {1.8, 0.0, 1.0};
+    double q[3], n[3], d, bary[3];
+    int tri = -1;
+    assert_int_equal(cff_mesh_closest_tri(m, p, INFINITY, q, n, &d, &tri, bary), 1);
+    assert_true(fabs(d + 0.3) < TOL);
+    assert_vec(n, -1, 0, 0, TOL);
+    assert_true(tri >= 0 && tri < 12);
+    double r[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c)
+            r[c] += bary[k] * v[CUBE_TRIS[tri][k]][c];
+    assert_vec(r, q[0], q[1], q[2], TOL);
+    assert_true(fabs(bary[0] + bary[1] + bary[2] - 1) < TOL);
+    /* The old position of the cube is empty now. */
+    const double old[3] = {0, 0, 0};
+    assert_int_equal(cff_mesh_closest(m, old, INFINITY, q, n, &d), 1);
+    assert_true(fabs(d - 1.5) < TOL);
+    assert_vec(n, -1, 0, 0, TOL);
+    /* A non-finite vertex is refused and leaves the mesh as it was. */
+    v[3][1] = NAN;
+    assert_int_equal(cff_mesh_update(m, &v[0][0]), -1);
+    assert_non_null(strstr(cff_last_error(), "non-finite"));
+    assert_int_equal(cff_mesh_closest(m, old, INFINITY, q, n, &d), 1);
+    assert_true(fabs(d - 1.5) < TOL);
+    cff_mesh_destroy(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cube_regions),
         cmocka_unit_test(test_max_dist),
         cmocka_unit_test(test_brute_force),
+        cmocka_unit_test(test_update),
         cmocka_unit_test(test_concurrent_queries),
         cmocka_unit_test(test_bad_input),
     };
