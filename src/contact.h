@@ -2,11 +2,16 @@
  * is a point pushed out of the convex hulls of the Bullet bodies near its
  * fragment (penetration by Minkowski portal refinement in libccd), and the impulse
  * that push gives the node goes back to the body, so linear momentum is
- * conserved across the coupling. */
+ * conserved across the coupling (contact.c).
+ *
+ * Contact between fracture-mode fragments of different bodies
+ * (contact_bodies.c): node-to-surface, each node of one fragment against
+ * the deforming boundary of the other, both ways. */
 #ifndef COHFRAC_CONTACT_H
 #define COHFRAC_CONTACT_H
 
 typedef struct cf_sim cf_sim;
+typedef struct cff_mesh cff_mesh;
 
 /* Convex hulls of the rigid bodies near one fragment, in world coordinates
  * at the bodies' poses after the rigid step (they stay put while the
@@ -60,5 +65,45 @@ void cf_node_impulses_free(cf_node_impulses *ni);
  * contact point, add its size to the body fragment's `pushed`, and clear the
  * record.  Returns the kinetic energy the bodies gained, J. */
 double cf_node_impulses_flush(cf_sim *sim, cf_node_impulses *ni);
+
+/* The boundary of a fracture-mode fragment as a deforming triangle mesh:
+ * the faces of its tets used by one of its tets only (crack faces opened by
+ * node duplication included), outward, in an FCL hierarchy refitted to the
+ * nodes' current positions before every query pass. */
+typedef struct cf_frag_surface {
+    cff_mesh *mesh;    /* NULL until first needed */
+    int *node;         /* [nv] solid node of each surface vertex */
+    int *slot;         /* [nv] its index in the fragment's node list */
+    int *tri;          /* [ntri][3] surface vertices, counter-clockwise from outside */
+    double *xv;        /* [nv][3] the vertices' current positions, m (refit scratch) */
+    int nv, ntri;
+    int built_nodes;   /* the fragment's node count when built: node
+                          duplication changes the surface */
+} cf_frag_surface;
+
+void cf_frag_surface_free(cf_frag_surface *fs);
+
+/* Contact between fracture-mode fragments of different initial bodies
+ * (fragments of one body do not collide with each other, as in Bullet),
+ * after every fracture sub-step of length h (s), with every fragment's
+ * step done.  For each pair whose node boxes overlap, every node a of one
+ * fragment found behind the other's surface (signed distance d < 0 to its
+ * closest point q, on triangle (b0, b1, b2) with barycentric coordinates
+ * l) is projected out with the surface, a PBD contact constraint
+ * C = |q - x_a| >= 0 along u = (q - x_a)/|q - x_a| (Mueller et al. 2007):
+ *   dx_a = w_a s u,  dx_bk = -l_k w_bk s u,  s = |d| / (w_a + sum l_k^2 w_bk),
+ * w = 1/m (0 for prescribed nodes); each moved node's velocity changes by
+ * dx/h.  The impulses m dx/h sum to zero and act along one line, so linear
+ * and angular momentum are conserved to round-off.  The contact is
+ * frictionless and perfectly plastic along u.  Limits: node-to-surface
+ * only (edge-edge crossings go unseen); a node nearer a crack face of the
+ * other fragment than its outer surface is taken as outside.
+ * *removed gets the energy the pass removed (J): minus the leapfrog work
+ * of its impulses, sum m dv . (v_start + v)/2 over the moved nodes (v_start
+ * the velocity at the start of the step), which the position change turns
+ * partly into strain energy; so that the energy ledger balances.  Returns
+ * 0, or -1 out of memory or on an FCL error (a message in
+ * cff_last_error(); "out of memory" is not set there). */
+int cf_body_contact(cf_sim *sim, double h, double *removed);
 
 #endif

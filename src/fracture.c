@@ -249,15 +249,15 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
                 v3_sub(&s->p[3 * a], before, dp);
                 w_obs += s->m[a] * v3_dot(dp, u) / dt;
             }
-            if (sim->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
+            if (f->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
                 double *pa = &s->p[3 * a], before[3], dJ[3];
                 memcpy(before, pa, sizeof before);
-                int h = cf_hull_set_project(&sim->near, &s->x[3 * a], pa);
+                int h = cf_hull_set_project(&f->near, &s->x[3 * a], pa);
                 if (h >= 0) {
                     v3_sub(pa, before, dJ);
                     for (int c = 0; c < 3; c++)
                         dJ[c] *= s->m[a] / dt;
-                    cf_node_impulses_add(&f->push, i, sim->near.frag[h], dJ, pa);
+                    cf_node_impulses_add(&f->push, i, f->near.frag[h], dJ, pa);
                 }
             }
         }

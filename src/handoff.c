@@ -427,6 +427,8 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
     }
     if (sim->bullet || k > 1)
         cf_bars_free(&sim->frag[fi].bars);
+    cf_hull_set_free(&sim->frag[fi].near);
+    cf_frag_surface_free(&sim->frag[fi].surface);
     free(tets), free(comp), free(seen);
     for (int c = 0; c < k; c++) {
         double P[3], L[3];

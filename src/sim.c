@@ -472,12 +472,13 @@ void cf_sim_destroy(cf_sim *sim)
         cf_bars_free(&f->bars);
         cf_hulls_free(&f->hulls);
         cf_node_impulses_free(&f->push);
+        cf_hull_set_free(&f->near);
+        cf_frag_surface_free(&f->surface);
     }
     free(sim->frag);
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
         cff_mesh_destroy(sim->obs.mesh[j]);
     free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
-    cf_hull_set_free(&sim->near);
     free(sim->body_boxes);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
@@ -862,7 +863,9 @@ static double contact_pad(const cf_sim *sim, int fi, double dt)
     return dt * (sqrt(v2) + dt * v3_norm(sim->scene->gravity));
 }
 
-/* Sub-cycle every fracture-mode fragment through the rigid step. */
+/* Sub-cycle every fracture-mode fragment through the rigid step, all of
+ * them in step so that fragments of different bodies meet in contact after
+ * each sub-step. */
 static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
 {
     const cf_solver_settings *set = &sim->scene->solver;
@@ -870,22 +873,34 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
     if (n_sub < 1)
         n_sub = 1;
     double h = dt / (double)n_sub;
-    int n = sim->n_frag;
-    int boxed = 0; /* the rigid bodies' boxes are taken once for every fragment */
+    int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
     for (int fi = 0; fi < n; fi++) {
-        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
-            continue;
-        if ((!boxed++ && cf_body_boxes(sim, &sim->body_boxes)) ||
-            cf_hull_set_gather(sim, fi, contact_pad(sim, fi, dt), sim->body_boxes, &sim->near))
+        cf_fragment *f = &sim->frag[fi];
+        if (f->mode == CF_MODE_FRACTURE &&
+            ((!boxed++ && cf_body_boxes(sim, &sim->body_boxes)) ||
+             cf_hull_set_gather(sim, fi, contact_pad(sim, fi, dt), sim->body_boxes, &f->near)))
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
-        for (long k = 0; k < n_sub; k++) {
+    }
+    for (long k = 0; k < n_sub; k++) {
+        for (int fi = 0; fi < n; fi++) {
+            if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+                continue;
             if (cf_solver_step(sim, fi, sim->t + (double)k * h, h, 1) != CF_OK)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
             sim->steps_fracture++;
         }
-        sim->flow.contact -= cf_node_impulses_flush(sim, &sim->frag[fi].push);
-        sim->near.n = 0;
-        const cf_fragment *f = &sim->frag[fi];
+        double removed;
+        if (cf_body_contact(sim, h, &removed))
+            return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
+                                cff_last_error());
+        sim->flow.contact += removed;
+    }
+    for (int fi = 0; fi < n; fi++) {
+        cf_fragment *f = &sim->frag[fi];
+        if (f->mode != CF_MODE_FRACTURE)
+            continue;
+        sim->flow.contact -= cf_node_impulses_flush(sim, &f->push);
+        f->near.n = 0;
         char what[160];
         if (!nodes_sane(&sim->solid, f)) {
             snprintf(what, sizeof what,
@@ -1075,6 +1090,11 @@ void cf_sim_memory(const cf_sim *sim, cf_memory *m)
     m->bullet = b > sim->bullet_base ? b - sim->bullet_base : 0;
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
         m->collision += cff_mesh_bytes(sim->obs.mesh[j]);
+    for (int i = 0; i < sim->n_frag; i++) {
+        const cf_frag_surface *fs = &sim->frag[i].surface;
+        m->collision += cff_mesh_bytes(fs->mesh) +
+                        (unsigned long long)fs->nv * (I + 3 * D) + 3ull * fs->ntri * I;
+    }
     m->output = sim->output_peak;
 }
 

@@ -47,6 +47,10 @@ typedef struct cf_fragment {
     double pushed;           /* N s: impulse fracture-mode nodes gave its body
                                 since the last rigid step (impact trigger) */
     cf_node_impulses push;   /* fracture mode: impulses its nodes gave bodies */
+    cf_hull_set near;        /* fracture mode: hulls of the rigid bodies near it
+                                this rigid step */
+    cf_frag_surface surface; /* fracture mode: its boundary, for contact with
+                                other bodies' fragments */
 } cf_fragment;
 
 /* Convex decomposition settings (DESIGN §5): split until the hulls exceed
@@ -102,7 +106,6 @@ struct cf_sim {
     int *obstacle_body;      /* [n_obstacles] Bullet body of each obstacle */
     unsigned char *obstacle_moving; /* [n_obstacles] kinematic (restored on a re-step) */
     double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
-    cf_hull_set near;        /* hulls near the fragment being sub-cycled */
     unsigned long long bullet_base; /* Bullet allocator bytes when the run was created */
     unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
 };

@@ -37,6 +37,7 @@ CASES = [
     "mode_i",
     "mode_ii",
     "momentum",
+    "bar_collision",
     "cfl",
     "mixed_mode_beam",
     "ledger",

@@ -132,7 +132,8 @@ typedef struct cf_memory {
     unsigned long long bullet;    /* held by Bullet's allocator beyond what it held when
                                      this run was created (world, bodies, shapes); counted
                                      for the process, so exact with one run at a time */
-    unsigned long long collision; /* FCL hierarchies of mesh obstacles */
+    unsigned long long collision; /* FCL hierarchies of mesh obstacles and of
+                                     fragment surfaces (contact between bodies) */
     unsigned long long output;    /* HDF5 metadata cache of the output file, the
                                      largest seen at a frame (the file is closed at
                                      the end of cf_sim_run) */

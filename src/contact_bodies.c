@@ -1,0 +1,325 @@
+/* Contact between fracture-mode fragments of different bodies: node to
+ * deforming surface, a PBD contact constraint (see contact.h). */
+#include "contact.h"
+
+#include "cf_fcl.h"
+#include "linalg.h"
+#include "sim.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cf_frag_surface_free(cf_frag_surface *fs)
+{
+    cff_mesh_destroy(fs->mesh);
+    free(fs->node), free(fs->slot), free(fs->tri), free(fs->xv);
+    memset(fs, 0, sizeof *fs);
+}
+
+/* One tet face: its nodes sorted (the key) and in outward order. */
+typedef struct face_rec {
+    int key[3], v[3];
+} face_rec;
+
+static int cmp_key(const void *pa, const void *pb)
+{
+    const face_rec *a = pa, *b = pb;
+    for (int i = 0; i < 3; i++)
+        if (a->key[i] != b->key[i])
+            return a->key[i] < b->key[i] ? -1 : 1;
+    return 0;
+}
+
+static void sort3(int k[3])
+{
+    int t;
+    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
+    if (k[1] > k[2]) t = k[1], k[1] = k[2], k[2] = t;
+    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
+}
+
+/* The faces of f's tets that no other of its tets uses, on the current
+ * nodes, built over the rest positions (a valid mesh whatever the
+ * deformation) and refitted later.  Returns 0, or -1. */
+static int surface_build(const cf_solid *s, const cf_fragment *f, cf_frag_surface *fs)
+{
+    cf_frag_surface_free(fs);
+    int nf = 4 * f->nt, rc = -1;
+    face_rec *r = malloc((size_t)nf * sizeof *r);
+    int *local = malloc((size_t)s->n_nodes * sizeof(int));
+    double *rest = NULL;
+    if (!r || !local)
+        goto done;
+    for (int i = 0; i < f->nt; i++)
+        for (int k = 0; k < 4; k++) {
+            face_rec *e = &r[4 * i + k];
+            for (int j = 0; j < 3; j++)
+                e->v[j] = e->key[j] = s->tet[4 * f->tets[i] + CF_TET_FACE[k][j]];
+            sort3(e->key);
+        }
+    qsort(r, (size_t)nf, sizeof *r, cmp_key);
+    fs->tri = malloc((size_t)nf * 3 * sizeof(int));
+    fs->node = malloc((size_t)nf * sizeof(int)); /* at most one new vertex per face */
+    if (!fs->tri || !fs->node)
+        goto done;
+    fs->slot = malloc((size_t)nf * sizeof(int));
+    if (!fs->slot)
+        goto done;
+    for (int a = 0; a < s->n_nodes; a++)
+        local[a] = -1;
+    for (int i = 0; i < nf;) {
+        int j = i + 1;
+        while (j < nf && !cmp_key(&r[i], &r[j]))
+            j++;
+        if (j == i + 1)
+            for (int k = 0; k < 3; k++) {
+                int a = r[i].v[k];
+                if (local[a] < 0)
+                    local[a] = fs->nv, fs->node[fs->nv++] = a;
+                fs->tri[3 * fs->ntri + k] = local[a];
+            }
+        fs->ntri += j == i + 1;
+        i = j;
+    }
+    fs->xv = malloc((size_t)(fs->nv > 0 ? fs->nv : 1) * 3 * sizeof(double));
+    rest = malloc((size_t)(fs->nv > 0 ? fs->nv : 1) * 3 * sizeof(double));
+    if (!fs->xv || !rest)
+        goto done;
+    for (int i = 0; i < fs->nv; i++)
+        memcpy(&rest[3 * i], &s->X[3 * fs->node[i]], 3 * sizeof(double));
+    for (int i = 0; i < f->nodes.n; i++) /* local now maps node -> surface vertex */
+        if (local[f->nodes.v[i]] >= 0)
+            fs->slot[local[f->nodes.v[i]]] = i;
+    fs->mesh = cff_mesh_create(rest, fs->nv, fs->tri, fs->ntri);
+    fs->built_nodes = f->nodes.n;
+    rc = fs->mesh ? 0 : -1;
+done:
+    free(r), free(local), free(rest);
+    return rc;
+}
+
+/* The surface of f at the nodes' current positions (built when missing or
+ * when node duplication has changed it).  Returns 0, 1 when a position is
+ * not finite (a diverged fragment: the engine's guard reports it), or -1. */
+static int surface_refit(const cf_solid *s, const cf_fragment *f, cf_frag_surface *fs)
+{
+    if ((!fs->mesh || fs->built_nodes != f->nodes.n) && surface_build(s, f, fs))
+        return -1;
+    for (int i = 0; i < fs->nv; i++) {
+        const double *x = &s->x[3 * fs->node[i]];
+        if (!isfinite(x[0] + x[1] + x[2]))
+            return 1;
+        memcpy(&fs->xv[3 * i], x, 3 * sizeof(double));
+    }
+    return cff_mesh_update(fs->mesh, fs->xv);
+}
+
+/* Bounding box of f's nodes: box[0..2] lo, box[3..5] hi, m. */
+static void node_box(const cf_solid *s, const cf_fragment *f, double box[6])
+{
+    for (int k = 0; k < 3; k++)
+        box[k] = INFINITY, box[3 + k] = -INFINITY;
+    for (int i = 0; i < f->nodes.n; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = s->x[3 * f->nodes.v[i] + k];
+            box[k] = fmin(box[k], x), box[3 + k] = fmax(box[3 + k], x);
+        }
+}
+
+static int in_box(const double x[3], const double box[6])
+{
+    for (int k = 0; k < 3; k++)
+        if (x[k] < box[k] || x[k] > box[3 + k])
+            return 0;
+    return 1;
+}
+
+/* The nodes a contact pass moved, for its work. */
+typedef struct moved_nodes {
+    int n, cap;
+    int *slot;      /* [n_nodes] record of each node, -1 */
+    int *node;      /* [cap] */
+    double *v0;     /* [cap][3] velocity before the pass, m/s */
+    double *vh;     /* [cap][3] velocity at the start of the step, m/s */
+} moved_nodes;
+
+static void moved_free(moved_nodes *mv)
+{
+    free(mv->slot), free(mv->node), free(mv->v0), free(mv->vh);
+}
+
+/* Record node a (fragment f, local index i) before its first move.
+ * Returns 0, or -1 out of memory. */
+static int remember(moved_nodes *mv, const cf_solid *s, const cf_fragment *f, int i, int a)
+{
+    if (!mv->slot) {
+        mv->slot = malloc((size_t)s->n_nodes * sizeof(int));
+        if (!mv->slot)
+            return -1;
+        for (int k = 0; k < s->n_nodes; k++)
+            mv->slot[k] = -1;
+    }
+    if (mv->slot[a] >= 0)
+        return 0;
+    if (mv->n == mv->cap) {
+        int cap = 2 * mv->cap + 64;
+        int *node = realloc(mv->node, (size_t)cap * sizeof(int));
+        if (node)
+            mv->node = node;
+        double *v0 = realloc(mv->v0, (size_t)cap * 3 * sizeof(double));
+        if (v0)
+            mv->v0 = v0;
+        double *vh = realloc(mv->vh, (size_t)cap * 3 * sizeof(double));
+        if (vh)
+            mv->vh = vh;
+        if (!node || !v0 || !vh)
+            return -1;
+        mv->cap = cap;
+    }
+    mv->slot[a] = mv->n;
+    mv->node[mv->n] = a;
+    memcpy(&mv->v0[3 * mv->n], &s->v[3 * a], 3 * sizeof(double));
+    memcpy(&mv->vh[3 * mv->n], &f->v_old[3 * i], 3 * sizeof(double));
+    mv->n++;
+    return 0;
+}
+
+/* Work of the pass's impulses, J: for each moved node the leapfrog work
+ * of a force at this step, m (v - v0) . (v_start + v)/2 with v_start the
+ * velocity at the start of the step (as the boundary's work is booked), so
+ * that the energy ledger balances. */
+static double moved_work(const moved_nodes *mv, const cf_solid *s)
+{
+    double w = 0;
+    for (int k = 0; k < mv->n; k++) {
+        int a = mv->node[k];
+        const double *v = &s->v[3 * a], *v0 = &mv->v0[3 * k], *vh = &mv->vh[3 * k];
+        for (int c = 0; c < 3; c++)
+            w += s->m[a] * (v[c] - v0[c]) * 0.5 * (vh[c] + v[c]);
+    }
+    return w;
+}
+
+static int boxes_overlap(const double a[6], const double b[6])
+{
+    for (int k = 0; k < 3; k++)
+        if (a[k] > b[3 + k] || b[k] > a[3 + k])
+            return 0;
+    return 1;
+}
+
+static double inverse_mass(const cf_solid *s, int a)
+{
+    return s->bc[a] >= 0 || !(s->m[a] > 0) ? 0 : 1 / s->m[a];
+}
+
+/* Move node a (fragment f, local index i) by `amount` times u and change
+ * its velocity by that over h.  Returns 0, or -1 out of memory. */
+static int move(cf_solid *s, moved_nodes *mv, const cf_fragment *f, int i, int a, double amount,
+                const double u[3], double h)
+{
+    if (amount == 0)
+        return 0;
+    if (remember(mv, s, f, i, a))
+        return -1;
+    v3_axpy(amount, u, &s->x[3 * a]);
+    v3_axpy(amount / h, u, &s->v[3 * a]);
+    return 0;
+}
+
+/* Every node of fragment fa inside box_b and behind fb's surface, projected
+ * out with it (the constraint of contact.h).  Returns 0, or -1. */
+static int push_out(cf_sim *sim, const cf_fragment *fa, const cf_fragment *fb,
+                    cf_frag_surface *sb, const double box_b[6], double h, moved_nodes *mv)
+{
+    cf_solid *s = &sim->solid;
+    int fit = surface_refit(s, fb, sb);
+    if (fit)
+        return fit < 0 ? -1 : 0;
+    for (int i = 0; i < fa->nodes.n; i++) {
+        int a = fa->nodes.v[i];
+        const double *xa = &s->x[3 * a];
+        if (!in_box(xa, box_b)) /* also skips a non-finite node */
+            continue;
+        double q[3], n[3], d, l[3], u[3];
+        int tri, found = cff_mesh_closest_tri(sb->mesh, xa, INFINITY, q, n, &d, &tri, l);
+        if (found < 0)
+            return -1;
+        if (!found || !(d < 0))
+            continue;
+        v3_sub(q, xa, u); /* |u| = -d */
+        double wa = inverse_mass(s, a), W = wa, w[3];
+        int b[3];
+        for (int k = 0; k < 3; k++) {
+            b[k] = sb->node[sb->tri[3 * tri + k]];
+            w[k] = inverse_mass(s, b[k]);
+            W += l[k] * l[k] * w[k];
+        }
+        if (!(W > 0))
+            continue;
+        if (move(s, mv, fa, i, a, wa / W, u, h))
+            return -1;
+        for (int k = 0; k < 3; k++) {
+            int v = sb->tri[3 * tri + k];
+            if (move(s, mv, fb, sb->slot[v], b[k], -l[k] * w[k] / W, u, h))
+                return -1;
+        }
+    }
+    return 0;
+}
+
+static int root_of(const cf_sim *sim, int fi)
+{
+    while (sim->frag[fi].parent >= 0)
+        fi = sim->frag[fi].parent;
+    return fi;
+}
+
+int cf_body_contact(cf_sim *sim, double h, double *removed)
+{
+    *removed = 0;
+    /* Nothing to do unless fracture-mode fragments of two bodies exist. */
+    int first_root = -1, two_bodies = 0;
+    for (int fi = 0; fi < sim->n_frag && !two_bodies; fi++) {
+        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+            continue;
+        int r = root_of(sim, fi);
+        if (first_root < 0)
+            first_root = r;
+        two_bodies = r != first_root;
+    }
+    if (!two_bodies)
+        return 0;
+    int n = sim->n_frag;
+    double *box = malloc((size_t)n * 6 * sizeof(double));
+    int *root = malloc((size_t)n * sizeof(int));
+    if (!box || !root) {
+        free(box), free(root);
+        return -1;
+    }
+    for (int fi = 0; fi < n; fi++)
+        if (sim->frag[fi].mode == CF_MODE_FRACTURE) {
+            node_box(&sim->solid, &sim->frag[fi], &box[6 * fi]);
+            root[fi] = root_of(sim, fi);
+        }
+    int rc = 0;
+    moved_nodes mv = {0};
+    for (int i = 0; i < n && !rc; i++) {
+        cf_fragment *fa = &sim->frag[i];
+        if (fa->mode != CF_MODE_FRACTURE)
+            continue;
+        for (int j = i + 1; j < n && !rc; j++) {
+            cf_fragment *fb = &sim->frag[j];
+            if (fb->mode != CF_MODE_FRACTURE || root[j] == root[i] ||
+                !boxes_overlap(&box[6 * i], &box[6 * j]))
+                continue;
+            rc = push_out(sim, fa, fb, &fb->surface, &box[6 * j], h, &mv) ||
+                 push_out(sim, fb, fa, &fa->surface, &box[6 * i], h, &mv);
+        }
+    }
+    *removed = -moved_work(&mv, &sim->solid);
+    moved_free(&mv);
+    free(box), free(root);
+    return rc ? -1 : 0;
+}
