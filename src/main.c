@@ -113,6 +113,8 @@ static int cmd_mesh(int argc, char **argv)
     return 0;
 }
 
+static char *command_line(const char *prefix, int argc, char **argv);
+
 static int cmd_stability(int argc, char **argv)
 {
     static const struct option lo[] = {{"quick", no_argument, 0, 'Q'},
@@ -131,6 +133,8 @@ static int cmd_stability(int argc, char **argv)
     }
     if (optind != argc)
         return usage_error("'stability' takes no positional argument");
+    char *cmd = command_line("cohfrac stability", argc - 1, argv + 1);
+    o.command = cmd;
     cf_error err = {0};
     cf_stability_result res;
     int rc = 0;
@@ -145,6 +149,7 @@ static int cmd_stability(int argc, char **argv)
                res.plot_made ? " (heatmaps: stability.png)" : "");
     }
     cf_stability_free(&res);
+    free(cmd);
     return rc;
 }
 

@@ -1,13 +1,16 @@
 /* Report files for the studies (see report.h). */
 #include "report.h"
 
+#include "file_text.h"
 #include "process.h"
 
 #include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
+#include <sys/utsname.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -94,4 +97,23 @@ int cf_report_plot(const char *script, const char *script_path, const char *cons
                         "python3-matplotlib)\n", py, path,
                 WIFEXITED(status) ? WEXITSTATUS(status) : -1);
     return 0;
+}
+
+void cf_report_machine(char *out, size_t max)
+{
+    char cpu[256] = "unknown CPU", deb[64] = "?";
+    char *info = cf_file_read("/proc/cpuinfo", NULL);
+    const char *m = info ? strstr(info, "model name") : NULL;
+    if (m && (m = strchr(m, ':')))
+        sscanf(m + 1, " %255[^\n]", cpu);
+    free(info);
+    char *d = cf_file_read("/etc/debian_version", NULL);
+    if (d)
+        sscanf(d, "%63s", deb);
+    free(d);
+    struct utsname u;
+    if (uname(&u) != 0)
+        snprintf(u.release, sizeof u.release, "?");
+    snprintf(out, max, "%s, %ld cores, Linux %s, Debian %s", cpu, sysconf(_SC_NPROCESSORS_ONLN),
+             u.release, deb);
 }

@@ -4,6 +4,7 @@
 #ifndef COHFRAC_REPORT_H
 #define COHFRAC_REPORT_H
 
+#include <stddef.h>
 #include <stdio.h>
 
 #include "cohfrac/error.h"
@@ -26,5 +27,9 @@ cf_status cf_out_close(cf_outfile *o, cf_error *err);
  * were written, and returns 0. */
 int cf_report_plot(const char *script, const char *script_path, const char *const *args,
                    const char *others);
+
+/* "CPU model, N cores, Linux release, Debian version" into out (at most
+ * max bytes), for a report's header. */
+void cf_report_machine(char *out, size_t max);
 
 #endif

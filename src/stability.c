@@ -14,16 +14,20 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define SIDE 0.1            /* m, the cube */
 #define CELLS 3
 #define SLIVER_SHIFT 0.45   /* of a cell, the largest move of an interior node */
+#define SLIVER_NAME "sliver_cube" /* beside the scene files (scene paths are relative to them) */
 
 static const double E_AXIS[] = {0.6, 1e3, 1e6, 1e9, 7e10, 2e11};
 static const double DT_AXIS[] = {0.5, 1, 2, 10, 100, 1000};
 static const double SPEED_AXIS[] = {1, 10, 100};
+static const double MASS_AXIS[] = {0.01, 0.1, 1, 10, 100};
 static const double E_QUICK[] = {0.6, 7e10};
 static const double DT_QUICK[] = {0.5, 10, 100};
+static const double MASS_QUICK[] = {0.01, 100};
 #define LEN(a) ((int)(sizeof(a) / sizeof(a)[0]))
 
 const char *cf_stability_mode_name(cf_stability_mode m)
@@ -42,6 +46,25 @@ static const char *const scene_text =
     "                     tets_per_cell = 6},\n"
     "             position = {0, 0, 0.05}, velocity = {0, 0, -10}}},\n"
     "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {mode = 'fracture', criterion = 'none', cfl_fraction = 1, threads = 1,\n"
+    "            guard = {max_energy_growth = 0.1, max_inverted_fraction = 0.01}},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+/* The mass-ratio slice: the same cube at rest, hit on its top face by a
+ * cube of the same material and mesh, side 0.1 (m_impactor/m_target)^(1/3)
+ * m; no obstacle. */
+static const char *const pair_scene_text =
+    "-- Written by `cohfrac stability`: the mass-ratio case (see cohfrac/stability.h).\n"
+    "return {\n"
+    "  name = 'stability_pair', duration = 1, gravity = {0, 0, 0},\n"
+    "  material = {E = 1e6, nu = 0.25, rho = 2400, G_I = 1, sigma_max = 1,\n"
+    "              friction = 0.5, restitution = 0},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"
+    "                     tets_per_cell = 6}, position = {0, 0, 0}},\n"
+    "            {mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"
+    "                     tets_per_cell = 6},\n"
+    "             position = {0, 0, 0.1}, velocity = {0, 0, -10}}},\n"
     "  solver = {mode = 'fracture', criterion = 'none', cfl_fraction = 1, threads = 1,\n"
     "            guard = {max_energy_growth = 0.1, max_inverted_fraction = 0.01}},\n"
     "  output = {file = ''},\n"
@@ -67,10 +90,9 @@ static double tet_quality(const double *x, const int *v)
 
 /* The grid of the regular cube with its interior nodes moved at random (a
  * fixed seed) by up to SLIVER_SHIFT of a cell per axis; a draw that inverts
- * a tet is drawn again.  Writes DIR/sliver_cube.{node,ele}; *quality gets
+ * a tet is drawn again.  Writes DIR/SLIVER_NAME.{node,ele}; *quality gets
  * the smallest 6 sqrt(2) V / l_max^3 over the tets (1 for a regular tet). */
-static cf_status write_sliver_mesh(const char *dir, char *base, size_t n, double *quality,
-                                   cf_error *err)
+static cf_status write_sliver_mesh(const char *dir, double *quality, cf_error *err)
 {
     const double size[3] = {SIDE, SIDE, SIDE};
     const int cells[3] = {CELLS, CELLS, CELLS};
@@ -105,7 +127,8 @@ static cf_status write_sliver_mesh(const char *dir, char *base, size_t n, double
     }
     free(x0);
     *quality = q;
-    snprintf(base, n, "%s/sliver_cube", dir);
+    char base[1100];
+    snprintf(base, sizeof base, "%s/%s", dir, SLIVER_NAME);
     st = q > 0 ? cf_mesh_write_tetgen(&m, base, err)
                : cf_error_set(err, CF_ERR_MESH_INVERTED, "no valid sliver mesh drawn");
     cf_mesh_free(&m);
@@ -113,15 +136,21 @@ static cf_status write_sliver_mesh(const char *dir, char *base, size_t n, double
 }
 
 /* The case's --set overrides; `dt` > 0 also fixes dt_rigid and the duration. */
-static int case_overrides(const cf_stability_case *c, const char *sliver, double dt,
-                          char ov[][160])
+static int case_overrides(const cf_stability_case *c, double dt, char ov[][160])
 {
     int n = 0;
     snprintf(ov[n++], 160, "material.E=%.17g", c->E);
     snprintf(ov[n++], 160, "solver.cfl_fraction=%.17g", c->dt_ratio);
-    snprintf(ov[n++], 160, "bodies[1].velocity={0,0,%.17g}", -c->speed);
+    if (c->mass_ratio > 0) {
+        double a = SIDE * cbrt(c->mass_ratio);
+        snprintf(ov[n++], 160, "bodies[2].mesh.size={%.17g,%.17g,%.17g}", a, a, a);
+        snprintf(ov[n++], 160, "bodies[2].position={0,0,%.17g}", 0.5 * (SIDE + a));
+        snprintf(ov[n++], 160, "bodies[2].velocity={0,0,%.17g}", -c->speed);
+    } else {
+        snprintf(ov[n++], 160, "bodies[1].velocity={0,0,%.17g}", -c->speed);
+    }
     if (c->sliver)
-        snprintf(ov[n++], 160, "bodies[1].mesh=\"%s\"", sliver);
+        snprintf(ov[n++], 160, "bodies[1].mesh=\"./%s\"", SLIVER_NAME);
     const char *cons = c->mode == CF_STAB_NONE ? "none" : c->mode == CF_STAB_XPBD ? "xpbd" : "pbd";
     snprintf(ov[n++], 160, "solver.constraints=\"%s\"", cons);
     if (c->mode == CF_STAB_PBD_STIFF) {
@@ -136,12 +165,12 @@ static int case_overrides(const cf_stability_case *c, const char *sliver, double
     return n;
 }
 
-static cf_status make_sim(const char *scene, const cf_stability_case *c, const char *sliver,
-                          double dt, cf_scene *sc, cf_sim **sim, cf_error *err)
+static cf_status make_sim(const char *scene, const cf_stability_case *c, double dt, cf_scene *sc,
+                          cf_sim **sim, cf_error *err)
 {
     char ov[12][160];
     const char *ovp[12];
-    int n = case_overrides(c, sliver, dt, ov);
+    int n = case_overrides(c, dt, ov);
     for (int i = 0; i < n; i++)
         ovp[i] = ov[i];
     cf_status st = cf_scene_load(scene, ovp, n, NULL, sc, err);
@@ -166,23 +195,42 @@ static const char *guard_reason(const char *msg)
     return "error";
 }
 
+/* Centre of mass of every fragment together, m; 0 when there is none. */
+static int system_com(cf_sim *sim, double com[3])
+{
+    int n = cf_sim_fragments(sim, NULL, 0);
+    cf_fragment_state *f = n > 0 ? malloc((size_t)n * sizeof *f) : NULL;
+    if (!f)
+        return 0;
+    n = cf_sim_fragments(sim, f, n);
+    double m = 0;
+    com[0] = com[1] = com[2] = 0;
+    for (int i = 0; i < n; i++) {
+        v3_axpy(f[i].mass, f[i].com, com);
+        m += f[i].mass;
+    }
+    for (int k = 0; k < 3; k++)
+        com[k] /= m;
+    free(f);
+    return n;
+}
+
 /* One case: dt from the mesh's dt_cfl, then CF_STABILITY_STEPS steps. */
-static cf_status run_case(const char *scene, const char *sliver, cf_stability_case *c,
-                          cf_error *err)
+static cf_status run_case(const char *scene, cf_stability_case *c, cf_error *err)
 {
     double t0 = cf_wall_time();
     cf_scene sc;
     cf_sim *sim = NULL;
-    cf_status st = make_sim(scene, c, sliver, 0, &sc, &sim, err);
+    cf_status st = make_sim(scene, c, 0, &sc, &sim, err);
     if (st != CF_OK)
         return st;
     c->dt = cf_sim_dt_fracture(sim);
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
-    if ((st = make_sim(scene, c, sliver, c->dt, &sc, &sim, err)) != CF_OK)
+    if ((st = make_sim(scene, c, c->dt, &sc, &sim, err)) != CF_OK)
         return st;
-    cf_fragment_state f0, f;
-    cf_sim_fragments(sim, &f0, 1);
+    double com0[3], com[3];
+    system_com(sim, com0);
     double reach = 2 * c->speed * CF_STABILITY_STEPS * c->dt + 2 * SIDE;
     c->stable = 1, c->reason = "", c->fail_step = 0, c->energy_ratio = 1;
     for (long step = 1; !cf_sim_done(sim); step++) {
@@ -197,11 +245,10 @@ static cf_status run_case(const char *scene, const char *sliver, cf_stability_ca
             why = guard_reason(e.msg);
         else if (st != CF_OK)
             why = "error";
-        else if (cf_sim_fragments(sim, &f, 1) >= 1) {
-            double d2 = 0;
-            for (int k = 0; k < 3; k++)
-                d2 += (f.com[k] - f0.com[k]) * (f.com[k] - f0.com[k]);
-            if (!(sqrt(d2) <= reach) || f.com[2] < -SIDE)
+        else if (system_com(sim, com)) {
+            double d[3];
+            v3_sub(com, com0, d);
+            if (!(v3_norm(d) <= reach) || (c->mass_ratio == 0 && com[2] < -SIDE))
                 why = "escaped";
         }
         if (why) {
@@ -227,6 +274,19 @@ static int build_cases(int quick, cf_stability_case *out)
             for (int j = 0; j < nd; j++) {
                 cf_stability_case c = base;
                 c.mode = (cf_stability_mode)m, c.E = ea[i], c.dt_ratio = da[j];
+                if (out)
+                    out[n] = c;
+                n++;
+            }
+    }
+    for (int m = 0; m < CF_STAB_N_MODES; m++) {
+        const double *ma = quick ? MASS_QUICK : MASS_AXIS, *da = quick ? DT_QUICK : DT_AXIS;
+        int nm = quick ? LEN(MASS_QUICK) : LEN(MASS_AXIS), nd = quick ? LEN(DT_QUICK) : LEN(DT_AXIS);
+        for (int i = 0; i < nm; i++)
+            for (int j = 0; j < nd; j++) {
+                cf_stability_case c = {.slice = "mass x dt", .E = 7e10, .speed = 10,
+                                       .mass_ratio = ma[i], .dt_ratio = da[j],
+                                       .mode = (cf_stability_mode)m};
                 if (out)
                     out[n] = c;
                 n++;
@@ -262,14 +322,14 @@ static cf_status write_csv(const cf_stability_result *r, cf_error *err)
     cf_status st = cf_out_open(&o, r->out_dir, "stability.csv", err);
     if (st != CF_OK)
         return st;
-    fprintf(o.f, "slice,constraints,E_Pa,dt_over_dt_cfl,speed_m_s,mesh,dt_s,stable,reason,"
-                 "first_failing_step,max_energy_ratio,wall_s\n");
+    fprintf(o.f, "slice,constraints,E_Pa,dt_over_dt_cfl,speed_m_s,mesh,mass_ratio,dt_s,stable,"
+                 "reason,first_failing_step,max_energy_ratio,wall_s\n");
     for (int i = 0; i < r->n; i++) {
         const cf_stability_case *c = &r->cases[i];
-        fprintf(o.f, "%s,%s,%.6g,%g,%g,%s,%.6g,%d,%s,%ld,%.6g,%.4f\n", c->slice,
+        fprintf(o.f, "%s,%s,%.6g,%g,%g,%s,%g,%.6g,%d,%s,%ld,%.6g,%.4f\n", c->slice,
                 cf_stability_mode_name(c->mode), c->E, c->dt_ratio, c->speed,
-                c->sliver ? "sliver" : "regular", c->dt, c->stable, c->reason, c->fail_step,
-                c->energy_ratio, c->wall);
+                c->sliver ? "sliver" : "regular", c->mass_ratio, c->dt, c->stable, c->reason,
+                c->fail_step, c->energy_ratio, c->wall);
     }
     return cf_out_close(&o, err);
 }
@@ -289,13 +349,20 @@ static double stiffest_stable(const cf_stability_result *r, cf_stability_mode mo
     return best;
 }
 
-static cf_status write_md(const cf_stability_result *r, int quick, double quality, cf_error *err)
+static cf_status write_md(const cf_stability_result *r, int quick, const char *command,
+                          double quality, cf_error *err)
 {
     cf_outfile o;
     cf_status st = cf_out_open(&o, r->out_dir, "stability.md", err);
     if (st != CF_OK)
         return st;
     FILE *f = o.f;
+    char mach[512], date[32];
+    cf_report_machine(mach, sizeof mach);
+    time_t now = time(NULL);
+    strftime(date, sizeof date, "%Y-%m-%d", gmtime(&now));
+    fprintf(f, "<!-- cohfrac stability, %s, %s; regenerate with: %s -->\n", date, mach,
+            command ? command : "cohfrac stability");
     fprintf(f, "# Stability map%s\n\n", quick ? " (--quick)" : "");
     fprintf(f, "Each case: a %.1f m cube (rho 2400 kg/m^3, nu 0.25, %d^3 cells of 6 Tet4) "
                "touching a rigid plane moves into it at the impact speed; fracture mode only, "
@@ -307,6 +374,11 @@ static cf_status write_md(const cf_stability_result *r, int quick, double qualit
                "**escaped** the centre of mass is farther than 2 v T + 0.2 m from its start "
                "or 0.1 m below the plane.  Cells give `stable`, or the criterion and the first "
                "failing step.\n\n");
+    fprintf(f, "Mass ratio (slice \"mass x dt\"): the cube at rest, no plane, is hit on its "
+               "top face at the impact speed by a cube of the same material and mesh (%d^3 "
+               "cells) whose side is %.1f (m_impactor / m_target)^(1/3) m; both deform, and "
+               "they meet through the contact between fracture-mode bodies; the escape "
+               "criterion follows the centre of mass of both.\n\n", CELLS, SIDE);
     if (!quick)
         fprintf(f, "Sliver mesh: interior nodes moved at random by up to %.0f%% of a cell; "
                    "smallest tet quality 6 sqrt(2) V / l_max^3 = %.3f (1 for a regular tet, "
@@ -325,8 +397,9 @@ static cf_status write_md(const cf_stability_result *r, int quick, double qualit
         const cf_stability_case *c = &r->cases[i];
         if (strcmp(c->slice, slice)) {
             slice = c->slice;
-            fprintf(f, "\n## %s\n\n| constraints | E (Pa) | speed (m/s) | mesh | dt/dt_cfl | "
-                       "dt (s) | result | max energy ratio |\n|---|---|---|---|---|---|---|---|\n",
+            fprintf(f, "\n## %s\n\n| constraints | E (Pa) | speed (m/s) | mesh | mass ratio | "
+                       "dt/dt_cfl | dt (s) | result | max energy ratio |\n"
+                       "|---|---|---|---|---|---|---|---|---|\n",
                     slice);
         }
         char res[64];
@@ -334,13 +407,28 @@ static cf_status write_md(const cf_stability_result *r, int quick, double qualit
             snprintf(res, sizeof res, "stable");
         else
             snprintf(res, sizeof res, "**%s** at step %ld", c->reason, c->fail_step);
-        fprintf(f, "| %s | %.3g | %g | %s | %g | %.3g | %s | %.3g |\n",
+        char mass[32] = "-";
+        if (c->mass_ratio > 0)
+            snprintf(mass, sizeof mass, "%g", c->mass_ratio);
+        fprintf(f, "| %s | %.3g | %g | %s | %s | %g | %.3g | %s | %.3g |\n",
                 cf_stability_mode_name(c->mode), c->E, c->speed, c->sliver ? "sliver" : "regular",
-                c->dt_ratio, c->dt, res, c->energy_ratio);
+                mass, c->dt_ratio, c->dt, res, c->energy_ratio);
     }
     fprintf(f, "\nFiles: `stability.csv` (every case), `stability.png` (heatmaps by "
                "tools/stability_plot.py).\n");
     return cf_out_close(&o, err);
+}
+
+/* Write `text` to DIR/NAME; path gets DIR/NAME. */
+static cf_status write_scene(const char *dir, const char *name, const char *text, char path[1100],
+                             cf_error *err)
+{
+    snprintf(path, 1100, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    int ok = f && fputs(text, f) >= 0;
+    if (f && fclose(f) != 0)
+        ok = 0;
+    return ok ? CF_OK : cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s", path);
 }
 
 cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result *r,
@@ -351,13 +439,12 @@ cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result 
     cf_status st = cf_mkdirs(r->out_dir, "report directory", err);
     if (st != CF_OK)
         return st;
-    char scene[1100], sliver[1100] = "";
-    snprintf(scene, sizeof scene, "%s/stability_scene.lua", r->out_dir);
-    FILE *sf = fopen(scene, "w");
-    if (!sf || fputs(scene_text, sf) < 0 || fclose(sf) != 0)
-        return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s", scene);
+    char scene[1100], pair[1100];
+    if ((st = write_scene(r->out_dir, "stability_scene.lua", scene_text, scene, err)) != CF_OK ||
+        (st = write_scene(r->out_dir, "stability_pair_scene.lua", pair_scene_text, pair, err)))
+        return st;
     double quality = NAN;
-    if (!opt->quick && (st = write_sliver_mesh(r->out_dir, sliver, sizeof sliver, &quality, err)))
+    if (!opt->quick && (st = write_sliver_mesh(r->out_dir, &quality, err)))
         return st;
     r->n = build_cases(opt->quick, NULL);
     r->cases = calloc((size_t)r->n, sizeof *r->cases);
@@ -366,15 +453,16 @@ cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result 
     build_cases(opt->quick, r->cases);
     for (int i = 0; i < r->n; i++) {
         cf_stability_case *c = &r->cases[i];
-        if ((st = run_case(scene, sliver, c, err)) != CF_OK)
+        if ((st = run_case(c->mass_ratio > 0 ? pair : scene, c, err)) != CF_OK)
             return st;
         if (opt->progress)
-            fprintf(stderr, "stability %3d/%d  %-12s E %-8.3g dt/dt_cfl %-6g v %-4g %-7s  %s%s\n",
+            fprintf(stderr, "stability %3d/%d  %-12s E %-8.3g dt/dt_cfl %-6g v %-4g %-7s "
+                            "mass ratio %-5g %s%s\n",
                     i + 1, r->n, cf_stability_mode_name(c->mode), c->E, c->dt_ratio, c->speed,
-                    c->sliver ? "sliver" : "regular", c->stable ? "stable" : "unstable: ",
-                    c->reason);
+                    c->sliver ? "sliver" : "regular", c->mass_ratio,
+                    c->stable ? "stable" : "unstable: ", c->reason);
     }
-    if ((st = write_csv(r, err)) != CF_OK || (st = write_md(r, opt->quick, quality, err)) != CF_OK)
+    if ((st = write_csv(r, err)) != CF_OK || (st = write_md(r, opt->quick, opt->command, quality, err)) != CF_OK)
         return st;
     if (opt->plot) {
         char csv[1100], png[1100];

@@ -20,7 +20,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/utsname.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -497,26 +496,6 @@ static int pareto(cf_study_case *c, int n, double tol)
 
 /* ---- Report ------------------------------------------------------------ */
 
-/* "CPU model, N cores, Linux release, Debian version" for the report. */
-static void machine(char *out, size_t max)
-{
-    char cpu[256] = "unknown CPU", deb[64] = "?";
-    char *info = cf_file_read("/proc/cpuinfo", NULL);
-    const char *m = info ? strstr(info, "model name") : NULL;
-    if (m && (m = strchr(m, ':')))
-        sscanf(m + 1, " %255[^\n]", cpu);
-    free(info);
-    char *d = cf_file_read("/etc/debian_version", NULL);
-    if (d)
-        sscanf(d, "%63s", deb);
-    free(d);
-    struct utsname u;
-    if (uname(&u) != 0)
-        snprintf(u.release, sizeof u.release, "?");
-    snprintf(out, max, "%s, %ld cores, Linux %s, Debian %s", cpu, sysconf(_SC_NPROCESSORS_ONLN),
-             u.release, deb);
-}
-
 static void csv_quoted(FILE *f, const char *s)
 {
     fputc('"', f);
@@ -573,7 +552,7 @@ static cf_status write_md(const cf_study_options *o, const cf_study_result *res,
     FILE *m = f.f;
     const cf_study_case *c = res->cases, *r = &c[0];
     char mach[512], date[32];
-    machine(mach, sizeof mach);
+    cf_report_machine(mach, sizeof mach);
     time_t now = time(NULL);
     strftime(date, sizeof date, "%Y-%m-%d", gmtime(&now));
     fprintf(m, "<!-- cohfrac study, %s, %s; regenerate with: %s -->\n", date, mach,

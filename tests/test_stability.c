@@ -1,6 +1,7 @@
 /* `cohfrac stability --quick` (include/cohfrac/stability.h): the corners of
  * the map whose outcome is known from the theory of the explicit step and
- * of PBD, and the files it writes. */
+ * of PBD, with one body on a plane and two bodies of very different mass in
+ * contact, and the files it writes. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,14 +14,24 @@
 #include <string.h>
 #include <unistd.h>
 
+/* The case of mode m, E, dt/dt_cfl and mass ratio (0: the cube against the
+ * plane). */
+static const cf_stability_case *find_case(const cf_stability_result *r, cf_stability_mode m,
+                                          double E, double ratio, double mass)
+{
+    for (int i = 0; i < r->n; i++)
+        if (r->cases[i].mode == m && r->cases[i].E == E && r->cases[i].dt_ratio == ratio &&
+            r->cases[i].mass_ratio == mass)
+            return &r->cases[i];
+    fail_msg("no case %s E %g dt/dt_cfl %g mass ratio %g", cf_stability_mode_name(m), E, ratio,
+             mass);
+    return NULL;
+}
+
 static const cf_stability_case *find(const cf_stability_result *r, cf_stability_mode m,
                                      double E, double ratio)
 {
-    for (int i = 0; i < r->n; i++)
-        if (r->cases[i].mode == m && r->cases[i].E == E && r->cases[i].dt_ratio == ratio)
-            return &r->cases[i];
-    fail_msg("no case %s E %g dt/dt_cfl %g", cf_stability_mode_name(m), E, ratio);
-    return NULL;
+    return find_case(r, m, E, ratio, 0);
 }
 
 static void test_quick_map_corners(void **state)
@@ -35,10 +46,11 @@ static void test_quick_map_corners(void **state)
     if (cf_stability_run(&opt, &r, &err) != CF_OK)
         fail_msg("stability: %s", err.msg);
     for (int i = 0; i < r.n; i++)
-        printf("FIGURE %-12s E %-8.3g dt/dt_cfl %-4g %s %s step %ld, energy ratio %.3g\n",
+        printf("FIGURE %-12s E %-8.3g dt/dt_cfl %-4g mass ratio %-5g %s %s step %ld, energy "
+               "ratio %.3g\n",
                cf_stability_mode_name(r.cases[i].mode), r.cases[i].E, r.cases[i].dt_ratio,
-               r.cases[i].stable ? "stable" : "unstable:", r.cases[i].reason,
-               r.cases[i].fail_step, r.cases[i].energy_ratio);
+               r.cases[i].mass_ratio, r.cases[i].stable ? "stable" : "unstable:",
+               r.cases[i].reason, r.cases[i].fail_step, r.cases[i].energy_ratio);
     /* Explicit elasticity is stable below the CFL limit and not far above it. */
     const cf_stability_case *c = find(&r, CF_STAB_NONE, 7e10, 0.5);
     assert_true(c->stable);
@@ -52,6 +64,18 @@ static void test_quick_map_corners(void **state)
     c = find(&r, CF_STAB_PBD_SRC, 0.6, 0.5);
     assert_false(c->stable);
     assert_string_equal(c->reason, "inverted");
+    /* Two deformable cubes in contact, a light impactor on a heavy target
+     * and the reverse: below the CFL limit the contact adds no instability
+     * and no energy; far above it they blow up within a few steps. */
+    for (int k = 0; k < 2; k++) {
+        double mass = k ? 100 : 0.01;
+        c = find_case(&r, CF_STAB_NONE, 7e10, 0.5, mass);
+        assert_true(c->stable);
+        assert_true(c->energy_ratio <= 1.1);
+        c = find_case(&r, CF_STAB_NONE, 7e10, 100, mass);
+        assert_false(c->stable);
+        assert_true(c->fail_step > 0 && c->fail_step <= 10);
+    }
     char path[400];
     snprintf(path, sizeof path, "%s/stability.csv", dir);
     assert_int_equal(access(path, R_OK), 0);

@@ -2,7 +2,7 @@
 """Heatmaps of `cohfrac stability`: stability_plot.py STABILITY.csv OUT.png
 
 One row of panels per slice of the map written by src/stability.c
-("E x dt", "speed x dt", "mesh x dt"), one panel per constraint mode; each
+("E x dt", "mass x dt", "speed x dt", "mesh x dt"), one panel per constraint mode; each
 cell is green when the case is stable and red when not, labelled with the
 criterion that failed first (n = nan, e = energy, i = inverted,
 x = escaped) and the first failing step.  Debian python3 and
@@ -17,7 +17,9 @@ from mpl_agg import pyplot, save_png
 plt = pyplot("stability_plot.py")
 from matplotlib.colors import ListedColormap  # noqa: E402
 
-ROWS = {"E x dt": ("E_Pa", "E (Pa)"), "speed x dt": ("speed_m_s", "impact speed (m/s)"),
+ROWS = {"E x dt": ("E_Pa", "E (Pa)"),
+        "mass x dt": ("mass_ratio", "m_impactor / m_target"),
+        "speed x dt": ("speed_m_s", "impact speed (m/s)"),
         "mesh x dt": ("mesh", "mesh")}
 
 

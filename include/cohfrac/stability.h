@@ -23,17 +23,27 @@
  *               plane (T the case's simulated time, v its impact speed).
  * Otherwise it is stable.
  *
+ * The mass-ratio cases are two bodies instead: the cube at rest (no plane)
+ * hit on its top face by a cube of the same material and mesh whose side is
+ * 0.1 (m_impactor/m_target)^(1/3) m, moving at the impact speed; both are
+ * in fracture mode and meet through the contact between bodies
+ * (contact.h); "escaped" then follows the centre of mass of both.
+ *
  * Axes of the full map (cf_stability_run with quick = 0): E in {0.6 Pa (the
  * source's), 1 kPa, 1 MPa, 1 GPa, 70 GPa (glass), 200 GPa (steel)} x
  * dt/dt_cfl in {0.5, 1, 2, 10, 100, 1000} x constraints {none, pbd
  * (k 0.9, 3 iterations: the source's), pbd (k 1, 10 iterations), xpbd} at
- * 10 m/s on the regular mesh; then impact speed {1, 10, 100} m/s x
- * dt/dt_cfl x constraints at 70 GPa; then the sliver mesh x dt/dt_cfl x
- * constraints at 70 GPa, 10 m/s.  quick = 1 runs the corners: E {0.6 Pa,
- * 70 GPa} x dt/dt_cfl {0.5, 10, 100} x the four constraint modes at 10 m/s.
+ * 10 m/s on the regular mesh; then m_impactor/m_target in {0.01, 0.1, 1,
+ * 10, 100} x dt/dt_cfl x constraints at 70 GPa, 10 m/s; then impact speed
+ * {1, 10, 100} m/s x dt/dt_cfl x constraints at 70 GPa; then the sliver
+ * mesh x dt/dt_cfl x constraints at 70 GPa, 10 m/s.  quick = 1 runs the
+ * corners: E {0.6 Pa, 70 GPa} x dt/dt_cfl {0.5, 10, 100} x the four
+ * constraint modes at 10 m/s, and mass ratio {0.01, 100} x dt/dt_cfl {0.5,
+ * 10, 100} x the four modes at 70 GPa.
  *
  * Files written into the output directory (whole or not at all):
- *   stability.md   the criteria and one table per slice
+ *   stability.md   date, machine and command; the criteria and one table
+ *                  per slice
  *   stability.csv  one row per case
  *   stability.png  heatmaps by tools/stability_plot.py (Debian python3 and
  *                  python3-matplotlib); a failure there is a warning only */
@@ -57,11 +67,13 @@ typedef enum {
 const char *cf_stability_mode_name(cf_stability_mode m);
 
 typedef struct cf_stability_case {
-    const char *slice;      /* "E x dt", "speed x dt", "mesh x dt" */
+    const char *slice;      /* "E x dt", "mass x dt", "speed x dt", "mesh x dt" */
     double E;               /* Pa */
     double dt_ratio;        /* dt / dt_cfl */
     double speed;           /* m/s */
     int sliver;             /* 1: the perturbed mesh */
+    double mass_ratio;      /* m_impactor / m_target of the two-cube case, 0:
+                               the cube against the plane */
     cf_stability_mode mode;
     /* results */
     int stable;
@@ -79,6 +91,7 @@ typedef struct cf_stability_options {
     const char *plot_script;/* NULL: tools/stability_plot.py (see report.h) */
     int progress;           /* 1: a line per case on stderr */
     int plot;               /* 1: make stability.png */
+    const char *command;    /* the command line, quoted in stability.md (may be NULL) */
 } cf_stability_options;
 
 typedef struct cf_stability_result {
