@@ -17,70 +17,29 @@ void cf_frag_surface_free(cf_frag_surface *fs)
     memset(fs, 0, sizeof *fs);
 }
 
-/* One tet face: its nodes sorted (the key) and in outward order. */
-typedef struct face_rec {
-    int key[3], v[3];
-} face_rec;
-
-static int cmp_key(const void *pa, const void *pb)
-{
-    const face_rec *a = pa, *b = pb;
-    for (int i = 0; i < 3; i++)
-        if (a->key[i] != b->key[i])
-            return a->key[i] < b->key[i] ? -1 : 1;
-    return 0;
-}
-
-static void sort3(int k[3])
-{
-    int t;
-    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
-    if (k[1] > k[2]) t = k[1], k[1] = k[2], k[2] = t;
-    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
-}
-
 /* The faces of f's tets that no other of its tets uses, on the current
  * nodes, built over the rest positions (a valid mesh whatever the
  * deformation) and refitted later.  Returns 0, or -1. */
 static int surface_build(const cf_solid *s, const cf_fragment *f, cf_frag_surface *fs)
 {
     cf_frag_surface_free(fs);
-    int nf = 4 * f->nt, rc = -1;
-    face_rec *r = malloc((size_t)nf * sizeof *r);
+    int rc = -1, nf = 4 * f->nt;
     int *local = malloc((size_t)s->n_nodes * sizeof(int));
     double *rest = NULL;
-    if (!r || !local)
-        goto done;
-    for (int i = 0; i < f->nt; i++)
-        for (int k = 0; k < 4; k++) {
-            face_rec *e = &r[4 * i + k];
-            for (int j = 0; j < 3; j++)
-                e->v[j] = e->key[j] = s->tet[4 * f->tets[i] + CF_TET_FACE[k][j]];
-            sort3(e->key);
-        }
-    qsort(r, (size_t)nf, sizeof *r, cmp_key);
-    fs->tri = malloc((size_t)nf * 3 * sizeof(int));
-    fs->node = malloc((size_t)nf * sizeof(int)); /* at most one new vertex per face */
-    if (!fs->tri || !fs->node)
-        goto done;
-    fs->slot = malloc((size_t)nf * sizeof(int));
-    if (!fs->slot)
+    size_t room = (size_t)(nf > 0 ? nf : 1) * 3; /* corners of every tet face */
+    fs->tri = malloc(room * sizeof(int));
+    fs->node = malloc(room * sizeof(int));
+    fs->slot = malloc(room * sizeof(int));
+    if (!local || !fs->tri || !fs->node || !fs->slot ||
+        (fs->ntri = cf_boundary_faces(s->tet, f->tets, f->nt, fs->tri)) < 0)
         goto done;
     for (int a = 0; a < s->n_nodes; a++)
         local[a] = -1;
-    for (int i = 0; i < nf;) {
-        int j = i + 1;
-        while (j < nf && !cmp_key(&r[i], &r[j]))
-            j++;
-        if (j == i + 1)
-            for (int k = 0; k < 3; k++) {
-                int a = r[i].v[k];
-                if (local[a] < 0)
-                    local[a] = fs->nv, fs->node[fs->nv++] = a;
-                fs->tri[3 * fs->ntri + k] = local[a];
-            }
-        fs->ntri += j == i + 1;
-        i = j;
+    for (int i = 0; i < 3 * fs->ntri; i++) { /* nodes -> surface vertices */
+        int a = fs->tri[i];
+        if (local[a] < 0)
+            local[a] = fs->nv, fs->node[fs->nv++] = a;
+        fs->tri[i] = local[a];
     }
     fs->xv = malloc((size_t)(fs->nv > 0 ? fs->nv : 1) * 3 * sizeof(double));
     rest = malloc((size_t)(fs->nv > 0 ? fs->nv : 1) * 3 * sizeof(double));
@@ -95,7 +54,9 @@ static int surface_build(const cf_solid *s, const cf_fragment *f, cf_frag_surfac
     fs->built_nodes = f->nodes.n;
     rc = fs->mesh ? 0 : -1;
 done:
-    free(r), free(local), free(rest);
+    free(local), free(rest);
+    if (rc)
+        cf_frag_surface_free(fs);
     return rc;
 }
 
@@ -135,18 +96,22 @@ static int in_box(const double x[3], const double box[6])
     return 1;
 }
 
-/* The nodes a contact pass moved, for its work. */
+/* A node a contact pass moved, for the pass's work. */
+typedef struct moved_node {
+    int node;
+    double v0[3];   /* velocity before the pass, m/s */
+    double vh[3];   /* velocity at the start of the step, m/s */
+} moved_node;
+
 typedef struct moved_nodes {
     int n, cap;
     int *slot;      /* [n_nodes] record of each node, -1 */
-    int *node;      /* [cap] */
-    double *v0;     /* [cap][3] velocity before the pass, m/s */
-    double *vh;     /* [cap][3] velocity at the start of the step, m/s */
+    moved_node *m;  /* [cap] */
 } moved_nodes;
 
 static void moved_free(moved_nodes *mv)
 {
-    free(mv->slot), free(mv->node), free(mv->v0), free(mv->vh);
+    free(mv->slot), free(mv->m);
 }
 
 /* Record node a (fragment f, local index i) before its first move.
@@ -164,24 +129,16 @@ static int remember(moved_nodes *mv, const cf_solid *s, const cf_fragment *f, in
         return 0;
     if (mv->n == mv->cap) {
         int cap = 2 * mv->cap + 64;
-        int *node = realloc(mv->node, (size_t)cap * sizeof(int));
-        if (node)
-            mv->node = node;
-        double *v0 = realloc(mv->v0, (size_t)cap * 3 * sizeof(double));
-        if (v0)
-            mv->v0 = v0;
-        double *vh = realloc(mv->vh, (size_t)cap * 3 * sizeof(double));
-        if (vh)
-            mv->vh = vh;
-        if (!node || !v0 || !vh)
+        moved_node *m = realloc(mv->m, (size_t)cap * sizeof *m);
+        if (!m)
             return -1;
-        mv->cap = cap;
+        mv->m = m, mv->cap = cap;
     }
-    mv->slot[a] = mv->n;
-    mv->node[mv->n] = a;
-    memcpy(&mv->v0[3 * mv->n], &s->v[3 * a], 3 * sizeof(double));
-    memcpy(&mv->vh[3 * mv->n], &f->v_old[3 * i], 3 * sizeof(double));
-    mv->n++;
+    moved_node *r = &mv->m[mv->n];
+    mv->slot[a] = mv->n++;
+    r->node = a;
+    memcpy(r->v0, &s->v[3 * a], sizeof r->v0);
+    memcpy(r->vh, &f->v_old[3 * i], sizeof r->vh);
     return 0;
 }
 
@@ -193,10 +150,10 @@ static double moved_work(const moved_nodes *mv, const cf_solid *s)
 {
     double w = 0;
     for (int k = 0; k < mv->n; k++) {
-        int a = mv->node[k];
-        const double *v = &s->v[3 * a], *v0 = &mv->v0[3 * k], *vh = &mv->vh[3 * k];
+        const moved_node *r = &mv->m[k];
+        const double *v = &s->v[3 * r->node];
         for (int c = 0; c < 3; c++)
-            w += s->m[a] * (v[c] - v0[c]) * 0.5 * (vh[c] + v[c]);
+            w += s->m[r->node] * (v[c] - r->v0[c]) * 0.5 * (r->vh[c] + v[c]);
     }
     return w;
 }

@@ -8,62 +8,21 @@
  * their old order (so node groups stay ascending).
  */
 #include "cohfrac/mesh.h"
+#include "solid.h"
 
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct face {
-    int v[3]; /* ascending */
-} face;
-
-static int face_cmp(const void *pa, const void *pb)
-{
-    const face *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->v[k] != b->v[k])
-            return a->v[k] < b->v[k] ? -1 : 1;
-    return 0;
-}
-
-static void sort3(int v[3])
-{
-    int t;
-    if (v[0] > v[1])
-        t = v[0], v[0] = v[1], v[1] = t;
-    if (v[1] > v[2])
-        t = v[1], v[1] = v[2], v[2] = t;
-    if (v[0] > v[1])
-        t = v[0], v[0] = v[1], v[1] = t;
-}
-
 /* on_boundary[n] = 1 for every node of a face used by exactly one tet. */
 static int mark_boundary_nodes(const cf_mesh *m, unsigned char *on_boundary)
 {
-    static const int opposite[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-    size_t nf = 4 * (size_t)m->n_tets;
-    face *f = malloc(nf * sizeof *f);
-    if (!f)
-        return -1;
-    for (int t = 0; t < m->n_tets; t++)
-        for (int j = 0; j < 4; j++) {
-            face *g = &f[4 * (size_t)t + (size_t)j];
-            for (int k = 0; k < 3; k++)
-                g->v[k] = m->tets[4 * t + opposite[j][k]];
-            sort3(g->v);
-        }
-    qsort(f, nf, sizeof *f, face_cmp);
-    for (size_t i = 0; i < nf;) {
-        size_t j = i + 1;
-        while (j < nf && face_cmp(&f[i], &f[j]) == 0)
-            j++;
-        if (j - i == 1)
-            for (int k = 0; k < 3; k++)
-                on_boundary[f[i].v[k]] = 1;
-        i = j;
-    }
-    free(f);
-    return 0;
+    int *faces = malloc((size_t)(m->n_tets > 0 ? m->n_tets : 1) * 12 * sizeof(int));
+    int n = faces ? cf_boundary_faces(m->tets, NULL, m->n_tets, faces) : -1;
+    for (int i = 0; i < 3 * n; i++)
+        on_boundary[faces[i]] = 1;
+    free(faces);
+    return n < 0 ? -1 : 0;
 }
 
 cf_status cf_mesh_hollow(cf_mesh *m, int layers, cf_error *err)

@@ -69,6 +69,38 @@ static int build_facets(cf_solid *s)
     return s->cracked ? 0 : -1;
 }
 
+int cf_boundary_faces(const int *tet_nodes, const int *list, int nt, int *faces)
+{
+    int nfk = 4 * nt, n = 0;
+    face_key *k = malloc((size_t)(nfk > 0 ? nfk : 1) * sizeof *k);
+    if (!k)
+        return -1;
+    for (int i = 0; i < nt; i++) {
+        int t = list ? list[i] : i;
+        for (int f = 0; f < 4; f++) {
+            face_key *e = &k[4 * i + f];
+            for (int j = 0; j < 3; j++)
+                e->v[j] = tet_nodes[4 * t + CF_TET_FACE[f][j]];
+            sort3(e->v);
+            e->tet = t, e->face = f;
+        }
+    }
+    qsort(k, (size_t)nfk, sizeof *k, cmp_face);
+    for (int i = 0; i < nfk;) {
+        int j = i + 1;
+        while (j < nfk && !memcmp(k[i].v, k[j].v, sizeof k[i].v))
+            j++;
+        if (j == i + 1) {
+            for (int c = 0; c < 3; c++)
+                faces[3 * n + c] = tet_nodes[4 * k[i].tet + CF_TET_FACE[k[i].face][c]];
+            n++;
+        }
+        i = j;
+    }
+    free(k);
+    return n;
+}
+
 static int build_vertex_tets(cf_solid *s)
 {
     int nv = s->n_verts0, nt = s->n_tets;

@@ -82,6 +82,13 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
  * failed completely (all three node pairs), one side counted. */
 double cf_solid_crack_area(const cf_solid *s);
 
+/* The boundary faces of a set of Tet4: the faces that no other tet of the
+ * set uses (same three nodes), in the vertex order of CF_TET_FACE (outward
+ * for a positive tet).  tet_nodes [.][4] node indices; list [nt] the tets
+ * of the set, or NULL for tets 0..nt-1; faces gets [n][3] node indices and
+ * needs room for 4 nt faces.  Returns n, or -1 out of memory. */
+int cf_boundary_faces(const int *tet_nodes, const int *list, int nt, int *faces);
+
 /* Append a copy of node n (same X, x, v, p; mass 0).  Returns the new index
  * or -1 when out of memory. */
 int cf_solid_copy_node(cf_solid *s, int n);
