@@ -1,6 +1,6 @@
 // cohfrac — point queries against triangle meshes, behind the C
 // header cf_fcl.h.  FCL builds and owns the bounding-volume hierarchy
-// (BVHModel<OBBRSS>) and runs the branch-and-bound distance traversal; the
+// (BVHModel<OBBRSS>, or BVHModel<AABB> for a deforming mesh) and runs the branch-and-bound distance traversal; the
 // leaf test (exact closest point on one triangle) and the sign (angle-weighted
 // pseudo-normals, Baerentzen & Aanaes 2005) are ours.
 //
@@ -20,6 +20,7 @@
 #include <fcl/math/bv/utility.h>  // fit(), used by BVHModel::refitTree
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/sphere.h>
+#include <fcl/math/bv/AABB.h>
 #include <fcl/math/bv/OBBRSS.h>
 #include <fcl/narrowphase/detail/traversal/collision_node.h>
 #include <fcl/narrowphase/detail/traversal/distance/bvh_shape_distance_traversal_node.h>
@@ -51,7 +52,11 @@ void set_error(const char *fmt, ...)
 }
 
 typedef fcl::Vector3d V3;
-typedef fcl::BVHModel<fcl::OBBRSSd> Model;
+// Static meshes get oriented boxes (tight, for many queries); deforming
+// ones axis-aligned boxes, whose refit after every move is cheap (refitting
+// oriented boxes fits each by an eigen-decomposition).
+typedef fcl::BVHModel<fcl::OBBRSSd> ObbModel;
+typedef fcl::BVHModel<fcl::AABBd> BoxModel;
 
 // Barycentric coordinates below this count as 0 when classifying the
 // closest point: a vertex or edge is then preferred to a neighbouring edge
@@ -120,10 +125,24 @@ double point_obb_distance(const fcl::OBBd &obb, const V3 &p)
     return std::sqrt(s2);
 }
 
+// Lower bounds of the distance from p to any triangle inside a node.
+double bv_distance(const fcl::OBBRSSd &bv, const V3 &p) { return point_obb_distance(bv.obb, p); }
+
+double bv_distance(const fcl::AABBd &bv, const V3 &p)
+{
+    double s2 = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        const double x = std::max(bv.min_[i] - p[i], p[i] - bv.max_[i]);
+        if (x > 0) s2 += x * x;
+    }
+    return std::sqrt(s2);
+}
+
 }  // namespace
 
 struct cff_mesh {
-    Model bvh;
+    std::unique_ptr<ObbModel> obb;  // static mesh: its hierarchy
+    std::unique_ptr<BoxModel> box;  // deforming mesh: its hierarchy
     std::vector<V3> v;            // vertices
     std::vector<int> t;           // [nt][3]
     std::vector<V3> face_n;       // unit normal per triangle
@@ -138,15 +157,19 @@ namespace {
 
 // Point query as an FCL distance traversal over the mesh's BVH.  The result
 // keeps the nearest triangle in b1 and the closest point in nearest_points[0].
-class PointNode : public fcl::detail::BVHShapeDistanceTraversalNode<fcl::OBBRSSd, fcl::Sphered> {
+template <typename BV>
+class PointNode : public fcl::detail::BVHShapeDistanceTraversalNode<BV, fcl::Sphered> {
 public:
+    using fcl::detail::BVHShapeDistanceTraversalNode<BV, fcl::Sphered>::model1;
+    using fcl::detail::BVHShapeDistanceTraversalNode<BV, fcl::Sphered>::model2;
+    using fcl::detail::BVHShapeDistanceTraversalNode<BV, fcl::Sphered>::result;
     PointNode(const cff_mesh *m, const V3 &p, double s) : mesh(m), point(p), slack(s) {}
 
     // Lower bound for the node, less the round-off of computing it, so
     // that no triangle is pruned by a bound a few ulps too high.
     double BVTesting(int b1, int) const override
     {
-        return point_obb_distance(model1->getBV(b1).bv.obb, point) - slack;
+        return bv_distance(model1->getBV(b1).bv, point) - slack;
     }
 
     void leafTesting(int b1, int) const override
@@ -216,7 +239,14 @@ int compute_normals(cff_mesh *m)
     return bad;
 }
 
-cff_mesh *create(const double *verts, int nv, const int *tris, int nt)
+template <typename BV>
+bool build(fcl::BVHModel<BV> &b, const std::vector<V3> &v, const std::vector<fcl::Triangle> &t)
+{
+    return b.beginModel(static_cast<int>(t.size()), static_cast<int>(v.size())) == fcl::BVH_OK &&
+           b.addSubModel(v, t) == fcl::BVH_OK && b.endModel() == fcl::BVH_OK;
+}
+
+cff_mesh *create(const double *verts, int nv, const int *tris, int nt, bool deforming)
 {
     if (!verts || nv < 3 || !tris || nt < 1) {
         set_error("mesh needs >= 3 vertices and >= 1 triangle (got %d, %d)", verts ? nv : 0,
@@ -266,12 +296,24 @@ cff_mesh *create(const double *verts, int nv, const int *tris, int nt)
     std::vector<fcl::Triangle> ftris(static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t)
         ftris[t] = fcl::Triangle(tris[3 * t], tris[3 * t + 1], tris[3 * t + 2]);
-    if (m->bvh.beginModel(nt, nv) != fcl::BVH_OK || m->bvh.addSubModel(m->v, ftris) != fcl::BVH_OK ||
-        m->bvh.endModel() != fcl::BVH_OK) {
+    if (deforming) m->box.reset(new BoxModel());
+    else m->obb.reset(new ObbModel());
+    if (!(deforming ? build(*m->box, m->v, ftris) : build(*m->obb, m->v, ftris))) {
         set_error("FCL could not build the bounding-volume hierarchy");
         return NULL;
     }
     return m.release();
+}
+
+template <typename BV>
+void traverse(const fcl::BVHModel<BV> *model, const cff_mesh *m, const V3 &point, double slack,
+              fcl::DistanceResultd *result)
+{
+    PointNode<BV> node(m, point, slack);
+    node.model1 = model;
+    node.request = fcl::DistanceRequestd(true);  // nearest points
+    node.result = result;
+    fcl::detail::distance(&node, NULL, 2);
 }
 
 int closest(const cff_mesh *m, const double p[3], double max_dist, double q[3], double n[3],
@@ -299,11 +341,8 @@ int closest(const cff_mesh *m, const double p[3], double max_dist, double q[3], 
     // comes out as round-off: hence the slack.
     const double limit = max_dist + slack;
     fcl::DistanceResultd result(std::isfinite(limit) ? limit : std::numeric_limits<double>::max());
-    PointNode node(m, point, slack);
-    node.model1 = &m->bvh;
-    node.request = fcl::DistanceRequestd(true);  // nearest points
-    node.result = &result;
-    fcl::detail::distance(&node, NULL, 2);
+    if (m->obb) traverse(m->obb.get(), m, point, slack, &result);
+    else traverse(m->box.get(), m, point, slack, &result);
     if (result.b1 == fcl::DistanceResultd::NONE) return 0;
 
     const int tri = result.b1;
@@ -336,6 +375,14 @@ int closest(const cff_mesh *m, const double p[3], double max_dist, double q[3], 
     return 1;
 }
 
+template <typename BV>
+bool refit(fcl::BVHModel<BV> &b, const std::vector<V3> &v)
+{
+    if (b.beginUpdateModel() != fcl::BVH_OK) return false;
+    for (const V3 &x : v) b.updateVertex(x);
+    return b.endUpdateModel(true, true) == fcl::BVH_OK;
+}
+
 int update(cff_mesh *m, const double *verts)
 {
     if (!m || !verts) {
@@ -349,20 +396,23 @@ int update(cff_mesh *m, const double *verts)
             return -1;
         }
     }
-    if (m->bvh.beginUpdateModel() != fcl::BVH_OK) {
-        set_error("FCL could not begin updating the hierarchy");
-        return -1;
-    }
-    for (size_t i = 0; i < nv; ++i) {
-        m->v[i] = V3(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
-        m->bvh.updateVertex(m->v[i]);
-    }
-    if (m->bvh.endUpdateModel(true, true) != fcl::BVH_OK) {
+    for (size_t i = 0; i < nv; ++i) m->v[i] = V3(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
+    if (!(m->obb ? refit(*m->obb, m->v) : refit(*m->box, m->v))) {
         set_error("FCL could not refit the hierarchy");
         return -1;
     }
     compute_normals(m);
     return 0;
+}
+
+// FCL's arrays: vertices (twice once refitted: the previous frame's are
+// kept), triangles, bounding-volume nodes, primitive indices.
+template <typename BV>
+size_t model_bytes(const fcl::BVHModel<BV> &b)
+{
+    return (size_t)b.num_vertices * sizeof(fcl::Vector3d) * (b.prev_vertices ? 2 : 1) +
+           (size_t)b.num_tris * (sizeof(fcl::Triangle) + sizeof(unsigned int)) +
+           (size_t)b.getNumBVs() * sizeof(fcl::BVNode<BV>);
 }
 
 }  // namespace
@@ -372,7 +422,21 @@ extern "C" {
 cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt)
 {
     try {
-        return create(verts, nv, tris, nt);
+        return create(verts, nv, tris, nt, false);
+    } catch (const std::bad_alloc &) {
+        set_error("out of memory");
+    } catch (const std::exception &e) {
+        set_error("FCL: %s", e.what());
+    } catch (...) {
+        set_error("FCL: unknown exception");
+    }
+    return NULL;
+}
+
+cff_mesh *cff_mesh_create_deforming(const double *verts, int nv, const int *tris, int nt)
+{
+    try {
+        return create(verts, nv, tris, nt, true);
     } catch (const std::bad_alloc &) {
         set_error("out of memory");
     } catch (const std::exception &e) {
@@ -387,14 +451,10 @@ size_t cff_mesh_bytes(const cff_mesh *m)
 {
     if (!m)
         return 0;
-    const Model &b = m->bvh;
-    size_t fcl = (size_t)b.num_vertices * sizeof(fcl::Vector3d) +
-                 (size_t)b.num_tris * (sizeof(fcl::Triangle) + sizeof(unsigned int)) +
-                 (size_t)b.getNumBVs() * sizeof(fcl::BVNode<fcl::OBBRSSd>);
-    return sizeof *m + fcl + m->v.capacity() * sizeof(V3) + m->t.capacity() * sizeof(int) +
+    return sizeof *m + (m->obb ? model_bytes(*m->obb) : model_bytes(*m->box)) +
+           m->v.capacity() * sizeof(V3) + m->t.capacity() * sizeof(int) +
            m->edge_of.capacity() * sizeof(int) +
-           (m->face_n.capacity() + m->edge_n.capacity() + m->vert_n.capacity()) * sizeof(V3) +
-           (b.prev_vertices ? (size_t)b.num_vertices * sizeof(fcl::Vector3d) : 0);
+           (m->face_n.capacity() + m->edge_n.capacity() + m->vert_n.capacity()) * sizeof(V3);
 }
 
 void cff_mesh_destroy(cff_mesh *m)

@@ -23,6 +23,11 @@ typedef struct cff_mesh cff_mesh;
 cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt);
 void cff_mesh_destroy(cff_mesh *m);
 
+/* As cff_mesh_create, for a mesh that cff_mesh_update will move often: its
+ * hierarchy is of axis-aligned boxes, cheap to refit (oriented boxes, the
+ * default, fit tighter but each refit solves an eigenproblem per box). */
+cff_mesh *cff_mesh_create_deforming(const double *verts, int nv, const int *tris, int nt);
+
 /* Bytes the mesh holds: FCL's hierarchy (vertices, triangles, bounding
  * volume nodes, primitive indices) and the copies and normals kept here. */
 size_t cff_mesh_bytes(const cff_mesh *m);

@@ -50,7 +50,7 @@ static int surface_build(const cf_solid *s, const cf_fragment *f, cf_frag_surfac
     for (int i = 0; i < f->nodes.n; i++) /* local now maps node -> surface vertex */
         if (local[f->nodes.v[i]] >= 0)
             fs->slot[local[f->nodes.v[i]]] = i;
-    fs->mesh = cff_mesh_create(rest, fs->nv, fs->tri, fs->ntri);
+    fs->mesh = cff_mesh_create_deforming(rest, fs->nv, fs->tri, fs->ntri);
     fs->built_nodes = f->nodes.n;
     rc = fs->mesh ? 0 : -1;
 done:

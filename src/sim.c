@@ -889,11 +889,12 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
             sim->steps_fracture++;
         }
-        double removed;
+        double removed, t0 = cf_wall_time();
         if (cf_body_contact(sim, h, &removed))
             return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
                                 cff_last_error());
         sim->flow.contact += removed;
+        sim->prof.bodies += cf_wall_time() - t0;
     }
     for (int fi = 0; fi < n; fi++) {
         cf_fragment *f = &sim->frag[fi];
@@ -1147,7 +1148,8 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
             sim->n_handoffs, sim->max_momentum_error, sim->total_handoff_loss);
     print_hull_summary(sim, out, wall);
     print_memory(sim, out);
-    double staged = p->rigid + p->stress + p->insertion + p->forces + p->pbd + p->handoff + p->output;
+    double staged = p->rigid + p->stress + p->insertion + p->forces + p->pbd + p->bodies +
+                    p->handoff + p->output;
     cf_ledger l;
     cf_sim_ledger(sim, &l);
     double scale = fmax(fabs(l.initial) + fabs(l.work_gravity) + fabs(l.work_boundary) +
@@ -1169,9 +1171,10 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
             (unsigned long long)cf_sim_state_hash(sim));
     fprintf(out, "wall time          %.2f s\n", wall);
     fprintf(out, "  rigid step %.2f s | stress %.2f s | insertion %.2f s | forces %.2f s | "
-                 "PBD %.2f s | hand-off %.2f s | output %.2f s | other %.2f s\n",
-            p->rigid, p->stress, p->insertion, p->forces, p->pbd, p->handoff, p->output,
-            wall - staged);
+                 "PBD %.2f s | contact between bodies %.2f s | hand-off %.2f s | output %.2f s | "
+                 "other %.2f s\n",
+            p->rigid, p->stress, p->insertion, p->forces, p->pbd, p->bodies, p->handoff,
+            p->output, wall - staged);
     if (sim->steps_fracture > 0)
         fprintf(out, "per fracture step  %.3f ms\n",
                 1e3 * (p->stress + p->insertion + p->forces + p->pbd) / (double)sim->steps_fracture);

@@ -74,7 +74,8 @@ typedef struct cf_energy_flows {
 } cf_energy_flows;
 
 typedef struct cf_profile {
-    double rigid, stress, insertion, forces, pbd, handoff, decompose, output; /* s of wall time */
+    double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose, output; /* s of
+                                                                      wall time */
 } cf_profile;
 
 struct cf_sim {

@@ -228,12 +228,14 @@ static double lcg(uint64_t *s)
 /* Random points in the box [lo, hi]: |d| equals the brute-force distance,
  * the sign says inside/outside, q lies |d| from p and n is unit.  Every
  * fifth point is put on the plane y = x, every tenth on a line x = y = c
- * (c around 1), to visit the edges and vertices there. */
+ * (c around 1), to visit the edges and vertices there.  Done on both kinds
+ * of hierarchy (odd seeds: the deforming mesh's axis-aligned boxes). */
 static void brute_force_check(const char *name, const double (*v)[3], const int (*t)[3], int nv,
                               int nt, int (*inside)(const double *), const double lo[3],
                               const double hi[3], uint64_t seed)
 {
-    cff_mesh *m = cff_mesh_create(&v[0][0], nv, &t[0][0], nt);
+    cff_mesh *m = seed % 2 ? cff_mesh_create_deforming(&v[0][0], nv, &t[0][0], nt)
+                           : cff_mesh_create(&v[0][0], nv, &t[0][0], nt);
     assert_non_null(m);
     int n_in = 0, n_out = 0;
     double worst = 0.0;
@@ -294,8 +296,9 @@ static void test_brute_force(void **state)
     const int nt = make_l_prism(v, t);
     assert_int_equal(nt, 20);
     const double lo[3] = {-0.7, -0.7, -0.7}, hi[3] = {2.7, 2.7, 1.7};
-    brute_force_check("L prism", (const double(*)[3])v, (const int(*)[3])t, 12, nt, inside_l, lo,
-                      hi, 12345);
+    for (uint64_t seed = 12344; seed <= 12345; seed++)
+        brute_force_check("L prism", (const double(*)[3])v, (const int(*)[3])t, 12, nt, inside_l,
+                          lo, hi, seed);
 
     /* Faces opposite each corner, counter-clockwise from outside (normal
      * along -v_i). */
@@ -316,7 +319,9 @@ static void test_brute_force(void **state)
         }
     }
     const double tlo[3] = {-1.6, -1.6, -1.6}, thi[3] = {1.6, 1.6, 1.6};
-    brute_force_check("tetrahedron", TET, (const int(*)[3])tt, 4, 4, inside_tet, tlo, thi, 777);
+    for (uint64_t seed = 776; seed <= 777; seed++)
+        brute_force_check("tetrahedron", TET, (const int(*)[3])tt, 4, 4, inside_tet, tlo, thi,
+                          seed);
 
     /* Closed form at the L's concave edge x = y = 1, from inside: q on the
      * edge, whose pseudo-normal is the mean of the notch walls' normals
@@ -437,11 +442,10 @@ static void test_bad_input(void **state)
 
 /* The cube moved by (2, 0, 0) and stretched to 3 units along z, refitted:
  * queries see the new surface only, and the triangle and barycentric
- * coordinates reproduce the closest point. */
-static void test_update(void **state)
+ * coordinates reproduce the closest point.  Destroys m. */
+static void check_update(cff_mesh *m)
 {
-    (void)state;
-    cff_mesh *m = make_cube();
+    assert_non_null(m);
     double v[8][3];
     cube_verts(v);
     for (int i = 0; i < 8; ++i)
@@ -474,6 +478,17 @@ static void test_update(void **state)
     assert_int_equal(cff_mesh_closest(m, old, INFINITY, q, n, &d), 1);
     assert_true(fabs(d - 1.5) < TOL);
     cff_mesh_destroy(m);
+}
+
+/* Both kinds of hierarchy: oriented boxes (static meshes) and axis-aligned
+ * boxes (deforming meshes). */
+static void test_update(void **state)
+{
+    (void)state;
+    check_update(make_cube());
+    double v[8][3];
+    cube_verts(v);
+    check_update(cff_mesh_create_deforming(&v[0][0], 8, &CUBE_TRIS[0][0], 12));
 }
 
 int main(void)
