@@ -415,14 +415,11 @@ size_t model_bytes(const fcl::BVHModel<BV> &b)
            (size_t)b.getNumBVs() * sizeof(fcl::BVNode<BV>);
 }
 
-}  // namespace
-
-extern "C" {
-
-cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt)
+// create() with every exception caught: none may leave this file.
+cff_mesh *create_caught(const double *verts, int nv, const int *tris, int nt, bool deforming)
 {
     try {
-        return create(verts, nv, tris, nt, false);
+        return create(verts, nv, tris, nt, deforming);
     } catch (const std::bad_alloc &) {
         set_error("out of memory");
     } catch (const std::exception &e) {
@@ -433,18 +430,18 @@ cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt)
     return NULL;
 }
 
+}  // namespace
+
+extern "C" {
+
+cff_mesh *cff_mesh_create(const double *verts, int nv, const int *tris, int nt)
+{
+    return create_caught(verts, nv, tris, nt, false);
+}
+
 cff_mesh *cff_mesh_create_deforming(const double *verts, int nv, const int *tris, int nt)
 {
-    try {
-        return create(verts, nv, tris, nt, true);
-    } catch (const std::bad_alloc &) {
-        set_error("out of memory");
-    } catch (const std::exception &e) {
-        set_error("FCL: %s", e.what());
-    } catch (...) {
-        set_error("FCL: unknown exception");
-    }
-    return NULL;
+    return create_caught(verts, nv, tris, nt, true);
 }
 
 size_t cff_mesh_bytes(const cff_mesh *m)
