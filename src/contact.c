@@ -50,8 +50,8 @@ static void center_hull(const void *obj, ccd_vec3_t *out)
     ccdVec3Set(out, c[0], c[1], c[2]);
 }
 
-static int boxes_overlap(const double lo0[3], const double hi0[3], const double lo1[3],
-                         const double hi1[3])
+int cf_boxes_overlap(const double lo0[3], const double hi0[3], const double lo1[3],
+                     const double hi1[3])
 {
     for (int k = 0; k < 3; k++)
         if (lo0[k] > hi1[k] || lo1[k] > hi0[k])
@@ -148,7 +148,7 @@ int cf_hull_set_gather(cf_sim *sim, int fi, double pad, const double *boxes, cf_
     double size = 0;
     for (int g = 0; g < sim->n_frag; g++) {
         const cf_fragment *o = &sim->frag[g];
-        if (!boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
+        if (!cf_boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
             continue;
         if (add_hulls(sim, g, hs))
             return -1;
@@ -173,7 +173,7 @@ void cf_hull_set_free(cf_hull_set *hs)
 static int penetration(const cf_hull_set *hs, int h, const double p[3], double *depth,
                        double dir[3])
 {
-    if (!boxes_overlap(p, p, &hs->lo[3 * h], &hs->hi[3 * h]))
+    if (!cf_boxes_overlap(p, p, &hs->lo[3 * h], &hs->hi[3 * h]))
         return 0;
     ccd_t ccd;
     CCD_INIT(&ccd);

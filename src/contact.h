@@ -13,6 +13,11 @@
 typedef struct cf_sim cf_sim;
 typedef struct cff_mesh cff_mesh;
 
+/* Whether boxes [lo0, hi0] and [lo1, hi1] (m) overlap, touching included;
+ * lo = hi is a point. */
+int cf_boxes_overlap(const double lo0[3], const double hi0[3], const double lo1[3],
+                     const double hi1[3]);
+
 /* Convex hulls of the rigid bodies near one fragment, in world coordinates
  * at the bodies' poses after the rigid step (they stay put while the
  * fragment is sub-cycled). */
@@ -83,10 +88,16 @@ typedef struct cf_frag_surface {
 
 void cf_frag_surface_free(cf_frag_surface *fs);
 
+/* Whether fracture-mode fragments of two initial bodies exist, so that
+ * cf_body_contact has work: asked once per rigid step (sub-steps change no
+ * fragment's mode). */
+int cf_body_contact_needed(const cf_sim *sim);
+
 /* Contact between fracture-mode fragments of different initial bodies
  * (fragments of one body do not collide with each other, as in Bullet),
  * after every fracture sub-step of length h (s), with every fragment's
- * step done.  For each pair whose node boxes overlap, every node a of one
+ * step done, in a rigid step for which cf_body_contact_needed holds.  For
+ * each pair whose node boxes overlap, every node a of one
  * fragment found behind the other's surface (signed distance d < 0 to its
  * closest point q, on triangle (b0, b1, b2) with barycentric coordinates
  * l) is projected out with the surface, a PBD contact constraint

@@ -88,14 +88,6 @@ static void node_box(const cf_solid *s, const cf_fragment *f, double box[6])
         }
 }
 
-static int in_box(const double x[3], const double box[6])
-{
-    for (int k = 0; k < 3; k++)
-        if (x[k] < box[k] || x[k] > box[3 + k])
-            return 0;
-    return 1;
-}
-
 /* A node a contact pass moved, for the pass's work. */
 typedef struct moved_node {
     int node;
@@ -158,14 +150,6 @@ static double moved_work(const moved_nodes *mv, const cf_solid *s)
     return w;
 }
 
-static int boxes_overlap(const double a[6], const double b[6])
-{
-    for (int k = 0; k < 3; k++)
-        if (a[k] > b[3 + k] || b[k] > a[3 + k])
-            return 0;
-    return 1;
-}
-
 static double inverse_mass(const cf_solid *s, int a)
 {
     return s->bc[a] >= 0 || !(s->m[a] > 0) ? 0 : 1 / s->m[a];
@@ -197,7 +181,7 @@ static int push_out(cf_sim *sim, const cf_fragment *fa, const cf_fragment *fb,
     for (int i = 0; i < fa->nodes.n; i++) {
         int a = fa->nodes.v[i];
         const double *xa = &s->x[3 * a];
-        if (!in_box(xa, box_b)) /* also skips a non-finite node */
+        if (!cf_boxes_overlap(xa, xa, box_b, box_b + 3)) /* also skips a non-finite node */
             continue;
         double q[3], n[3], d, l[3], u[3];
         int tri, found = cff_mesh_closest_tri(sb->mesh, xa, INFINITY, q, n, &d, &tri, l);
@@ -226,28 +210,23 @@ static int push_out(cf_sim *sim, const cf_fragment *fa, const cf_fragment *fb,
     return 0;
 }
 
-static int root_of(const cf_sim *sim, int fi)
+int cf_body_contact_needed(const cf_sim *sim)
 {
-    while (sim->frag[fi].parent >= 0)
-        fi = sim->frag[fi].parent;
-    return fi;
+    int first_root = -1;
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+            continue;
+        int r = cf_fragment_root(sim, fi);
+        if (first_root >= 0 && r != first_root)
+            return 1;
+        first_root = r;
+    }
+    return 0;
 }
 
 int cf_body_contact(cf_sim *sim, double h, double *removed)
 {
     *removed = 0;
-    /* Nothing to do unless fracture-mode fragments of two bodies exist. */
-    int first_root = -1, two_bodies = 0;
-    for (int fi = 0; fi < sim->n_frag && !two_bodies; fi++) {
-        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
-            continue;
-        int r = root_of(sim, fi);
-        if (first_root < 0)
-            first_root = r;
-        two_bodies = r != first_root;
-    }
-    if (!two_bodies)
-        return 0;
     int n = sim->n_frag;
     double *box = malloc((size_t)n * 6 * sizeof(double));
     int *root = malloc((size_t)n * sizeof(int));
@@ -258,7 +237,7 @@ int cf_body_contact(cf_sim *sim, double h, double *removed)
     for (int fi = 0; fi < n; fi++)
         if (sim->frag[fi].mode == CF_MODE_FRACTURE) {
             node_box(&sim->solid, &sim->frag[fi], &box[6 * fi]);
-            root[fi] = root_of(sim, fi);
+            root[fi] = cf_fragment_root(sim, fi);
         }
     int rc = 0;
     moved_nodes mv = {0};
@@ -269,7 +248,7 @@ int cf_body_contact(cf_sim *sim, double h, double *removed)
         for (int j = i + 1; j < n && !rc; j++) {
             cf_fragment *fb = &sim->frag[j];
             if (fb->mode != CF_MODE_FRACTURE || root[j] == root[i] ||
-                !boxes_overlap(&box[6 * i], &box[6 * j]))
+                !cf_boxes_overlap(&box[6 * i], &box[6 * i + 3], &box[6 * j], &box[6 * j + 3]))
                 continue;
             rc = push_out(sim, fa, fb, &fb->surface, &box[6 * j], h, &mv) ||
                  push_out(sim, fb, fa, &fa->surface, &box[6 * i], h, &mv);

@@ -29,6 +29,13 @@ int cf_fragment_new(cf_sim *sim, int parent, double birth_time)
     return sim->n_frag++;
 }
 
+int cf_fragment_root(const cf_sim *sim, int fi)
+{
+    while (sim->frag[fi].parent >= 0)
+        fi = sim->frag[fi].parent;
+    return fi;
+}
+
 /* Mass and centre of mass from the tets (identical to the lumped ones); the
  * inertia of the lumped masses, the solver's own discretisation, so that a
  * hand-off preserves linear and angular momentum and never adds kinetic
@@ -419,9 +426,7 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
      * thousands of touching pieces would dominate Bullet's narrow phase
      * (about 14 times the rigid-step cost on a shattering sphere). */
     if (sim->bullet) {
-        int root = fi;
-        while (sim->frag[root].parent >= 0)
-            root = sim->frag[root].parent;
+        int root = cf_fragment_root(sim, fi);
         for (int a = 0; a < k; a++)
             cfb_set_family(sim->bullet, sim->frag[first + a].body, root);
     }

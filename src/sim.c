@@ -874,6 +874,7 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
         n_sub = 1;
     double h = dt / (double)n_sub;
     int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
+    int bodies = cf_body_contact_needed(sim);
     for (int fi = 0; fi < n; fi++) {
         cf_fragment *f = &sim->frag[fi];
         if (f->mode == CF_MODE_FRACTURE &&
@@ -889,12 +890,14 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
             sim->steps_fracture++;
         }
-        double removed, t0 = cf_wall_time();
-        if (cf_body_contact(sim, h, &removed))
-            return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
-                                cff_last_error());
-        sim->flow.contact += removed;
-        sim->prof.bodies += cf_wall_time() - t0;
+        if (bodies) {
+            double removed, t0 = cf_wall_time();
+            if (cf_body_contact(sim, h, &removed))
+                return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
+                                    cff_last_error());
+            sim->flow.contact += removed;
+            sim->prof.bodies += cf_wall_time() - t0;
+        }
     }
     for (int fi = 0; fi < n; fi++) {
         cf_fragment *f = &sim->frag[fi];

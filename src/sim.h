@@ -174,4 +174,8 @@ double cf_body_kinetic_energy(const cf_sim *sim, int fi);
 /* Append a new fragment; returns its index or -1 (out of memory). */
 int cf_fragment_new(cf_sim *sim, int parent, double birth_time);
 
+/* The initial body fragment fi descends from (its family: fragments of one
+ * body do not collide with each other). */
+int cf_fragment_root(const cf_sim *sim, int fi);
+
 #endif
