@@ -12,6 +12,7 @@
 #include <sys/types.h>
 #include <sys/utsname.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error *err)
@@ -99,8 +100,10 @@ int cf_report_plot(const char *script, const char *script_path, const char *cons
     return 0;
 }
 
-void cf_report_machine(char *out, size_t max)
+void cf_report_stamp(char *out, size_t max, char date[32])
 {
+    time_t now = time(NULL);
+    strftime(date, 32, "%Y-%m-%d", gmtime(&now));
     char cpu[256] = "unknown CPU", deb[64] = "?";
     char *info = cf_file_read("/proc/cpuinfo", NULL);
     const char *m = info ? strstr(info, "model name") : NULL;

@@ -28,8 +28,9 @@ cf_status cf_out_close(cf_outfile *o, cf_error *err);
 int cf_report_plot(const char *script, const char *script_path, const char *const *args,
                    const char *others);
 
-/* "CPU model, N cores, Linux release, Debian version" into out (at most
- * max bytes), for a report's header. */
-void cf_report_machine(char *out, size_t max);
+/* For a report's header: "CPU model, N cores, Linux release, Debian
+ * version" into out (at most max bytes), and today's date (UTC,
+ * YYYY-MM-DD) into date. */
+void cf_report_stamp(char *out, size_t max, char date[32]);
 
 #endif

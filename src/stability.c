@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define SIDE 0.1            /* m, the cube */
 #define CELLS 3
@@ -36,20 +35,30 @@ const char *cf_stability_mode_name(cf_stability_mode m)
     return m >= 0 && m < CF_STAB_N_MODES ? names[m] : "?";
 }
 
+/* The pieces both generated scenes share: no gravity, the material (E is
+ * set per case), one cube of 3^3 cells, fracture mode without insertion
+ * and the guard's criteria. */
+#define SCENE_COMMON                                                                       \
+    ", duration = 1, gravity = {0, 0, 0},\n"                                               \
+    "  material = {E = 1e6, nu = 0.25, rho = 2400, G_I = 1, sigma_max = 1,\n"             \
+    "              friction = 0.5, restitution = 0},\n"
+#define SCENE_CUBE                                                                         \
+    "{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"                 \
+    "                     tets_per_cell = 6}"
+#define SCENE_SOLVER                                                                       \
+    "  solver = {mode = 'fracture', criterion = 'none', cfl_fraction = 1, threads = 1,\n"  \
+    "            guard = {max_energy_growth = 0.1, max_inverted_fraction = 0.01}},\n"      \
+    "  output = {file = ''},\n"                                                             \
+    "}\n"
+
 static const char *const scene_text =
     "-- Written by `cohfrac stability`: the base case (see cohfrac/stability.h).\n"
     "return {\n"
-    "  name = 'stability', duration = 1, gravity = {0, 0, 0},\n"
-    "  material = {E = 1e6, nu = 0.25, rho = 2400, G_I = 1, sigma_max = 1,\n"
-    "              friction = 0.5, restitution = 0},\n"
-    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"
-    "                     tets_per_cell = 6},\n"
+    "  name = 'stability'" SCENE_COMMON
+    "  bodies = {" SCENE_CUBE ",\n"
     "             position = {0, 0, 0.05}, velocity = {0, 0, -10}}},\n"
     "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
-    "  solver = {mode = 'fracture', criterion = 'none', cfl_fraction = 1, threads = 1,\n"
-    "            guard = {max_energy_growth = 0.1, max_inverted_fraction = 0.01}},\n"
-    "  output = {file = ''},\n"
-    "}\n";
+    SCENE_SOLVER;
 
 /* The mass-ratio slice: the same cube at rest, hit on its top face by a
  * cube of the same material and mesh, side 0.1 (m_impactor/m_target)^(1/3)
@@ -57,18 +66,11 @@ static const char *const scene_text =
 static const char *const pair_scene_text =
     "-- Written by `cohfrac stability`: the mass-ratio case (see cohfrac/stability.h).\n"
     "return {\n"
-    "  name = 'stability_pair', duration = 1, gravity = {0, 0, 0},\n"
-    "  material = {E = 1e6, nu = 0.25, rho = 2400, G_I = 1, sigma_max = 1,\n"
-    "              friction = 0.5, restitution = 0},\n"
-    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"
-    "                     tets_per_cell = 6}, position = {0, 0, 0}},\n"
-    "            {mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"
-    "                     tets_per_cell = 6},\n"
+    "  name = 'stability_pair'" SCENE_COMMON
+    "  bodies = {" SCENE_CUBE ", position = {0, 0, 0}},\n"
+    "            " SCENE_CUBE ",\n"
     "             position = {0, 0, 0.1}, velocity = {0, 0, -10}}},\n"
-    "  solver = {mode = 'fracture', criterion = 'none', cfl_fraction = 1, threads = 1,\n"
-    "            guard = {max_energy_growth = 0.1, max_inverted_fraction = 0.01}},\n"
-    "  output = {file = ''},\n"
-    "}\n";
+    SCENE_SOLVER;
 
 /* 6 sqrt(2) V / l_max^3 of a tet: 1 for a regular tet, 0 for a flat one,
  * negative when inverted. */
@@ -358,9 +360,7 @@ static cf_status write_md(const cf_stability_result *r, int quick, const char *c
         return st;
     FILE *f = o.f;
     char mach[512], date[32];
-    cf_report_machine(mach, sizeof mach);
-    time_t now = time(NULL);
-    strftime(date, sizeof date, "%Y-%m-%d", gmtime(&now));
+    cf_report_stamp(mach, sizeof mach, date);
     fprintf(f, "<!-- cohfrac stability, %s, %s; regenerate with: %s -->\n", date, mach,
             command ? command : "cohfrac stability");
     fprintf(f, "# Stability map%s\n\n", quick ? " (--quick)" : "");
@@ -419,16 +419,17 @@ static cf_status write_md(const cf_stability_result *r, int quick, const char *c
     return cf_out_close(&o, err);
 }
 
-/* Write `text` to DIR/NAME; path gets DIR/NAME. */
+/* Write `text` to DIR/NAME (whole or not at all); path gets DIR/NAME. */
 static cf_status write_scene(const char *dir, const char *name, const char *text, char path[1100],
                              cf_error *err)
 {
     snprintf(path, 1100, "%s/%s", dir, name);
-    FILE *f = fopen(path, "w");
-    int ok = f && fputs(text, f) >= 0;
-    if (f && fclose(f) != 0)
-        ok = 0;
-    return ok ? CF_OK : cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s", path);
+    cf_outfile o;
+    cf_status st = cf_out_open(&o, dir, name, err);
+    if (st != CF_OK)
+        return st;
+    fputs(text, o.f);
+    return cf_out_close(&o, err);
 }
 
 cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result *r,
@@ -462,7 +463,8 @@ cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result 
                     c->sliver ? "sliver" : "regular", c->mass_ratio,
                     c->stable ? "stable" : "unstable: ", c->reason);
     }
-    if ((st = write_csv(r, err)) != CF_OK || (st = write_md(r, opt->quick, opt->command, quality, err)) != CF_OK)
+    if ((st = write_csv(r, err)) != CF_OK ||
+        (st = write_md(r, opt->quick, opt->command, quality, err)) != CF_OK)
         return st;
     if (opt->plot) {
         char csv[1100], png[1100];

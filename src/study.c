@@ -21,7 +21,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #ifndef COHFRAC_VERSION
@@ -552,9 +551,7 @@ static cf_status write_md(const cf_study_options *o, const cf_study_result *res,
     FILE *m = f.f;
     const cf_study_case *c = res->cases, *r = &c[0];
     char mach[512], date[32];
-    cf_report_machine(mach, sizeof mach);
-    time_t now = time(NULL);
-    strftime(date, sizeof date, "%Y-%m-%d", gmtime(&now));
+    cf_report_stamp(mach, sizeof mach, date);
     fprintf(m, "<!-- cohfrac study, %s, %s; regenerate with: %s -->\n", date, mach,
             o->command ? o->command : "cohfrac study");
     fprintf(m, "# Study: %s\n\n", res->scene_name);
