@@ -1,8 +1,9 @@
 // cohfrac — point queries against triangle meshes, behind the C
-// header cf_fcl.h.  FCL builds and owns the bounding-volume hierarchy
-// (BVHModel<OBBRSS>, or BVHModel<AABB> for a deforming mesh) and runs the branch-and-bound distance traversal; the
-// leaf test (exact closest point on one triangle) and the sign (angle-weighted
-// pseudo-normals, Baerentzen & Aanaes 2005) are ours.
+// header cf_fcl.h.  FCL builds, refits and owns the bounding-volume
+// hierarchy (BVHModel<OBBRSS>, or BVHModel<AABB> for a deforming mesh) and
+// runs the branch-and-bound distance traversal; the leaf test (exact closest
+// point on one triangle) and the sign (angle-weighted pseudo-normals,
+// Baerentzen & Aanaes 2005) are ours.
 //
 // Why not fcl::distance with a small sphere: FCL 0.7's mesh-sphere leaf test
 // (meshShapeDistanceOrientedNodeLeafTesting -> sphereTriangleDistance with
