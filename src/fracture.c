@@ -29,33 +29,24 @@ static int ensure_scratch(cf_fragment *f)
     return 0;
 }
 
-/* Stresses, then extrinsic insertion on every facet that qualifies. */
-static cf_status check_and_insert(cf_sim *sim, cf_fragment *f, int *inserted)
+/* Extrinsic insertion on every facet that qualifies at this check. */
+static cf_status check_and_insert(cf_sim *sim, cf_fragment *f, int n_hot, int *inserted)
 {
     cf_solid *s = &sim->solid;
-    int *cand = malloc((size_t)f->nt * 4 * sizeof(int));
-    if (!cand)
-        return CF_ERR_NOMEM;
     double t0 = cf_wall_time();
-    int nc = cf_insertion_candidates(s, f->tets, f->nt, sim->scene->solver.criterion, cand);
-    if (nc < 0) {
-        free(cand);
+    int nc = cf_insertion_candidates(s, f->tets, f->nt, sim->scene->solver.criterion, n_hot,
+                                     &sim->cand);
+    if (nc < 0)
         return CF_ERR_NOMEM;
-    }
-    for (int i = 0; i < nc; i++) {
-        if (cf_crack_facet(s, cand[i], &f->nodes) || cf_int_list_push(&f->coh, s->n_coh - 1)) {
-            free(cand);
+    for (int i = 0; i < nc; i++)
+        if (cf_crack_facet(s, sim->cand.v[i], &f->nodes) || cf_int_list_push(&f->coh, s->n_coh - 1))
             return CF_ERR_NOMEM;
-        }
-    }
-    free(cand);
     if (nc > 0 && cf_bars_build(&f->bars, s, f->tets, f->nt))
         return CF_ERR_NOMEM;
     *inserted = nc;
     sim->prof.insertion += cf_wall_time() - t0;
     return CF_OK;
 }
-
 
 /* Friction and restitution of nodes in contact, relative to the obstacle.
  * Returns the kinetic energy this removes, J. */
@@ -131,13 +122,17 @@ static cf_status forces(cf_sim *sim, cf_fragment *f, double dt, int fracture)
     double t0 = cf_wall_time();
     f->e_strain = 0;
     if (fracture) {
-        int check = (f->steps % set->check_interval) == 0;
-        f->n_inverted = cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check);
+        /* Stresses only when the criterion is checked at this step. */
+        int check = set->criterion != CF_CRITERION_NONE && (f->steps % set->check_interval) == 0;
+        cf_stress_check bound = cf_insertion_bound(&s->mat, set->criterion);
+        int n_hot = 0;
+        f->n_inverted = cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check ? &bound : NULL,
+                                       &n_hot);
         f->e_strain = cf_tet4_strain_energy(s, f->tets, f->nt);
         sim->prof.stress += cf_wall_time() - t0;
         int inserted = 0;
-        if (check && set->criterion != CF_CRITERION_NONE) {
-            cf_status st = check_and_insert(sim, f, &inserted);
+        if (check) {
+            cf_status st = check_and_insert(sim, f, n_hot, &inserted);
             if (st != CF_OK)
                 return st;
         }
@@ -146,14 +141,15 @@ static cf_status forces(cf_sim *sim, cf_fragment *f, double dt, int fracture)
     }
     if (ensure_scratch(f))
         return CF_ERR_NOMEM;
-    for (int i = 0; i < f->nodes.n; i++) {
-        int a = f->nodes.v[i];
-        for (int k = 0; k < 3; k++)
-            s->f[3 * a + k] = s->m[a] * g[k];
-    }
     if (fracture) {
-        cf_tet4_scatter(s, f->tets, f->nt);
+        cf_tet4_gather(s, f->nodes.v, f->nodes.n, g);
         cf_cohesive_forces(s, &sim->ppr, f->coh.v, f->coh.n, dt, set->contact_stiffness);
+    } else {
+        for (int i = 0; i < f->nodes.n; i++) {
+            int a = f->nodes.v[i];
+            for (int k = 0; k < 3; k++)
+                s->f[3 * a + k] = s->m[a] * g[k];
+        }
     }
     sim->prof.forces += cf_wall_time() - t0;
     return CF_OK;

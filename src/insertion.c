@@ -46,54 +46,71 @@ static double max_principal(const double A[9])
     return q + 2 * p * cos(acos(r) / 3);
 }
 
-/* Volume-averaged nodal maximum principal stress of the nodes of `tets`
- * (written at the node's index of `out`, which has s->n_nodes entries). */
-static int nodal_principal(const cf_solid *s, const int *tets, int nt, double *out)
+/* Volume-averaged maximum principal stress at node n: over the tets that
+ * hold n, in ascending tet order. */
+static double nodal_principal(const cf_solid *s, int n)
 {
-    double *acc = malloc((size_t)s->n_nodes * 10 * sizeof(double));
-    if (!acc)
-        return -1;
-    for (int i = 0; i < nt; i++) /* clear only this fragment's nodes */
-        for (int j = 0; j < 4; j++)
-            memset(&acc[10 * s->tet[4 * tets[i] + j]], 0, 10 * sizeof(double));
-    for (int i = 0; i < nt; i++) {
-        int t = tets[i];
-        for (int j = 0; j < 4; j++) {
-            double *a = &acc[10 * s->tet[4 * t + j]];
-            for (int k = 0; k < 9; k++)
-                a[k] += s->vol[t] * s->sigma[9 * t + k];
-            a[9] += s->vol[t];
-        }
+    int o = s->origin[n];
+    double a[10] = {0};
+    for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
+        int slot = s->vt_slot[j], t = slot / 4;
+        if (s->tet[slot] != n)
+            continue;
+        for (int k = 0; k < 9; k++)
+            a[k] += s->vol[t] * s->sigma[9 * t + k];
+        a[9] += s->vol[t];
     }
-    for (int i = 0; i < nt; i++)
-        for (int j = 0; j < 4; j++) {
-            int n = s->tet[4 * tets[i] + j];
-            double *a = &acc[10 * n];
-            if (a[9] == 0) /* done already */
-                continue;
-            double sig[9];
-            for (int k = 0; k < 9; k++)
-                sig[k] = a[k] / a[9];
-            out[n] = max_principal(sig);
-            a[9] = 0;
-        }
-    free(acc);
-    return 0;
+    double sig[9];
+    for (int k = 0; k < 9; k++)
+        sig[k] = a[k] / a[9];
+    return max_principal(sig);
 }
 
-int cf_insertion_candidates(const cf_solid *s, const int *tets, int nt, cf_criterion rule, int *out)
+/* Whether facet (ta, face k) passes the source's rule: the nodal value at
+ * each of its three nodes, computed once per node and check (mark 2). */
+static int source_rule(cf_solid *s, int ta, int k, double threshold)
 {
-    double *nodal = NULL;
-    if (rule == CF_CRITERION_SOURCE) {
-        nodal = malloc((size_t)s->n_nodes * sizeof(double));
-        if (!nodal || nodal_principal(s, tets, nt, nodal)) {
-            free(nodal);
-            return -1;
-        }
+    int all = 1;
+    for (int j = 0; j < 3 && all; j++) {
+        int n = s->tet[4 * ta + CF_TET_FACE[k][j]];
+        if (s->node_mark[n] == 0) /* no hot tet holds it: below the bound */
+            return 0;
+        if (s->node_mark[n] == 1)
+            s->nodal[n] = nodal_principal(s, n), s->node_mark[n] = 2;
+        all &= s->nodal[n] >= threshold;
     }
-    int count = 0;
+    return all;
+}
+
+static void mark_hot_nodes(cf_solid *s, const int *tets, int nt, unsigned char value)
+{
+    for (int i = 0; i < nt; i++)
+        if (s->hot[tets[i]])
+            for (int j = 0; j < 4; j++)
+                s->node_mark[s->tet[4 * tets[i] + j]] = value;
+}
+
+cf_stress_check cf_insertion_bound(const cf_material *m, cf_criterion rule)
+{
+    cf_stress_check c = {INFINITY, INFINITY};
+    if (rule == CF_CRITERION_SOURCE)
+        c.s1 = 0.9 * m->sigma_max;
+    else if (rule == CF_CRITERION_TRACTION)
+        c.s1 = m->sigma_max, c.tau = m->tau_max;
+    return c;
+}
+
+int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
+                            cf_int_list *out)
+{
+    out->n = 0;
+    if (n_hot == 0 || rule == CF_CRITERION_NONE)
+        return 0;
+    if (rule == CF_CRITERION_SOURCE)
+        mark_hot_nodes(s, tets, nt, 1);
+    int rc = 0;
     double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
-    for (int i = 0; i < nt; i++) {
+    for (int i = 0; i < nt && rc == 0; i++) {
         int ta = tets[i];
         for (int k = 0; k < 4; k++) {
             int f = s->tet_facet[4 * ta + k];
@@ -101,14 +118,13 @@ int cf_insertion_candidates(const cf_solid *s, const int *tets, int nt, cf_crite
             if (F[2] < 0 || s->cracked[f] || F[0] != ta || (s->candidate && !s->candidate[f]))
                 continue;
             if (rule == CF_CRITERION_SOURCE) {
-                int all = 1;
-                for (int j = 0; j < 3; j++)
-                    all &= nodal[s->tet[4 * ta + CF_TET_FACE[k][j]]] >= 0.9 * smax;
-                if (all)
-                    out[count++] = f;
+                if (source_rule(s, ta, k, 0.9 * smax) && cf_int_list_push(out, f))
+                    rc = -1;
                 continue;
             }
             int tb = F[2];
+            if (!s->hot[ta] && !s->hot[tb]) /* the mean stress is below both bounds */
+                continue;
             double sig[9], n[3], t[3];
             for (int j = 0; j < 9; j++)
                 sig[j] = 0.5 * (s->sigma[9 * ta + j] + s->sigma[9 * tb + j]);
@@ -117,12 +133,13 @@ int cf_insertion_candidates(const cf_solid *s, const int *tets, int nt, cf_crite
             double sn = v3_dot(n, t);
             double tau2 = v3_dot(t, t) - sn * sn;
             double tau = tau2 > 0 ? sqrt(tau2) : 0;
-            if (sn >= smax || tau >= tmax)
-                out[count++] = f;
+            if ((sn >= smax || tau >= tmax) && cf_int_list_push(out, f))
+                rc = -1;
         }
     }
-    free(nodal);
-    return count;
+    if (rule == CF_CRITERION_SOURCE)
+        mark_hot_nodes(s, tets, nt, 0);
+    return rc ? -1 : out->n;
 }
 
 /* Slot of original vertex o in tet t, or -1. */
@@ -147,16 +164,15 @@ static int uf_find(int *parent, int i)
 static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
 {
     int lo = s->vt_start[o], hi = s->vt_start[o + 1];
-    int *buf = malloc(3 * (size_t)(hi - lo) * sizeof(int));
+    int local[3 * 256]; /* stars of up to 256 tets without the heap */
+    int *buf = hi - lo <= 256 ? local : malloc(3 * (size_t)(hi - lo) * sizeof(int));
     if (!buf)
         return -1;
     int *star = buf, *parent = buf + (hi - lo), *copy_of_root = buf + 2 * (hi - lo);
     int ns = 0, rc = 0;
-    for (int i = lo; i < hi; i++) {
-        int t = s->vt_list[i];
-        if (s->tet[4 * t + slot_of(s, t, o)] == n)
-            star[ns++] = t;
-    }
+    for (int i = lo; i < hi; i++)
+        if (s->tet[s->vt_slot[i]] == n)
+            star[ns++] = s->vt_slot[i] / 4;
     for (int i = 0; i < ns; i++)
         parent[i] = i;
     for (int i = 0; i < ns; i++) {
@@ -199,7 +215,8 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
         s->m[s->tet[4 * star[i] + slot_of(s, star[i], o)]] = 0;
     for (int i = 0; i < ns; i++)
         s->m[s->tet[4 * star[i] + slot_of(s, star[i], o)]] += s->mat.rho * s->vol[star[i]] / 4.0;
-    free(buf);
+    if (buf != local)
+        free(buf);
     return rc;
 }
 

@@ -13,39 +13,6 @@ void points_bbox(const double *x, int n, double lo[3], double hi[3])
         }
 }
 
-void m3_mul(const double A[9], const double B[9], double out[9])
-{
-    double C[9];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-    memcpy(out, C, sizeof C);
-}
-
-void m3_mul_tn(const double A[9], const double B[9], double out[9])
-{
-    double C[9];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            C[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
-    memcpy(out, C, sizeof C);
-}
-
-void m3_mul_nt(const double A[9], const double B[9], double out[9])
-{
-    double C[9];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            C[3 * i + j] = A[3 * i] * B[3 * j] + A[3 * i + 1] * B[3 * j + 1] + A[3 * i + 2] * B[3 * j + 2];
-    memcpy(out, C, sizeof C);
-}
-
-double m3_det(const double A[9])
-{
-    return A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
-           A[2] * (A[3] * A[7] - A[4] * A[6]);
-}
-
 double m3_inv(const double A[9], double out[9])
 {
     double d = m3_det(A);
@@ -63,25 +30,6 @@ double m3_inv(const double A[9], double out[9])
     C[8] = (A[0] * A[4] - A[1] * A[3]) * id;
     memcpy(out, C, sizeof C);
     return d;
-}
-
-void quat_normalize(double q[4])
-{
-    double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    if (n == 0.0) {
-        q[0] = 1, q[1] = q[2] = q[3] = 0;
-        return;
-    }
-    for (int i = 0; i < 4; i++)
-        q[i] /= n;
-}
-
-void quat_to_mat(const double q[4], double R[9])
-{
-    double w = q[0], x = q[1], y = q[2], z = q[3];
-    R[0] = 1 - 2 * (y * y + z * z), R[1] = 2 * (x * y - w * z), R[2] = 2 * (x * z + w * y);
-    R[3] = 2 * (x * y + w * z), R[4] = 1 - 2 * (x * x + z * z), R[5] = 2 * (y * z - w * x);
-    R[6] = 2 * (x * z - w * y), R[7] = 2 * (y * z + w * x), R[8] = 1 - 2 * (x * x + y * y);
 }
 
 void mat_to_quat(const double R[9], double q[4])
@@ -104,37 +52,6 @@ void mat_to_quat(const double R[9], double q[4])
         for (int i = 0; i < 4; i++)
             q[i] = -q[i];
     quat_normalize(q);
-}
-
-void polar_rotation(const double F[9], double q[4], int max_iter, double tol, double R[9])
-{
-    quat_normalize(q);
-    for (int it = 0; it < max_iter; it++) {
-        quat_to_mat(q, R);
-        /* Columns of R and F; omega = sum r_i x f_i / (|sum r_i . f_i| + eps). */
-        double om[3] = {0, 0, 0}, dotsum = 0;
-        for (int c = 0; c < 3; c++) {
-            double r[3] = {R[c], R[3 + c], R[6 + c]}, f[3] = {F[c], F[3 + c], F[6 + c]}, rf[3];
-            v3_cross(r, f, rf);
-            om[0] += rf[0], om[1] += rf[1], om[2] += rf[2];
-            dotsum += v3_dot(r, f);
-        }
-        double s = 1.0 / (fabs(dotsum) + 1e-9);
-        om[0] *= s, om[1] *= s, om[2] *= s;
-        double angle = v3_norm(om);
-        if (angle < tol)
-            break;
-        double half = 0.5 * angle, sh = sin(half) / angle;
-        double dq[4] = {cos(half), om[0] * sh, om[1] * sh, om[2] * sh};
-        /* q <- dq * q */
-        double nq[4] = {dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
-                        dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
-                        dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
-                        dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]};
-        memcpy(q, nq, sizeof nq);
-        quat_normalize(q);
-    }
-    quat_to_mat(q, R);
 }
 
 void sym3_eigen(const double A[9], double w[3], double V[9])

@@ -9,11 +9,14 @@
  *                 [--reference key.path=value]... [--set key.path=value]...
  *                 [-o DIR] [-j JOBS] [-t THREADS] [-m MESH_DIR] [--tolerance F] [-q]
  *   cohfrac stability [--quick] [-o DIR] [-q]
+ *   cohfrac bench [--mesh NAME] [--steps N] [--repeats N] [--threads N]
+ *                 [--criterion none|source|traction] [--peer] [--scaling[=LIST]]
  *   cohfrac --help | --version
  *
  * Exit codes: 0 success, 1 usage, 2 bad input (mesh, surface, scene),
  * 3 diverged, 4 output not written, 5 external program or memory failure
  * (see include/cohfrac/error.h). */
+#include "cohfrac/bench.h"
 #include "cohfrac/compare.h"
 #include "cohfrac/error.h"
 #include "cohfrac/scene.h"
@@ -26,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #ifndef COHFRAC_VERSION
 #define COHFRAC_VERSION "0.0.0"
@@ -72,6 +76,17 @@ static const char usage[] =
     "      --quick                         the corners only (under a minute)\n"
     "      -o, --output DIR                report directory (default build/stability)\n"
     "      -q, --quiet                     no line per case\n"
+    "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 3.1 m/s)\n"
+    "                                      against the memory floor, 1 against N threads\n"
+    "      --mesh NAME                     prepared mesh or TetGen base (default bunny)\n"
+    "      --steps N                       timed steps per repeat (default 60)\n"
+    "      --repeats N                     repeats per thread count (default 3)\n"
+    "      --threads N                     the N of the N-thread runs (default: all cores)\n"
+    "      --criterion none|source|traction  insertion rule (default source)\n"
+    "      --peer                          also step Bullet's btSoftBody on the same mesh\n"
+    "      --scaling[=M1,M2,...]           step time and memory per tet over meshes (default\n"
+    "                                      bunny_small,bunny_50k,bunny,bunny_800k)\n"
+    "      -m, --mesh-dir DIR              as for 'run'\n"
     "  cohfrac --help | --version\n"
     "exit codes: 0 ok, 1 usage, 2 bad input, 3 diverged, 4 output failed, 5 external/memory\n";
 
@@ -344,6 +359,95 @@ static int cmd_study(int argc, char **argv)
     return rc;
 }
 
+/* The peer program beside this executable (built from bench/). */
+static char *peer_path(void)
+{
+    static char path[4096];
+    ssize_t n = readlink("/proc/self/exe", path, sizeof path - 64);
+    if (n <= 0)
+        return NULL;
+    path[n] = 0;
+    char *slash = strrchr(path, '/');
+    strcpy(slash ? slash + 1 : path, "cohfrac_softbody_peer");
+    return access(path, X_OK) == 0 ? path : NULL;
+}
+
+/* A whole number >= lo from an option's text, or -1 with a message. */
+static int count_arg(const char *opt, const char *text, int lo)
+{
+    char *end;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end || v < lo || v > 1000000) {
+        fprintf(stderr, "cohfrac: %s needs a whole number from %d to 1000000, got '%s'\n", opt,
+                lo, text);
+        return -1;
+    }
+    return (int)v;
+}
+
+static int cmd_bench(int argc, char **argv)
+{
+    enum { O_MESH = 256, O_STEPS, O_REPEATS, O_THREADS, O_CRITERION, O_PEER, O_SCALING, O_WARMUP };
+    static const struct option lo[] = {{"mesh", required_argument, 0, O_MESH},
+                                       {"steps", required_argument, 0, O_STEPS},
+                                       {"warmup", required_argument, 0, O_WARMUP},
+                                       {"repeats", required_argument, 0, O_REPEATS},
+                                       {"threads", required_argument, 0, O_THREADS},
+                                       {"criterion", required_argument, 0, O_CRITERION},
+                                       {"peer", no_argument, 0, O_PEER},
+                                       {"scaling", optional_argument, 0, O_SCALING},
+                                       {"mesh-dir", required_argument, 0, 'm'},
+                                       {0, 0, 0, 0}};
+    const char *env = getenv("COHFRAC_MESH_DIR");
+    cf_bench_options o = {.mesh = "bunny", .mesh_dir = env ? env : "build/meshes", .steps = 60,
+                          .warmup = 5, .repeats = 3, .criterion = CF_CRITERION_SOURCE,
+                          .log = stdout};
+    const char *scaling = NULL;
+    int c, peer = 0;
+    while ((c = getopt_long(argc, argv, "m:", lo, NULL)) != -1) {
+        switch (c) {
+        case O_MESH: o.mesh = optarg; break;
+        case O_STEPS: o.steps = count_arg("--steps", optarg, 1); break;
+        case O_WARMUP: o.warmup = count_arg("--warmup", optarg, 0); break;
+        case O_REPEATS: o.repeats = count_arg("--repeats", optarg, 1); break;
+        case O_THREADS: o.threads = count_arg("--threads", optarg, 1); break;
+        case O_CRITERION:
+            if (!strcmp(optarg, "none")) o.criterion = CF_CRITERION_NONE;
+            else if (!strcmp(optarg, "source")) o.criterion = CF_CRITERION_SOURCE;
+            else if (!strcmp(optarg, "traction")) o.criterion = CF_CRITERION_TRACTION;
+            else return usage_error("--criterion is none, source or traction");
+            break;
+        case O_PEER: peer = 1; break;
+        case O_SCALING: scaling = optarg ? optarg : "bunny_small,bunny_50k,bunny,bunny_800k"; break;
+        case 'm': o.mesh_dir = optarg; break;
+        default: return usage_error("bad option for 'bench'");
+        }
+        if (o.steps < 0 || o.warmup < 0 || o.repeats < 0 || o.threads < 0)
+            return cf_status_exit_code(CF_ERR_USAGE);
+    }
+    if (optind != argc)
+        return usage_error("'bench' takes no positional argument");
+    if (peer && !(o.peer = peer_path())) {
+        fprintf(stderr, "cohfrac: --peer needs cohfrac_softbody_peer beside this program (built "
+                        "from bench/ by cmake)\n");
+        return cf_status_exit_code(CF_ERR_EXTERNAL);
+    }
+    cf_error err = {0};
+    if (scaling) {
+        char *list = strdup(scaling), *save = NULL;
+        const char *meshes[32];
+        int n = 0;
+        for (char *t = strtok_r(list, ",", &save); t && n < 32; t = strtok_r(NULL, ",", &save))
+            meshes[n++] = t;
+        double b, bytes;
+        cf_status st = cf_bench_scaling(&o, meshes, n, &b, &bytes, &err);
+        free(list);
+        return st == CF_OK ? 0 : fail(&err);
+    }
+    cf_bench_result r;
+    return cf_bench_run(&o, &r, &err) == CF_OK ? 0 : fail(&err);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2)
@@ -366,5 +470,7 @@ int main(int argc, char **argv)
         return cmd_study(argc - 1, argv + 1);
     if (!strcmp(argv[1], "stability"))
         return cmd_stability(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "bench"))
+        return cmd_bench(argc - 1, argv + 1);
     return usage_error("unknown command");
 }

@@ -141,6 +141,7 @@ static const double IDENTITY_QUAT[4] = {1.0, 0.0, 0.0, 0.0};
 typedef struct loader {
     lua_State *L;
     const char *file;     /* scene path as given: every message starts with it */
+    const char *text;     /* the script itself, or NULL to read `file` */
     char dir[1024];       /* the scene file's directory: relative mesh paths start here */
     const char *mesh_dir; /* where prepared meshes live; may be NULL */
     const char *const *overrides;
@@ -1774,11 +1775,13 @@ static char *resolved_text(const cf_scene *s)
 static cf_status load(loader *ld)
 {
     lua_State *L = ld->L;
-    FILE *f = fopen(ld->file, "r");
     int rc;
-    if (!f)
-        return fail(ld, CF_ERR_FILE_OPEN, "cannot open the scene file: %s", strerror(errno));
-    fclose(f);
+    if (!ld->text) {
+        FILE *f = fopen(ld->file, "r");
+        if (!f)
+            return fail(ld, CF_ERR_FILE_OPEN, "cannot open the scene file: %s", strerror(errno));
+        fclose(f);
+    }
 
     lua_pushcfunction(L, open_sandbox);
     if (lua_pcall(L, 0, 0, 0) != LUA_OK)
@@ -1786,7 +1789,8 @@ static cf_status load(loader *ld)
 
     /* Mode "t": precompiled chunks bypass the parser's checks and can crash
      * the VM, so only source text is accepted. */
-    rc = luaL_loadfilex(L, ld->file, "t");
+    rc = ld->text ? luaL_loadbufferx(L, ld->text, strlen(ld->text), ld->file, "t")
+                  : luaL_loadfilex(L, ld->file, "t");
     if (rc == LUA_ERRFILE)
         return lua_failure(ld, CF_ERR_FILE_OPEN, NULL);
     if (rc == LUA_ERRMEM)
@@ -1826,8 +1830,10 @@ static cf_status load(loader *ld)
     return CF_OK;
 }
 
-cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
-                        const char *mesh_dir, cf_scene *out, cf_error *err)
+/* The loader behind cf_scene_load and cf_scene_load_text: `text` NULL
+ * reads the file `path`, otherwise `path` only names the text in messages. */
+static cf_status load_scene(const char *path, const char *text, const char *const *overrides,
+                            int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err)
 {
     loader ld;
     const char *slash;
@@ -1837,13 +1843,14 @@ cf_status cf_scene_load(const char *path, const char *const *overrides, int n_ov
     memset(out, 0, sizeof *out);
     memset(&ld, 0, sizeof ld);
     ld.file = path;
+    ld.text = text;
     ld.mesh_dir = mesh_dir;
     ld.overrides = overrides;
     ld.n_overrides = n_overrides;
     ld.s = out;
     ld.err = err;
 
-    slash = strrchr(path, '/');
+    slash = text ? NULL : strrchr(path, '/');
     if (!slash)
         snprintf(ld.dir, sizeof ld.dir, ".");
     else if (slash == path)
@@ -1861,6 +1868,19 @@ cf_status cf_scene_load(const char *path, const char *const *overrides, int n_ov
     if (st != CF_OK)
         cf_scene_free(out);
     return st;
+}
+
+cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
+                        const char *mesh_dir, cf_scene *out, cf_error *err)
+{
+    return load_scene(path, NULL, overrides, n_overrides, mesh_dir, out, err);
+}
+
+cf_status cf_scene_load_text(const char *name, const char *text, const char *const *overrides,
+                             int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err)
+{
+    assert(text);
+    return load_scene(name, text, overrides, n_overrides, mesh_dir, out, err);
 }
 
 void cf_scene_free(cf_scene *s)

@@ -164,7 +164,7 @@ static cf_status load_bodies(const cf_scene *sc, const char *mesh_dir, cf_mesh *
 /* Body of an input node (-1 for a node no tet uses). */
 static int node_body(const cf_solid *s, const int *body, int a)
 {
-    return s->vt_start[a] < s->vt_start[a + 1] ? body[s->vt_list[s->vt_start[a]]] : -1;
+    return s->vt_start[a] < s->vt_start[a + 1] ? body[s->vt_slot[s->vt_start[a]] / 4] : -1;
 }
 
 /* With a crack plane, only the interior facets on it may crack: mark the
@@ -479,7 +479,7 @@ void cf_sim_destroy(cf_sim *sim)
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
         cff_mesh_destroy(sim->obs.mesh[j]);
     free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
-    free(sim->body_boxes);
+    free(sim->body_boxes), free(sim->cand.v);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
     cf_solid_free(&sim->solid);
@@ -1074,10 +1074,11 @@ void cf_sim_memory(const cf_sim *sim, cf_memory *m)
     const unsigned long long D = sizeof(double), I = sizeof(int);
     unsigned long long cn = (unsigned long long)s->cap_nodes, nt = (unsigned long long)s->n_tets;
     memset(m, 0, sizeof *m);
-    m->solid = cn * (16 * D + 2 * I) + nt * (36 * D + 9 * I) +
+    m->solid = cn * (16 * D + 2 * I) + nt * (27 * D + 9 * I) +
                ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I;
     if (s->facet)
-        m->fracture = nt * 20 * I + (unsigned long long)s->n_facets * (1 + (s->candidate != NULL));
+        m->fracture = nt * (9 * D + 1 + 20 * I) + cn * (1 + D) +
+                      (unsigned long long)s->n_facets * (1 + (s->candidate != NULL));
     m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
     m->fragments = (unsigned long long)sim->cap_frag * sizeof(cf_fragment);
     for (int i = 0; i < sim->n_frag; i++) {
@@ -1100,6 +1101,33 @@ void cf_sim_memory(const cf_sim *sim, cf_memory *m)
                         (unsigned long long)fs->nv * (I + 3 * D) + 3ull * fs->ntri * I;
     }
     m->output = sim->output_peak;
+}
+
+void cf_sim_step_stats(const cf_sim *sim, cf_step_stats *o)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
+    memset(o, 0, sizeof *o);
+    o->fracture_steps = sim->steps_fracture;
+    o->stress = sim->prof.stress, o->insertion = sim->prof.insertion;
+    o->forces = sim->prof.forces, o->pbd = sim->prof.pbd;
+    for (int i = 0; i < sim->n_frag; i++) {
+        const cf_fragment *f = &sim->frag[i];
+        if (f->mode != CF_MODE_FRACTURE)
+            continue;
+        o->tets += f->nt, o->nodes += f->nodes.n, o->bars += f->bars.n, o->cohesive += f->coh.n;
+    }
+    o->iterations = set->constraints == CF_CONSTRAINTS_NONE ? 0 : set->iterations;
+    o->check = set->criterion != CF_CRITERION_NONE;
+    o->xpbd = set->constraints == CF_CONSTRAINTS_XPBD;
+}
+
+double cf_step_traffic(const cf_step_stats *st)
+{
+    double tet = 168 + (st->check ? 144 : 0);
+    double node = 104 + 48.0 * st->iterations;
+    double bar = (st->xpbd ? 40.0 : 16.0) * st->iterations;
+    return tet * st->tets + node * st->nodes + bar * st->bars +
+           2.0 * sizeof(cf_cohesive) * st->cohesive;
 }
 
 static void print_memory(const cf_sim *sim, FILE *out)

@@ -109,6 +109,7 @@ struct cf_sim {
     double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
     unsigned long long bullet_base; /* Bullet allocator bytes when the run was created */
     unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
+    cf_int_list cand;        /* facets that qualify at a check (scratch of the step) */
 };
 
 /* One step of the in-house solver on fragment f (source Table 6.2): with

@@ -105,8 +105,8 @@ static int build_vertex_tets(cf_solid *s)
 {
     int nv = s->n_verts0, nt = s->n_tets;
     s->vt_start = calloc((size_t)nv + 1, sizeof(int));
-    s->vt_list = malloc((size_t)nt * 4 * sizeof(int));
-    if (!s->vt_start || !s->vt_list)
+    s->vt_slot = malloc((size_t)nt * 4 * sizeof(int));
+    if (!s->vt_start || !s->vt_slot)
         return -1;
     for (int i = 0; i < 4 * nt; i++)
         s->vt_start[s->tet0[i] + 1]++;
@@ -118,7 +118,7 @@ static int build_vertex_tets(cf_solid *s)
     memcpy(fill, s->vt_start, (size_t)nv * sizeof(int));
     for (int t = 0; t < nt; t++) /* ascending tet order within each list */
         for (int j = 0; j < 4; j++)
-            s->vt_list[fill[s->tet0[4 * t + j]]++] = t;
+            s->vt_slot[fill[s->tet0[4 * t + j]]++] = 4 * t + j;
     free(fill);
     return 0;
 }
@@ -134,7 +134,11 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
 {
     if (s->facet)
         return CF_OK;
-    if (build_facets(s))
+    s->sigma = malloc((size_t)s->n_tets * 9 * sizeof(double));
+    s->hot = calloc((size_t)s->n_tets, 1);
+    s->node_mark = calloc((size_t)s->cap_nodes, 1);
+    s->nodal = malloc((size_t)s->cap_nodes * sizeof(double));
+    if (!s->sigma || !s->hot || !s->node_mark || !s->nodal || build_facets(s))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
                             s->n_tets);
     return CF_OK;
@@ -174,13 +178,12 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->Dm_inv = malloc((size_t)nt * 9 * sizeof(double));
     s->vol = malloc((size_t)nt * sizeof(double));
     s->rq = malloc((size_t)nt * 4 * sizeof(double));
-    s->sigma = calloc((size_t)nt * 9, sizeof(double));
     s->tf = calloc((size_t)nt * 12, sizeof(double));
     s->tw = calloc((size_t)nt, sizeof(double));
     s->bc = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet_frag = malloc((size_t)nt * sizeof(int));
     if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->origin || !s->tet ||
-        !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->sigma || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
+        !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
     }
@@ -231,8 +234,8 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 void cf_solid_free(cf_solid *s)
 {
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->origin, s->tet, s->tet0,
-                    s->Dm_inv, s->vol, s->rq, s->sigma, s->tf, s->tw, s->bc, s->tet_frag, s->facet,
-                    s->tet_facet, s->cracked, s->candidate, s->vt_start, s->vt_list, s->coh};
+                    s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->node_mark, s->nodal, s->tf, s->tw, s->bc, s->tet_frag, s->facet,
+                    s->tet_facet, s->cracked, s->candidate, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
     memset(s, 0, sizeof *s);
@@ -257,6 +260,11 @@ int cf_solid_copy_node(cf_solid *s, int n)
             grow((void **)&s->f, v3, cap) || grow((void **)&s->m, sizeof(double), cap) ||
             grow((void **)&s->origin, sizeof(int), cap) || grow((void **)&s->bc, sizeof(int), cap))
             return -1;
+        if (s->node_mark && (grow((void **)&s->node_mark, 1, cap) ||
+                             grow((void **)&s->nodal, sizeof(double), cap)))
+            return -1;
+        if (s->node_mark)
+            memset(s->node_mark + s->cap_nodes, 0, (size_t)(cap - s->cap_nodes));
         s->cap_nodes = cap;
     }
     int k = s->n_nodes++;

@@ -48,7 +48,9 @@ typedef struct cf_solid {
     double *Dm_inv;           /* [nt][9] inverse rest edge matrix, 1/m */
     double *vol;              /* [nt] rest volume, m^3 */
     double *rq;               /* [nt][4] corotational rotation (warm start) */
-    double *sigma;            /* [nt][9] Cauchy stress at the last check, Pa */
+    double *sigma;            /* [nt][9] Cauchy stress at the last check, Pa (fracture state) */
+    unsigned char *hot;       /* [nt] may qualify for insertion at the last check
+                                 (cf_stress_check; fracture state) */
     double *tf;               /* [nt][12] internal force on each slot, N */
     double *tw;               /* [nt] strain energy at the last force pass, J */
     int *tet_frag;            /* [nt] fragment id */
@@ -58,7 +60,11 @@ typedef struct cf_solid {
     int *tet_facet;           /* [nt][4] facet of face k */
     unsigned char *cracked;   /* [nf] */
     unsigned char *candidate; /* [nf] may crack (NULL: every interior facet) */
-    int *vt_start, *vt_list;  /* original vertex -> tets (CSR, ascending) */
+    unsigned char *node_mark; /* [cap_nodes] scratch of the source criterion, all 0 between
+                                 checks (fracture state) */
+    double *nodal;            /* [cap_nodes] its nodal values, Pa (fracture state) */
+    int *vt_start, *vt_slot;  /* original vertex -> its slots 4 t + j in the tets that
+                                 hold it (CSR, ascending t) */
 
     int n_coh, cap_coh;
     cf_cohesive *coh;
@@ -73,8 +79,8 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
                         const int *tet_body, cf_error *err);
 void cf_solid_free(cf_solid *s);
 
-/* The facets (interior and boundary faces), each tet face's facet and the
- * crack flags: the fracture state, built only for a scene that may insert
+/* The facets (interior and boundary faces), each tet face's facet, the
+ * crack flags and the stress of the checks: the fracture state, built only for a scene that may insert
  * cohesive elements (criterion other than "none").  Errors: CF_ERR_NOMEM. */
 cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
 

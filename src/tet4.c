@@ -13,7 +13,7 @@ void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3])
 }
 
 /* Deformation gradient F = Ds Dm^-1 of tet t at positions x. */
-static void deformation_gradient(const cf_solid *s, int t, double F[9])
+static inline void deformation_gradient(const cf_solid *s, int t, double F[9])
 {
     const int *T = &s->tet[4 * t];
     const double *x0 = &s->x[3 * T[0]];
@@ -27,7 +27,7 @@ static void deformation_gradient(const cf_solid *s, int t, double F[9])
 }
 
 /* Strain (symmetric part minus identity) -> linear elastic stress. */
-static void hooke(const cf_solid *s, const double A[9], double sig[9], double *energy_density)
+static inline void hooke(const cf_solid *s, const double A[9], double sig[9], double *energy_density)
 {
     double eps[9];
     for (int i = 0; i < 3; i++)
@@ -39,14 +39,13 @@ static void hooke(const cf_solid *s, const double A[9], double sig[9], double *e
         sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : 0);
         w += 0.5 * sig[k] * eps[k];
     }
-    if (energy_density)
-        *energy_density = w;
+    *energy_density = w;
 }
 
 /* Stress in the element frame from the deformation gradient F, the
  * rotation that takes it to the world, and the strain energy density. */
-static void element_stress(const cf_solid *s, const double F[9], cf_elasticity kind, double q[4],
-                           double R[9], double sig[9], double *w)
+static inline void element_stress(const cf_solid *s, const double F[9], cf_elasticity kind,
+                                  double q[4], double R[9], double sig[9], double *w)
 {
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         double S[9];
@@ -61,20 +60,32 @@ static void element_stress(const cf_solid *s, const double F[9], cf_elasticity k
     }
 }
 
-int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int want_stress)
+/* Gershgorin bounds of a symmetric 3x3 matrix's eigenvalues: every one
+ * lies in [lo, hi].  The element-frame and world-frame stresses are similar
+ * matrices, so these bound the world stress's principal values too. */
+static inline void gershgorin(const double A[9], double *lo, double *hi)
 {
-    int inverted = 0;
+    double r0 = fabs(A[1]) + fabs(A[2]), r1 = fabs(A[1]) + fabs(A[5]),
+           r2 = fabs(A[2]) + fabs(A[5]);
+    *hi = fmax(A[0] + r0, fmax(A[4] + r1, A[8] + r2));
+    *lo = fmin(A[0] - r0, fmin(A[4] - r1, A[8] - r2));
+}
+
+int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
+                   const cf_stress_check *check, int *n_hot)
+{
+    int inverted = 0, hot = 0;
     /* Threads only for fragments large enough to repay the fork and join:
      * hundreds of few-tet fragments in fracture mode ran slower on 2
      * threads than on 1. */
-#pragma omp parallel for schedule(static) reduction(+ : inverted) if (nt >= CF_TET4_PARALLEL_MIN)
+#pragma omp parallel for schedule(static) reduction(+ : inverted, hot) if (nt >= CF_TET4_PARALLEL_MIN)
     for (int i = 0; i < nt; i++) {
         int t = tets[i];
-        double R[9], sig[9], P[9], g[4][3], F[9];
+        double R[9], sig[9], P[9], g[4][3], F[9], w;
         deformation_gradient(s, t, F);
         inverted += m3_det(F) <= 0;
-        element_stress(s, F, kind, &s->rq[4 * t], R, sig, &s->tw[t]);
-        s->tw[t] *= s->vol[t];
+        element_stress(s, F, kind, &s->rq[4 * t], R, sig, &w);
+        s->tw[t] = w * s->vol[t];
         m3_mul(R, sig, P); /* f_i = -V R sigma grad N_i */
         cf_tet4_gradients(s, t, g);
         double *tf = &s->tf[12 * t];
@@ -84,19 +95,43 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int
             for (int c = 0; c < 3; c++)
                 tf[3 * a + c] = -s->vol[t] * fa[c];
         }
-        if (want_stress)
+        if (check) {
+            double lo, hi;
             m3_mul_nt(P, R, &s->sigma[9 * t]); /* R sigma R^T */
+            gershgorin(sig, &lo, &hi);
+            s->hot[t] = hi >= check->s1 || 0.5 * (hi - lo) >= check->tau;
+            hot += s->hot[t];
+        }
     }
+    if (n_hot)
+        *n_hot = hot;
     return inverted;
 }
 
-void cf_tet4_scatter(cf_solid *s, const int *tets, int nt)
+void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9])
 {
-    for (int i = 0; i < nt; i++) {
-        int t = tets[i];
-        const double *tf = &s->tf[12 * t];
-        for (int a = 0; a < 4; a++)
-            v3_axpy(1.0, &tf[3 * a], &s->f[3 * s->tet[4 * t + a]]);
+    double F[9], R[9], sig[9], P[9], w, q[4];
+    for (int k = 0; k < 4; k++)
+        q[k] = s->rq[4 * t + k];
+    deformation_gradient(s, t, F);
+    element_stress(s, F, kind, q, R, sig, &w);
+    m3_mul(R, sig, P);
+    m3_mul_nt(P, R, sigma);
+}
+
+void cf_tet4_gather(cf_solid *s, const int *nodes, int nn, const double g[3])
+{
+#pragma omp parallel for schedule(static) if (nn >= CF_TET4_PARALLEL_MIN / 4)
+    for (int i = 0; i < nn; i++) {
+        int a = nodes[i], o = s->origin[a];
+        double *fa = &s->f[3 * a];
+        for (int k = 0; k < 3; k++)
+            fa[k] = s->m[a] * g[k];
+        for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
+            int slot = s->vt_slot[j];
+            if (s->tet[slot] == a)
+                v3_axpy(1.0, &s->tf[3 * slot], fa);
+        }
     }
 }
 

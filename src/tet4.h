@@ -16,16 +16,34 @@ void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3]);
 /* Fragments of fewer tets than this are done on one thread. */
 #define CF_TET4_PARALLEL_MIN 4096
 
-/* For each tet of the list: internal nodal forces into s->tf ([4][3] per
- * tet, N), strain energy V (1/2 sigma : eps) into s->tw (J) and, when
- * `want_stress`, the world-frame Cauchy stress into s->sigma (Pa).  Parallel
- * over tets (OpenMP) from CF_TET4_PARALLEL_MIN tets on; each tet writes only its own slots, so the result does
- * not depend on the thread count.  Returns the number of inverted tets
- * (det F <= 0). */
-int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind, int want_stress);
+/* The insertion criterion's bound (insertion.h): a tet is "hot" when the
+ * upper bound of its largest principal stress reaches s1 (Pa), or the bound
+ * of its largest shear stress (half the spread of the principal values)
+ * reaches tau (Pa; INFINITY: not checked).  A facet can qualify for
+ * insertion only near a hot tet, so with no hot tet the check costs nothing. */
+typedef struct cf_stress_check {
+    double s1, tau;
+} cf_stress_check;
 
-/* Add the per-tet forces to the nodes: f[node] += tf[slot], in list order. */
-void cf_tet4_scatter(cf_solid *s, const int *tets, int nt);
+/* For each tet of the list: internal nodal forces into s->tf ([4][3] per
+ * tet, N) and strain energy V (1/2 sigma : eps) into s->tw (J).  With
+ * `check` (a check is due; needs the fracture state of
+ * cf_solid_init_facets), also the world-frame Cauchy stress into s->sigma
+ * (Pa) and s->hot (0/1) per tet, and the number of hot tets into *n_hot.
+ * Parallel over tets (OpenMP) from CF_TET4_PARALLEL_MIN tets on; each tet
+ * writes only its own slots, so the result does not depend on the thread
+ * count.  Returns the number of inverted tets (det F <= 0). */
+int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
+                   const cf_stress_check *check, int *n_hot);
+
+/* World-frame Cauchy stress of tet t at the current positions (Pa), from
+ * the rotation warm start (not updated). */
+void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9]);
+
+/* Nodal forces of the listed nodes: f = m g + the tf slots of the tets
+ * that hold the node, added in ascending tet order (the same sum for any
+ * thread count; parallel over nodes). g: gravity, m/s^2. */
+void cf_tet4_gather(cf_solid *s, const int *nodes, int nn, const double g[3]);
 
 /* Elastic strain energy of the listed tets (J), from the last force pass. */
 double cf_tet4_strain_energy(const cf_solid *s, const int *tets, int nt);

@@ -10,6 +10,7 @@
 #include "fragments.h"
 #include "insertion.h"
 #include "linalg.h"
+#include "tet4.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -140,11 +141,14 @@ static void test_criterion_selects_facets_normal_to_tension(void **state)
     for (int t = 0; t < s.n_tets; t++) {
         memset(&s.sigma[9 * t], 0, 9 * sizeof(double));
         s.sigma[9 * t] = 1.5 * mat.sigma_max;
+        s.hot[t] = 1;
     }
-    int *all = malloc((size_t)s.n_tets * sizeof(int)), *out = malloc((size_t)s.n_tets * 4 * sizeof(int));
+    int *all = malloc((size_t)s.n_tets * sizeof(int));
+    cf_int_list cand = {0};
     for (int t = 0; t < s.n_tets; t++)
         all[t] = t;
-    int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, out);
+    int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, &cand);
+    const int *out = cand.v;
     assert_true(n > 0);
     int normal_x = 0;
     for (int i = 0; i < n; i++) {
@@ -163,8 +167,51 @@ static void test_criterion_selects_facets_normal_to_tension(void **state)
         assert_false(fabs(zs[0] - zs[1]) < 1e-12 && fabs(zs[1] - zs[2]) < 1e-12);
     }
     assert_int_equal(normal_x, 2 * 4); /* interior plane x = 0.5: 4 cell faces, 2 triangles each */
-    free(all), free(out);
+    free(all), free(cand.v);
     cf_solid_free(&s), cf_mesh_free(&m);
+}
+
+/* The tet-level bound (Gershgorin, cf_insertion_bound) never drops a facet
+ * that the full rule takes: under a random deformation, the candidates with
+ * the hot flags of cf_tet4_forces equal those with every tet marked hot,
+ * for both rules, at strengths where some but not all facets qualify. */
+static void test_bound_never_misses_a_facet(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 3, 3, 3, 1, 1, 1);
+    static const cf_criterion rules[] = {CF_CRITERION_SOURCE, CF_CRITERION_TRACTION};
+    int partial = 0, some = 0;
+    for (int r = 0; r < 2; r++)
+        for (int level = 0; level < 4; level++) {
+            cf_solid s;
+            init(&s, &m);
+            for (int i = 0; i < s.n_nodes; i++)
+                for (int k = 0; k < 3; k++)
+                    s.x[3 * i + k] += 0.02 * sin(12.9898 * i + 78.233 * k);
+            /* strengths from a fifth to 1.6 times E times the displacement scale */
+            s.mat.sigma_max = s.mat.tau_max = 0.2 * (1 << level) * 0.02 * s.mat.E;
+            int *all = malloc((size_t)s.n_tets * sizeof(int)), n_hot = 0;
+            for (int t = 0; t < s.n_tets; t++)
+                all[t] = t;
+            cf_stress_check bound = cf_insertion_bound(&s.mat, rules[r]);
+            cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, &bound, &n_hot);
+            cf_int_list a = {0}, b = {0};
+            int na = cf_insertion_candidates(&s, all, s.n_tets, rules[r], n_hot, &a);
+            memset(s.hot, 1, (size_t)s.n_tets);
+            int nb = cf_insertion_candidates(&s, all, s.n_tets, rules[r], s.n_tets, &b);
+            printf("FIGURE bound: rule %d level %d: %d of %d tets hot, %d candidates\n", r, level,
+                   n_hot, s.n_tets, na);
+            assert_int_equal(na, nb);
+            partial += n_hot > 0 && n_hot < s.n_tets;
+            some += na > 0 && n_hot < s.n_tets;
+            for (int i = 0; i < na; i++)
+                assert_int_equal(a.v[i], b.v[i]);
+            free(all), free(a.v), free(b.v);
+            cf_solid_free(&s);
+        }
+    assert_true(partial >= 2 && some >= 1); /* the bound really skipped tets */
+    cf_mesh_free(&m);
 }
 
 int main(void)
@@ -173,6 +220,7 @@ int main(void)
         cmocka_unit_test(test_two_tets_split_into_two_fragments),
         cmocka_unit_test(test_box_split_along_a_plane),
         cmocka_unit_test(test_criterion_selects_facets_normal_to_tension),
+        cmocka_unit_test(test_bound_never_misses_a_facet),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "sim.h"
+#include "tet4.h"
 #include "verify.h"
 
 /* Mean axial stress (Pa) of the tets whose centroid lies in [x0, x1]. */
@@ -21,8 +22,11 @@ static double gauge_stress(const cf_sim *sim, double x0, double x1)
         double c = 0;
         for (int j = 0; j < 4; j++)
             c += 0.25 * s->X[3 * s->tet[4 * t + j]];
-        if (c >= x0 && c <= x1)
-            sum += s->sigma[9 * t] * s->vol[t], vol += s->vol[t];
+        if (c >= x0 && c <= x1) {
+            double sig[9];
+            cf_tet4_stress(s, t, sim->scene->solver.elasticity, sig);
+            sum += sig[0] * s->vol[t], vol += s->vol[t];
+        }
     }
     return sum / vol;
 }

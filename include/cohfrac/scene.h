@@ -255,6 +255,12 @@ typedef struct cf_scene {
 cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
                         const char *mesh_dir, cf_scene *out, cf_error *err);
 
+/* The same for a scene script held in memory: `name` stands for the file in
+ * messages, and relative paths start at the working directory.  Errors as
+ * cf_scene_load, without CF_ERR_FILE_OPEN for the script itself. */
+cf_status cf_scene_load_text(const char *name, const char *text, const char *const *overrides,
+                             int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err);
+
 /* Free what cf_scene_load allocated and zero *s.  NULL and an already
  * freed (zeroed) scene are fine. */
 void cf_scene_free(cf_scene *s);

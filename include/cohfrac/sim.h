@@ -141,6 +141,38 @@ typedef struct cf_memory {
 
 void cf_sim_memory(const cf_sim *sim, cf_memory *m);
 
+/* The fracture-mode step so far, for benchmarks: steps taken, wall time
+ * per stage (s, as in the run summary), and the sizes of what the step
+ * works on now (fracture-mode fragments only). */
+typedef struct cf_step_stats {
+    long fracture_steps;
+    double stress, insertion, forces, pbd; /* s of wall time since creation */
+    int tets, nodes, bars, cohesive;       /* in fracture mode now */
+    int iterations;                        /* constraint iterations per step */
+    int check;                             /* 1: the insertion criterion is checked */
+    int xpbd;                              /* 1: XPBD bars (compliance, multipliers) */
+} cf_step_stats;
+
+void cf_sim_step_stats(const cf_sim *sim, cf_step_stats *out);
+
+/* The traffic model (docs/performance.md): the bytes one fracture-mode
+ * step must move between memory and the cores at the least, each array
+ * the step needs read or written once per pass that needs it, from the
+ * sizes in `st`:
+ *   per tet:  node indices 16 + inverse rest shape 72 + volume 8 + rotation
+ *             warm start read and written 64 + strain energy 8 = 168 B;
+ *             plus, when the criterion is checked, the stress written
+ *             72 B and read back 72 B by the criterion
+ *   per node: position and velocity read and written 96 + lumped mass 8 =
+ *             104 B, and the prediction read and written in every
+ *             constraint iteration, 48 B each
+ *   per bar:  node pair 8 + rest length 8 read in every constraint
+ *             iteration; XPBD also compliance 8 and the multiplier read
+ *             and written 16
+ *   per cohesive element: its state read and written, 2 sizeof(cf_cohesive)
+ * Returns bytes per step. */
+double cf_step_traffic(const cf_step_stats *st);
+
 void cf_sim_print_summary(const cf_sim *sim, FILE *out);
 void cf_sim_destroy(cf_sim *sim);
 

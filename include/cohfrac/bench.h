@@ -1,0 +1,78 @@
+/* cohfrac — the fracture-mode step benchmark (`cohfrac bench`, `make bench`).
+ *
+ * The scene: a prepared mesh (default "bunny", 203k tets) rotated y-up to
+ * z-up as in scenes/bunny_drop.lua, its lowest point on a rigid plane,
+ * moving into it at 3.1 m/s (the bunny drop's impact speed) with the
+ * bunny drop's material (E 0.6 Pa, nu 0.23, rho 2400 kg/m^3, sigma_max
+ * 0.1 mPa, G_I 22 N/m) and solver (dt 5 us, PBD k 0.9, 3 iterations), in
+ * fracture mode only, so that cohesive insertion really happens under
+ * criterion "source" or "traction".  Every repeat builds the scene anew and
+ * times `steps` fracture steps after `warmup` untimed ones; stage times are
+ * the run profile's (stress, insertion, forces, PBD).
+ *
+ * In the same run it measures the machine's memory bandwidth with a
+ * STREAM-like triad a = b + s c over three arrays of CF_BENCH_TRIAD_MB MiB
+ * each (far beyond the last-level cache), counting 24 bytes per element,
+ * best of 5, at the step's thread count; the floor is the traffic model's
+ * bytes (cf_sim_step_traffic in sim.h, docs/performance.md) over that
+ * bandwidth.
+ *
+ * Times are min and median over the repeats (wall clock), with the process
+ * CPU time per step beside them; runs at 1 thread and at `threads` are
+ * interleaved (1, N, 1, N, ...) so that a load on the machine hits both. */
+#ifndef COHFRAC_BENCH_H
+#define COHFRAC_BENCH_H
+
+#include <stdio.h>
+
+#include "cohfrac/error.h"
+#include "cohfrac/scene.h"
+
+#define CF_BENCH_TRIAD_MB 256
+
+typedef struct cf_bench_options {
+    const char *mesh;       /* prepared mesh name or TetGen base path ["bunny"] */
+    const char *mesh_dir;   /* where prepared meshes live */
+    int steps;              /* timed fracture steps per repeat [60] */
+    int warmup;             /* untimed steps before them [5] */
+    int repeats;            /* per thread count [3] */
+    int threads;            /* N of the N-thread runs; 0: all cores */
+    cf_criterion criterion; /* [CF_CRITERION_SOURCE] */
+    const char *peer;       /* path of the btSoftBody peer program, or NULL for none */
+    FILE *log;              /* progress and tables (stdout), or NULL */
+} cf_bench_options;
+
+/* One timed configuration: ms per step (min, median over repeats), CPU ms
+ * per step (median), stage shares (median repeat), insertions per repeat. */
+typedef struct cf_bench_timing {
+    double ms_min, ms_median, cpu_ms;
+    double stress, insertion, forces, pbd; /* ms per step, median repeat */
+    long insertions;
+} cf_bench_timing;
+
+typedef struct cf_bench_result {
+    int tets, nodes, bars;
+    double bytes;           /* traffic model, bytes per step */
+    double bw_1t, bw_nt;    /* triad bandwidth, bytes/s, 1 and N threads */
+    int threads;
+    cf_bench_timing t1, tn; /* 1 thread, N threads */
+    double floor_ms;        /* bytes / bw_nt */
+    double ratio;           /* tn.ms_min / floor_ms */
+    double speedup;         /* t1.ms_min / tn.ms_min */
+    double peer_ms;         /* btSoftBody ms per step (min), 0 when not run */
+    double peer_ratio;      /* peer_ms / t1.ms_min: one core each */
+    double memory_per_tet;  /* engine memory (cf_sim_memory) / tets, bytes */
+} cf_bench_result;
+
+/* Run the benchmark.  Errors: those of loading the mesh and building the
+ * scene, CF_ERR_EXTERNAL (the peer failed), CF_ERR_NOMEM. */
+cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *err);
+
+/* Scaling: the step (criterion "none", N threads, min of `repeats`) on each
+ * of `n` meshes; prints a table (tets, ms per step, ns per tet-step, bytes
+ * of engine memory per tet) and the least-squares exponent b of
+ * ms = a tets^b.  Writes the exponent and the largest bytes per tet. */
+cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes, int n,
+                           double *exponent, double *bytes_per_tet, cf_error *err);
+
+#endif

@@ -1,0 +1,330 @@
+/* `cohfrac bench`: the fracture-mode step against the memory floor, the
+ * thread speed-up and the btSoftBody peer (include/cohfrac/bench.h). */
+#include "cohfrac/bench.h"
+
+#include "clock.h"
+#include "cohfrac/mesh.h"
+#include "cohfrac/sim.h"
+#include "file_text.h"
+#include "process.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char *criterion_name[] = {"traction", "source", "none"};
+
+static double cpu_time(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* STREAM-like triad a = b + s c on `threads` threads: bytes/s (24 per
+ * element), best of 5; 0 when the arrays cannot be had. */
+static double triad_bandwidth(int threads)
+{
+    size_t n = (size_t)CF_BENCH_TRIAD_MB * 1048576 / sizeof(double);
+    double *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b), *c = malloc(n * sizeof *c);
+    double best = INFINITY;
+    if (a && b && c) {
+        omp_set_num_threads(threads);
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) /* first touch by the threads that use them */
+            a[i] = 0, b[i] = 1, c[i] = 2;
+        for (int r = 0; r < 5; r++) {
+            double t0 = cf_wall_time();
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++)
+                a[i] = b[i] + 3.0 * c[i];
+            best = fmin(best, cf_wall_time() - t0);
+        }
+    }
+    int ok = a && b && c && a[n / 2] == 7.0;
+    free(a), free(b), free(c);
+    return ok ? 24.0 * (double)n / best : 0;
+}
+
+static int by_value(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, by_value);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The bench scene for `mesh` under `criterion`: the half height of the
+ * mesh along its y axis (z once rotated) puts its lowest point on the plane. */
+static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_criterion criterion,
+                            cf_scene *sc, cf_error *err)
+{
+    static const char *fmt =
+        "return {\n"
+        "  name = 'bench', duration = 1, gravity = {0, 0, -9.81},\n"
+        "  material = {E = 0.6, nu = 0.23, rho = 2400, G_I = 22, sigma_max = 1e-4, alpha = 2,\n"
+        "              friction = 0.5, restitution = 0},\n"
+        "  bodies = {{mesh = [==[%s]==], orientation = {0.7071067811865476, 0.7071067811865476, 0, "
+        "0},\n"
+        "             position = {0, 0, 0}, velocity = {0, 0, -3.1}}},\n"
+        "  obstacles = {{type = 'plane', point = {0, 0, %.17g}, normal = {0, 0, 1}}},\n"
+        "  solver = {mode = 'fracture', dt_rigid = 5e-6, dt_fracture = 5e-6, criterion = '%s',\n"
+        "            pbd = {k_stiffness = 0.9, iterations = 3, k_damping = 1}},\n"
+        "  output = {file = ''},\n"
+        "}\n";
+    /* The scene's mesh lookup first, then the mesh itself for its extent. */
+    char text[4096];
+    snprintf(text, sizeof text, fmt, mesh, 0.0, criterion_name[criterion]);
+    cf_status st = cf_scene_load_text("bench scene", text, NULL, 0, o->mesh_dir, sc, err);
+    if (st != CF_OK)
+        return st;
+    cf_mesh m;
+    st = cf_mesh_load_tetgen(sc->bodies[0].mesh, &m, err);
+    if (st != CF_OK) {
+        cf_scene_free(sc);
+        return st;
+    }
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < m.n_nodes; i++)
+        lo = fmin(lo, m.x[3 * i + 1]), hi = fmax(hi, m.x[3 * i + 1]);
+    cf_mesh_free(&m);
+    cf_scene_free(sc);
+    snprintf(text, sizeof text, fmt, mesh, -0.5 * (hi - lo), criterion_name[criterion]);
+    return cf_scene_load_text("bench scene", text, NULL, 0, o->mesh_dir, sc, err);
+}
+
+typedef struct sample {
+    double ms, cpu_ms, stress, insertion, forces, pbd; /* per step */
+    long insertions;
+    cf_step_stats stats;
+    double memory; /* engine bytes */
+} sample;
+
+/* One repeat: build the world, `warmup` steps, then `steps` timed ones. */
+static cf_status time_steps(const cf_bench_options *o, const cf_scene *sc, int threads,
+                            sample *out, cf_error *err)
+{
+    cf_run_options ro = {.progress = 0, .threads = threads, .mesh_dir = o->mesh_dir};
+    cf_sim *sim = NULL;
+    cf_status st = cf_sim_create(sc, &ro, &sim, err);
+    for (int k = 0; st == CF_OK && k < o->warmup; k++)
+        st = cf_sim_advance(sim, err);
+    cf_step_stats a, b;
+    if (st == CF_OK)
+        cf_sim_step_stats(sim, &a);
+    double w0 = cf_wall_time(), c0 = cpu_time();
+    for (int k = 0; st == CF_OK && k < o->steps; k++)
+        st = cf_sim_advance(sim, err);
+    double wall = cf_wall_time() - w0, cpu = cpu_time() - c0;
+    if (st == CF_OK) {
+        cf_sim_step_stats(sim, &b);
+        double n = (double)(b.fracture_steps - a.fracture_steps);
+        out->ms = 1e3 * wall / n, out->cpu_ms = 1e3 * cpu / n;
+        out->stress = 1e3 * (b.stress - a.stress) / n;
+        out->insertion = 1e3 * (b.insertion - a.insertion) / n;
+        out->forces = 1e3 * (b.forces - a.forces) / n;
+        out->pbd = 1e3 * (b.pbd - a.pbd) / n;
+        out->insertions = b.cohesive - a.cohesive;
+        out->stats = b;
+        cf_memory m;
+        cf_sim_memory(sim, &m);
+        out->memory = (double)(m.solid + m.fracture + m.cohesive + m.fragments + m.collision);
+    }
+    cf_sim_destroy(sim);
+    return st;
+}
+
+/* The peer on the same mesh, steps and dt: its ms per step (min), or a
+ * negative number when it failed (the log is kept and named). */
+static double run_peer(const cf_bench_options *o, const cf_scene *sc, cf_error *err)
+{
+    char log[] = "/tmp/cohfrac_peer_XXXXXX", steps[32], dt[32];
+    int fd = mkstemp(log);
+    if (fd < 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL, "cannot create a log for the peer"), -1;
+    close(fd);
+    snprintf(steps, sizeof steps, "%d", o->steps);
+    snprintf(dt, sizeof dt, "%.17g", sc->solver.dt_fracture);
+    char *argv[] = {(char *)o->peer, (char *)sc->bodies[0].mesh, "--steps", steps, "--dt", dt,
+                    "--iterations", "3", NULL};
+    pid_t pid;
+    int status = 0;
+    if (cf_spawn(argv, log, &pid) != 0 || cf_wait(pid, &status, NULL) < 0 ||
+        !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        cf_error_set(err, CF_ERR_EXTERNAL, "the btSoftBody peer %s failed: see %s", o->peer, log);
+        return -1;
+    }
+    char *text = cf_file_read(log, NULL);
+    const char *line = text ? strstr(text, "peer: ") : NULL;
+    const char *ms = line ? strstr(line, "ms_min=") : NULL;
+    double v = ms ? atof(ms + 7) : -1;
+    free(text);
+    if (v <= 0)
+        return cf_error_set(err, CF_ERR_EXTERNAL, "no 'peer:' line from %s: see %s", o->peer,
+                            log), -1;
+    unlink(log);
+    return v;
+}
+
+static void summarize(sample *s, int n, cf_bench_timing *t)
+{
+    double v[64];
+    for (int i = 0; i < n; i++)
+        v[i] = s[i].ms;
+    qsort(v, (size_t)n, sizeof *v, by_value);
+    t->ms_min = v[0];
+    t->ms_median = median(v, n);
+    int mid = 0; /* the repeat whose time is the median: its stage split */
+    for (int i = 0; i < n; i++)
+        if (fabs(s[i].ms - t->ms_median) < fabs(s[mid].ms - t->ms_median))
+            mid = i;
+    for (int i = 0; i < n; i++)
+        v[i] = s[i].cpu_ms;
+    t->cpu_ms = median(v, n);
+    t->stress = s[mid].stress, t->insertion = s[mid].insertion;
+    t->forces = s[mid].forces, t->pbd = s[mid].pbd, t->insertions = s[mid].insertions;
+}
+
+static void print_row(FILE *f, const char *what, const cf_bench_timing *t, int tets)
+{
+    fprintf(f, "  %-10s %8.2f %9.2f %8.2f %9.1f %8.2f %9.2f %7.2f %7.2f %10ld\n", what, t->ms_min,
+            t->ms_median, t->cpu_ms, 1e6 * t->ms_min / tets, t->stress, t->insertion, t->forces,
+            t->pbd, t->insertions);
+}
+
+cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *err)
+{
+    memset(r, 0, sizeof *r);
+    int nt = o->threads > 0 ? o->threads : omp_get_num_procs();
+    int reps = o->repeats < 1 ? 1 : o->repeats > 64 ? 64 : o->repeats;
+    FILE *log = o->log;
+    cf_scene sc;
+    cf_status st = make_scene(o, o->mesh, o->criterion, &sc, err);
+    if (st != CF_OK)
+        return st;
+    r->threads = nt;
+    r->bw_1t = triad_bandwidth(1);
+    r->bw_nt = triad_bandwidth(nt);
+    if (log)
+        fprintf(log,
+                "cohfrac bench: mesh %s, criterion %s, %d steps x %d repeats after %d warm-up "
+                "steps, dt %.3g s\n"
+                "memory bandwidth (triad, 3 x %d MiB): 1 thread %.1f GB/s, %d threads %.1f GB/s\n",
+                o->mesh, criterion_name[o->criterion], o->steps, reps, o->warmup,
+                sc.solver.dt_fracture, CF_BENCH_TRIAD_MB, r->bw_1t / 1e9, nt, r->bw_nt / 1e9);
+    sample s1[64], sn[64];
+    double peer[64];
+    int np = 0;
+    for (int i = 0; i < reps && st == CF_OK; i++) {
+        st = time_steps(o, &sc, 1, &s1[i], err);
+        if (st == CF_OK)
+            st = time_steps(o, &sc, nt, &sn[i], err);
+        if (st == CF_OK && o->peer) {
+            peer[np] = run_peer(o, &sc, err);
+            st = peer[np++] > 0 ? CF_OK : CF_ERR_EXTERNAL;
+        }
+        if (st == CF_OK && log) {
+            fprintf(log, "repeat %d/%d: 1 thread %.2f ms, %d threads %.2f ms", i + 1, reps,
+                    s1[i].ms, nt, sn[i].ms);
+            if (o->peer)
+                fprintf(log, ", btSoftBody %.2f ms", peer[np - 1]);
+            fprintf(log, " per step\n");
+            fflush(log);
+        }
+    }
+    if (st != CF_OK) {
+        cf_scene_free(&sc);
+        return st;
+    }
+    cf_step_stats *z = &sn[0].stats;
+    r->tets = z->tets, r->nodes = z->nodes, r->bars = z->bars;
+    r->bytes = cf_step_traffic(z);
+    summarize(s1, reps, &r->t1);
+    summarize(sn, reps, &r->tn);
+    r->floor_ms = r->bw_nt > 0 ? 1e3 * r->bytes / r->bw_nt : 0;
+    r->ratio = r->floor_ms > 0 ? r->tn.ms_min / r->floor_ms : 0;
+    r->speedup = r->t1.ms_min / r->tn.ms_min;
+    r->memory_per_tet = sn[0].memory / z->tets;
+    if (np) {
+        qsort(peer, (size_t)np, sizeof *peer, by_value);
+        r->peer_ms = peer[0];
+        r->peer_ratio = r->peer_ms / r->t1.ms_min;
+    }
+    if (log) {
+        fprintf(log,
+                "solid: %d tets, %d nodes, %d bars in fracture mode at the end; engine memory %.0f "
+                "B per tet\n"
+                "traffic model: %.1f MB per step -> floor %.3f ms at %.1f GB/s (docs/performance.md)\n"
+                "  %-10s %8s %9s %8s %9s %8s %9s %7s %7s %10s\n",
+                r->tets, r->nodes, r->bars, r->memory_per_tet, r->bytes / 1e6, r->floor_ms,
+                r->bw_nt / 1e9, "threads", "min ms", "median ms", "CPU ms", "ns/tet", "stress",
+                "insertion", "forces", "PBD", "insertions");
+        char what[32];
+        print_row(log, "1", &r->t1, r->tets);
+        snprintf(what, sizeof what, "%d", nt);
+        print_row(log, what, &r->tn, r->tets);
+        fprintf(log, "  (stage columns: ms per step in the median repeat; insertions: cohesive "
+                     "elements inserted in the timed steps)\n");
+        if (np)
+            fprintf(log,
+                    "peer_ratio = %.2f (btSoftBody %.2f ms / cohfrac %.2f ms per step, both on 1 "
+                    "thread; min of %d)\n",
+                    r->peer_ratio, r->peer_ms, r->t1.ms_min, np);
+        fprintf(log, "bench: tets=%d step_ms=%.3f floor_ms=%.3f ratio=%.2f speedup_%dt=%.2f", r->tets,
+                r->tn.ms_min, r->floor_ms, r->ratio, nt, r->speedup);
+        if (np)
+            fprintf(log, " peer_ratio=%.2f", r->peer_ratio);
+        fputc('\n', log);
+    }
+    cf_scene_free(&sc);
+    return CF_OK;
+}
+
+cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes, int n,
+                           double *exponent, double *bytes_per_tet, cf_error *err)
+{
+    int nt = o->threads > 0 ? o->threads : omp_get_num_procs();
+    int reps = o->repeats < 1 ? 1 : o->repeats > 64 ? 64 : o->repeats;
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    FILE *log = o->log;
+    *bytes_per_tet = 0;
+    if (log)
+        fprintf(log, "cohfrac bench --scaling: criterion none, %d threads, %d steps, min of %d\n"
+                     "  %-28s %9s %9s %11s %13s\n",
+                nt, o->steps, reps, "mesh", "tets", "step ms", "ns/tet-step", "memory B/tet");
+    for (int i = 0; i < n; i++) {
+        cf_scene sc;
+        cf_status st = make_scene(o, meshes[i], CF_CRITERION_NONE, &sc, err);
+        double best = INFINITY;
+        sample s;
+        for (int k = 0; st == CF_OK && k < reps; k++) {
+            st = time_steps(o, &sc, nt, &s, err);
+            best = fmin(best, s.ms);
+        }
+        cf_scene_free(&sc);
+        if (st != CF_OK)
+            return st;
+        double tets = s.stats.tets, bpt = s.memory / tets;
+        *bytes_per_tet = fmax(*bytes_per_tet, bpt);
+        double x = log10(tets), y = log10(best);
+        sx += x, sy += y, sxx += x * x, sxy += x * y;
+        if (log) {
+            fprintf(log, "  %-28s %9d %9.2f %11.1f %13.0f\n", meshes[i], s.stats.tets, best,
+                    1e6 * best / tets, bpt);
+            fflush(log);
+        }
+    }
+    *exponent = n > 1 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 1;
+    if (log)
+        fprintf(log, "bench scaling: exponent=%.3f (ms ~ tets^b, least squares) bytes_per_tet=%.0f\n",
+                *exponent, *bytes_per_tet);
+    return CF_OK;
+}
