@@ -2,62 +2,165 @@
 
 #include "linalg.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 typedef struct {
-    int a, b;       /* ascending node pair */
-    double vol;     /* m^3, this tet's share */
-} edge;
+    int b;          /* the other end */
+    double vol;     /* m^3, tributary volume */
+} nbr;
 
-static int cmp_edge(const void *x, const void *y)
+/* The bars (a, b > a) of node a: every other node of the tets that hold a,
+ * merged per node with their tets' sixths of volume added in ascending tet
+ * order.  Writes them ascending in b into out (room for 3 x the star) and
+ * returns how many. */
+static int node_bars(const cf_solid *s, int a, nbr *out)
 {
-    const edge *e = x, *f = y;
-    if (e->a != f->a)
-        return e->a < f->a ? -1 : 1;
-    return (e->b > f->b) - (e->b < f->b);
+    int o = s->origin[a], n = 0;
+    for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
+        int slot = s->vt_slot[j], t = slot / 4;
+        if (s->tet[slot] != a)
+            continue;
+        for (int k = 0; k < 4; k++) {
+            int b = s->tet[4 * t + k];
+            if (b <= a)
+                continue;
+            /* insertion, stable: equal ends keep ascending tet order */
+            int i = n++;
+            for (; i > 0 && out[i - 1].b > b; i--)
+                out[i] = out[i - 1];
+            out[i] = (nbr){b, s->vol[t] / 6.0}; /* tributary volume: a sixth per edge */
+        }
+    }
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        if (m > 0 && out[m - 1].b == out[i].b)
+            out[m - 1].vol += out[i].vol;
+        else
+            out[m++] = out[i];
+    }
+    return m;
+}
+
+static int star_size(const cf_solid *s, int a)
+{
+    return s->vt_start[s->origin[a] + 1] - s->vt_start[s->origin[a]];
+}
+
+/* Bars of node a into the arrays at position at; returns 0, -1 out of memory. */
+static int fill_node(const cf_solid *s, int a, int *ends, double *rest, double *compliance,
+                     int at, int *count)
+{
+    nbr local[3 * 128];
+    int need = 3 * star_size(s, a);
+    nbr *e = need <= 3 * 128 ? local : malloc((size_t)need * sizeof *e);
+    if (!e)
+        return -1;
+    int m = node_bars(s, a, e);
+    for (int i = 0; ends && i < m; i++) {
+        double d[3];
+        int b = e[i].b;
+        ends[2 * (at + i)] = a, ends[2 * (at + i) + 1] = b;
+        v3_sub(&s->X[3 * a], &s->X[3 * b], d);
+        rest[at + i] = v3_norm(d);
+        /* A bar of section V/L and length L: stiffness E V / L^2. */
+        compliance[at + i] = rest[at + i] * rest[at + i] / (s->mat.E * e[i].vol);
+    }
+    *count = m;
+    if (e != local)
+        free(e);
+    return 0;
+}
+
+/* Greedy colouring in bar order: the lowest colour that no bar at either
+ * end has yet (128 per node in two masks; beyond that, the last, serial
+ * group CF_BARS_COLORS).  Returns the number of groups used. */
+static int colour(const int *ends, int n, int nodes, unsigned char *colour_of)
+{
+    uint64_t (*mask)[2] = calloc((size_t)nodes, sizeof *mask);
+    if (!mask)
+        return -1;
+    int used = 0;
+    for (int i = 0; i < n; i++) {
+        uint64_t *ma = mask[ends[2 * i]], *mb = mask[ends[2 * i + 1]];
+        uint64_t lo = ~(ma[0] | mb[0]), hi = ~(ma[1] | mb[1]);
+        int c = lo ? __builtin_ctzll(lo) : hi ? 64 + __builtin_ctzll(hi) : CF_BARS_COLORS;
+        if (c < CF_BARS_COLORS) {
+            ma[c / 64] |= 1ull << (c % 64);
+            mb[c / 64] |= 1ull << (c % 64);
+        }
+        colour_of[i] = (unsigned char)c;
+        used = c + 1 > used ? c + 1 : used;
+    }
+    free(mask);
+    return used;
 }
 
 int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
 {
-    static const int E[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-    edge *e = malloc((size_t)(nt ? nt : 1) * 6 * sizeof *e);
-    if (!e)
-        return -1;
-    for (int i = 0; i < nt; i++)
-        for (int k = 0; k < 6; k++) {
-            int p = s->tet[4 * tets[i] + E[k][0]], q = s->tet[4 * tets[i] + E[k][1]];
-            edge *x = &e[6 * i + k];
-            x->a = p < q ? p : q, x->b = p < q ? q : p;
-            x->vol = s->vol[tets[i]] / 6.0; /* tributary volume: a sixth per edge */
+    /* The nodes of the tets, in tet order; then each node's bars. */
+    unsigned char *seen = calloc((size_t)s->n_nodes, 1);
+    int *nodes = malloc((size_t)(4 * nt + 1) * sizeof(int)), nn = 0;
+    int *start = malloc((size_t)(4 * nt + 2) * sizeof(int));
+    int rc = -(!seen || !nodes || !start);
+    for (int i = 0; rc == 0 && i < nt; i++)
+        for (int j = 0; j < 4; j++) {
+            int a = s->tet[4 * tets[i] + j];
+            if (!seen[a])
+                seen[a] = 1, nodes[nn++] = a;
         }
-    qsort(e, (size_t)nt * 6, sizeof *e, cmp_edge);
+    free(seen);
+    int big = nn >= CF_BARS_PARALLEL_MIN;
+#pragma omp parallel for schedule(static) reduction(| : rc) if (big)
+    for (int i = 0; i < nn; i++)
+        rc |= fill_node(s, nodes[i], NULL, NULL, NULL, 0, &start[i + 1]);
     int n = 0;
-    for (int i = 0; i < 6 * nt; i++) {
-        if (n > 0 && e[i].a == e[n - 1].a && e[i].b == e[n - 1].b)
-            e[n - 1].vol += e[i].vol;
-        else
-            e[n++] = e[i];
+    if (rc == 0) {
+        start[0] = 0;
+        for (int i = 0; i < nn; i++)
+            start[i + 1] += start[i];
+        n = start[nn];
     }
     size_t cap = (size_t)(n ? n : 1);
-    int *ends = malloc(cap * 2 * sizeof(int));
-    double *rest = malloc(cap * sizeof(double)), *compliance = malloc(cap * sizeof(double));
+    int *ends = malloc(cap * 2 * sizeof(int)), *e2 = malloc(cap * 2 * sizeof(int));
+    double *rest = malloc(cap * sizeof(double)), *r2 = malloc(cap * sizeof(double));
+    double *compliance = malloc(cap * sizeof(double)), *c2 = malloc(cap * sizeof(double));
     double *lambda = calloc(cap, sizeof(double));
-    if (!ends || !rest || !compliance || !lambda) {
-        free(e), free(ends), free(rest), free(compliance), free(lambda);
+    unsigned char *col = malloc(cap);
+    int *color_start = calloc(CF_BARS_COLORS + 2, sizeof(int));
+    if (rc || !ends || !e2 || !rest || !r2 || !compliance || !c2 || !lambda || !col || !color_start)
+        rc = -1;
+#pragma omp parallel for schedule(static) reduction(| : rc) if (big)
+    for (int i = 0; i < nn; i++) {
+        int m;
+        if (rc == 0)
+            rc |= fill_node(s, nodes[i], ends, rest, compliance, start[i], &m);
+    }
+    int groups = rc ? -1 : colour(ends, n, s->n_nodes, col);
+    if (groups < 0)
+        rc = -1;
+    if (rc == 0) { /* counting sort by colour, stable */
+        for (int i = 0; i < n; i++)
+            color_start[col[i] + 1]++;
+        for (int c = 0; c <= CF_BARS_COLORS; c++)
+            color_start[c + 1] += color_start[c];
+        int at[CF_BARS_COLORS + 1]; /* the next slot of each colour */
+        memcpy(at, color_start, sizeof at);
+        for (int i = 0; i < n; i++) {
+            int k = at[col[i]]++;
+            e2[2 * k] = ends[2 * i], e2[2 * k + 1] = ends[2 * i + 1];
+            r2[k] = rest[i], c2[k] = compliance[i];
+        }
+    }
+    free(nodes), free(start), free(col), free(ends), free(rest), free(compliance);
+    if (rc) {
+        free(e2), free(r2), free(c2), free(lambda), free(color_start);
         return -1;
     }
-    for (int i = 0; i < n; i++) {
-        double d[3];
-        ends[2 * i] = e[i].a, ends[2 * i + 1] = e[i].b;
-        v3_sub(&s->X[3 * e[i].a], &s->X[3 * e[i].b], d);
-        rest[i] = v3_norm(d);
-        /* A bar of section V/L and length L: stiffness E V / L^2. */
-        compliance[i] = rest[i] * rest[i] / (s->mat.E * e[i].vol);
-    }
-    free(e);
     cf_bars_free(b);
-    b->n = n, b->ends = ends, b->rest = rest, b->compliance = compliance, b->lambda = lambda;
+    b->n = n, b->ends = e2, b->rest = r2, b->compliance = c2, b->lambda = lambda;
+    b->n_colors = groups, b->color_start = color_start;
     return 0;
 }
 
@@ -67,6 +170,7 @@ void cf_bars_free(cf_bars *b)
     free(b->rest);
     free(b->compliance);
     free(b->lambda);
+    free(b->color_start);
     memset(b, 0, sizeof *b);
 }
 
@@ -77,40 +181,66 @@ double cf_pbd_effective_stiffness(double k, int iterations, int iteration_indepe
     return 1.0 - pow(1.0 - k, 1.0 / iterations);
 }
 
+/* One bar of the PBD sweep. */
+static inline void project_bar(const cf_bars *b, cf_solid *s, double k, int i)
+{
+    int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
+    double *p1 = &s->p[3 * i1], *p2 = &s->p[3 * i2];
+    double w1 = 1.0 / s->m[i1], w2 = 1.0 / s->m[i2];
+    double d[3];
+    v3_sub(p1, p2, d);
+    double len = v3_norm(d);
+    if (len == 0)
+        return;
+    double c = k * (len - b->rest[i]) / ((w1 + w2) * len);
+    v3_axpy(-w1 * c, d, p1);
+    v3_axpy(w2 * c, d, p2);
+}
+
+/* One bar of the XPBD sweep. */
+static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double scale, int i)
+{
+    int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
+    double *p1 = &s->p[3 * i1], *p2 = &s->p[3 * i2];
+    double w1 = 1.0 / s->m[i1], w2 = 1.0 / s->m[i2];
+    double d[3];
+    v3_sub(p1, p2, d);
+    double len = v3_norm(d);
+    if (len == 0)
+        return;
+    double at = scale * b->compliance[i] / (dt * dt);
+    double dl = (-(len - b->rest[i]) - at * b->lambda[i]) / (w1 + w2 + at);
+    b->lambda[i] += dl;
+    v3_axpy(w1 * dl / len, d, p1);
+    v3_axpy(-w2 * dl / len, d, p2);
+}
+
+/* Colour by colour; the bars of one colour share no node, so they run in
+ * parallel and in any order with the same result.  The last group holds
+ * bars no colour could take: one thread. */
+#define SWEEP(b, CALL)                                                                         \
+    _Pragma("omp parallel if ((b)->n >= CF_BARS_PARALLEL_MIN)")                                \
+    {                                                                                          \
+        for (int c = 0; c < (b)->n_colors && c < CF_BARS_COLORS; c++) {                        \
+            _Pragma("omp for schedule(static)")                                                \
+            for (int i = (b)->color_start[c]; i < (b)->color_start[c + 1]; i++)                \
+                CALL;                                                                          \
+        }                                                                                      \
+        _Pragma("omp single")                                                                  \
+        for (int i = (b)->color_start[CF_BARS_COLORS]; i < (b)->n; i++)                        \
+            CALL;                                                                              \
+    }
+
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
 {
-    for (int i = 0; i < b->n; i++) {
-        int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-        double *p1 = &s->p[3 * i1], *p2 = &s->p[3 * i2];
-        double w1 = 1.0 / s->m[i1], w2 = 1.0 / s->m[i2];
-        double d[3];
-        v3_sub(p1, p2, d);
-        double len = v3_norm(d);
-        if (len == 0)
-            continue;
-        double c = k * (len - b->rest[i]) / ((w1 + w2) * len);
-        v3_axpy(-w1 * c, d, p1);
-        v3_axpy(w2 * c, d, p2);
-    }
+    if (b->n > 0)
+        SWEEP(b, project_bar(b, s, k, i))
 }
 
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
 {
-    for (int i = 0; i < b->n; i++) {
-        int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-        double *p1 = &s->p[3 * i1], *p2 = &s->p[3 * i2];
-        double w1 = 1.0 / s->m[i1], w2 = 1.0 / s->m[i2];
-        double d[3];
-        v3_sub(p1, p2, d);
-        double len = v3_norm(d);
-        if (len == 0)
-            continue;
-        double at = scale * b->compliance[i] / (dt * dt);
-        double dl = (-(len - b->rest[i]) - at * b->lambda[i]) / (w1 + w2 + at);
-        b->lambda[i] += dl;
-        v3_axpy(w1 * dl / len, d, p1);
-        v3_axpy(-w2 * dl / len, d, p2);
-    }
+    if (b->n > 0)
+        SWEEP(b, project_bar_xpbd(b, s, dt, scale, i))
 }
 
 void cf_bars_reset_lambda(cf_bars *b)

@@ -11,19 +11,30 @@
  * XPBD compliance of a bar: L^2 / (E V_trib) (m/N), V_trib the sum of a
  * sixth of the volume of every tet that has the edge, so that a bar is a rod
  * of section V_trib / L of the bulk material. */
+#define CF_BARS_COLORS 128        /* colours; bars beyond them go to one serial group */
+#define CF_BARS_PARALLEL_MIN 4096 /* fewer bars (or nodes to build from): one thread */
+
 typedef struct cf_bars {
     int n;
-    int *ends;          /* [n][2] node indices, ascending pairs, sorted */
+    int n_colors;       /* colour groups used */
+    int *color_start;   /* [CF_BARS_COLORS + 2]: bars of colour c are color_start[c] ..
+                           color_start[c+1] - 1; the serial group from
+                           color_start[CF_BARS_COLORS] to n - 1 */
+    int *ends;          /* [n][2] node indices, ascending pairs, grouped by colour */
     double *rest;       /* [n] m */
     double *compliance; /* [n] m/N */
     double *lambda;     /* [n] XPBD Lagrange multipliers of this step, N s^2 */
 } cf_bars;
 
-/* (Re)build the bars of `tets`.  Returns 0, or -1 when out of memory. */
+/* (Re)build the bars of `tets`: node by node through the solid's
+ * vertex-to-tet map (no global sort; parallel over nodes), then coloured
+ * greedily so that no two bars of a colour share a node.  Returns 0, or -1
+ * when out of memory. */
 int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt);
 void cf_bars_free(cf_bars *b);
 
-/* One Gauss-Seidel sweep over the bars on s->p, in bar order:
+/* One Gauss-Seidel sweep over the bars on s->p, colour after colour (in
+ * parallel within a colour; the same bits for any thread count):
  * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
 

@@ -9,6 +9,7 @@
 
 #include "cohfrac/surface.h"
 #include "linalg.h"
+#include "renumber.h"
 
 #include <math.h>
 #include <omp.h>
@@ -407,6 +408,15 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
     int *body = NULL, *bc = NULL;
     cf_status st = load_bodies(scene, opt->mesh_dir, &all, &body, &bc, err);
     if (st == CF_OK) {
+        int *user = malloc((size_t)all.n_tets * sizeof(int));
+        sim->tet_of_user = malloc((size_t)all.n_tets * sizeof(int));
+        if (!user || !sim->tet_of_user || cf_renumber_locality(&all, bc, body, user))
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory renumbering %d tets", all.n_tets);
+        for (int t = 0; st == CF_OK && t < all.n_tets; t++)
+            sim->tet_of_user[user[t]] = t;
+        free(user);
+    }
+    if (st == CF_OK) {
         st = cf_solid_init(&sim->solid, &all, &scene->material, body, err);
         if (st == CF_OK)
             memcpy(sim->solid.bc, bc, (size_t)all.n_nodes * sizeof(int));
@@ -479,7 +489,7 @@ void cf_sim_destroy(cf_sim *sim)
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
         cff_mesh_destroy(sim->obs.mesh[j]);
     free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
-    free(sim->body_boxes), free(sim->cand.v);
+    free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
     cf_solid_free(&sim->solid);
@@ -608,7 +618,7 @@ int cf_sim_tet_count(const cf_sim *sim) { return sim->solid.n_tets; }
 
 int cf_sim_tet_fragment(const cf_sim *sim, int t)
 {
-    return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[t] : -1;
+    return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[sim->tet_of_user[t]] : -1;
 }
 
 static cf_status write_frame(cf_sim *sim, cf_error *err)

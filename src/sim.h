@@ -109,6 +109,8 @@ struct cf_sim {
     double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
     unsigned long long bullet_base; /* Bullet allocator bytes when the run was created */
     unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
+    int *tet_of_user;        /* [n_tets] the solid's tet of each input tet (the solid is
+                                renumbered for locality at load: renumber.h) */
     cf_int_list cand;        /* facets that qualify at a check (scratch of the step) */
 };
 
