@@ -25,6 +25,10 @@ static int ensure_scratch(cf_fragment *f)
     if (!v)
         return -1;
     f->v_old = v;
+    v = realloc(f->term, (size_t)cap * sizeof(double));
+    if (!v)
+        return -1;
+    f->term = v;
     f->scratch_cap = cap;
     return 0;
 }
@@ -162,6 +166,7 @@ static void update_velocities(cf_sim *sim, cf_fragment *f, double dt, int fractu
     cf_solid *s = &sim->solid;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n;
+#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         memcpy(&f->v_old[3 * i], &s->v[3 * a], 3 * sizeof(double));
@@ -198,6 +203,43 @@ static void update_velocities(cf_sim *sim, cf_fragment *f, double dt, int fractu
     memcpy(f->mx, mx, sizeof mx);
 }
 
+/* The obstacles and rigid neighbours' hulls on node i's prediction at
+ * t_next; records its contact and approach speed.  Returns the work of
+ * moving obstacles on it in this pass, J. */
+static double obstacle_node(cf_sim *sim, cf_fragment *f, int i, double t_next, double dt)
+{
+    cf_solid *s = &sim->solid;
+    int a = f->nodes.v[i];
+    double n[3], before[3], w = 0;
+    memcpy(before, &s->p[3 * a], sizeof before);
+    int hit = cf_obstacles_project(&sim->obs, t_next, &s->p[3 * a], n);
+    if (hit >= 0 && f->contact[i] < 0) {
+        double u[3], vr[3];
+        cf_obstacle_velocity(&sim->obs.o[hit], u);
+        v3_sub(&s->v[3 * a], u, vr);
+        f->vn_pre[i] = v3_dot(vr, n);
+    }
+    if (hit >= 0) {
+        double u[3], dp[3];
+        f->contact[i] = hit;
+        cf_obstacle_velocity(&sim->obs.o[hit], u);
+        v3_sub(&s->p[3 * a], before, dp);
+        w = s->m[a] * v3_dot(dp, u) / dt;
+    }
+    if (f->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
+        double *pa = &s->p[3 * a], dJ[3];
+        memcpy(before, pa, sizeof before);
+        int h = cf_hull_set_project(&f->near, &s->x[3 * a], pa);
+        if (h >= 0) {
+            v3_sub(pa, before, dJ);
+            for (int c = 0; c < 3; c++)
+                dJ[c] *= s->m[a] / dt;
+            cf_node_impulses_add(&f->push, i, f->near.frag[h], dJ, pa);
+        }
+    }
+    return w;
+}
+
 /* Prediction p = x + dt v, then the constraint projection: bars (PBD or
  * XPBD), crack-face contact, obstacles, prescribed nodes. */
 static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int fracture)
@@ -205,7 +247,10 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->scene->solver;
     const int *nodes = f->nodes.v;
-    int nn = f->nodes.n;
+    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, mesh_obstacles = 0;
+    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++) /* FCL queries: one thread */
+        mesh_obstacles |= sim->obs.mesh[j] != NULL;
+#pragma omp parallel for schedule(static) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         for (int k = 0; k < 3; k++)
@@ -227,36 +272,14 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
             cf_bars_project(&f->bars, s, k);
         if (fracture && bars)
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
-        for (int i = 0; i < nn; i++) {
-            int a = nodes[i];
-            double n[3], before[3];
-            memcpy(before, &s->p[3 * a], sizeof before);
-            int hit = cf_obstacles_project(&sim->obs, t_next, &s->p[3 * a], n);
-            if (hit >= 0 && f->contact[i] < 0) {
-                double u[3], vr[3];
-                cf_obstacle_velocity(&sim->obs.o[hit], u);
-                v3_sub(&s->v[3 * a], u, vr);
-                f->vn_pre[i] = v3_dot(vr, n);
-            }
-            if (hit >= 0) {
-                double u[3], dp[3];
-                f->contact[i] = hit;
-                cf_obstacle_velocity(&sim->obs.o[hit], u);
-                v3_sub(&s->p[3 * a], before, dp);
-                w_obs += s->m[a] * v3_dot(dp, u) / dt;
-            }
-            if (f->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
-                double *pa = &s->p[3 * a], before[3], dJ[3];
-                memcpy(before, pa, sizeof before);
-                int h = cf_hull_set_project(&f->near, &s->x[3 * a], pa);
-                if (h >= 0) {
-                    v3_sub(pa, before, dJ);
-                    for (int c = 0; c < 3; c++)
-                        dJ[c] *= s->m[a] / dt;
-                    cf_node_impulses_add(&f->push, i, f->near.frag[h], dJ, pa);
-                }
-            }
-        }
+        /* Obstacles node by node in parallel (each writes its own p and
+         * term); the hull pushes of rigid neighbours append to one list:
+         * one thread then.  The work terms are added in node order. */
+#pragma omp parallel for schedule(static) if (par && f->near.n == 0 && !mesh_obstacles)
+        for (int i = 0; i < nn; i++)
+            f->term[i] = obstacle_node(sim, f, i, t_next, dt);
+        for (int i = 0; i < nn; i++)
+            w_obs += f->term[i];
         for (int i = 0; i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
                 sim->flow.boundary += impose_boundary(sim, nodes[i], dt, 1);
@@ -265,17 +288,20 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
      * kinetic energy it removes, 1/2 m (v_pred^2 - v^2); the strain energy it
      * changes shows in the ledger's residual. */
     double removed = 0;
+#pragma omp parallel for schedule(static) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         double *va = &s->v[3 * a], vnew[3];
         for (int c = 0; c < 3; c++)
             vnew[c] = (s->p[3 * a + c] - s->x[3 * a + c]) / dt;
-        removed += 0.5 * s->m[a] * (v3_dot(va, va) - v3_dot(vnew, vnew));
+        f->term[i] = 0.5 * s->m[a] * (v3_dot(va, va) - v3_dot(vnew, vnew));
         for (int c = 0; c < 3; c++) {
             va[c] = vnew[c];
             s->x[3 * a + c] = s->p[3 * a + c];
         }
     }
+    for (int i = 0; i < nn; i++) /* node order: the same sum for any thread count */
+        removed += f->term[i];
     /* The kinetic change includes what moving obstacles put in: book that as
      * their work, and the rest as the projection's own removal. */
     sim->flow.obstacles += w_obs;

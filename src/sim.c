@@ -478,7 +478,7 @@ void cf_sim_destroy(cf_sim *sim)
     for (int i = 0; i < sim->n_frag; i++) {
         cf_fragment *f = &sim->frag[i];
         free(f->tets), free(f->nodes.v), free(f->coh.v), free(f->contact), free(f->vn_pre);
-        free(f->v_old);
+        free(f->v_old), free(f->term);
         cf_bars_free(&f->bars);
         cf_hulls_free(&f->hulls);
         cf_node_impulses_free(&f->push);
@@ -1096,7 +1096,7 @@ void cf_sim_memory(const cf_sim *sim, cf_memory *m)
         m->fragments += (unsigned long long)f->nt * I + (unsigned long long)f->nodes.cap * I +
                         (unsigned long long)f->coh.cap * I +
                         (unsigned long long)f->bars.n * (2 * I + 3 * D) +
-                        (unsigned long long)f->scratch_cap * (I + 4 * D + I + 6 * D);
+                        (unsigned long long)f->scratch_cap * (I + 5 * D + I + 6 * D);
         if (f->hulls.n_hulls)
             m->fragments += (unsigned long long)f->hulls.start[f->hulls.n_hulls] * 3 * D +
                             ((unsigned long long)f->hulls.n_hulls + 1) * I;

@@ -35,6 +35,7 @@ typedef struct cf_fragment {
     int *contact;            /* [nodes.n] obstacle in contact after the last projection, -1 */
     double *vn_pre;          /* [nodes.n] normal velocity before projection, m/s */
     double *v_old;           /* [nodes.n][3] velocity at the start of the step, m/s */
+    double *term;            /* [nodes.n] per-node energy terms, J, summed in node order */
     int scratch_cap;
     /* Energy ledger state at the last force evaluation (in-house solver). */
     double e_kin;            /* J, 1/2 sum m v(n-1/2).v(n+1/2) (leapfrog estimate) */
@@ -155,6 +156,9 @@ void cf_fragment_ledger_reset(cf_sim *sim, int fi);
 /* Bullet collision margin of fragment fi: 0.1% of its size, m (Bullet's
  * default 4 cm would hold small fragments off the ground). */
 double cf_fragment_margin(const cf_sim *sim, int fi);
+
+/* Node loops of the step run on the threads from this many nodes on. */
+#define CF_NODES_PARALLEL_MIN 2048
 
 /* A rigid step is re-run at most this many times for fragments that go to
  * fracture mode during it. */
