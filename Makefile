@@ -1,12 +1,12 @@
 # Thin wrapper around CMake.  `make run`: set up, build, prepare the bunny,
 # run the default scene (the bunny drop on the coarse bunny).  `make test`:
-# set up, build, run every test.
+# set up, build, run every test.  `make bench`: time the fracture-mode step.
 BUILD     ?= build
 BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
 MESHES    := $(BUILD)/meshes
 JOBS      ?= 2
 
-.PHONY: all deps build meshes run test clean
+.PHONY: all deps build meshes run test bench bench-scaling clean
 
 all: build
 
@@ -24,6 +24,17 @@ meshes: build
 run: meshes
 	$(BUILD)/cohfrac run scenes/bunny_drop.lua --mesh-dir $(MESHES)
 	/usr/bin/python3 tools/check_run.py out/bunny_drop.h5
+
+# The fracture-mode step on the 203k-tet bunny against the memory floor, 1
+# against 2 threads and against btSoftBody (docs/performance.md).
+bench: meshes
+	$(BUILD)/cohfrac bench --peer -m $(MESHES)
+
+# Step time and memory per tet from 15k to 800k tets.
+bench-scaling: meshes
+	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_50k --target-tets 50000
+	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_800k --target-tets 800000
+	$(BUILD)/cohfrac bench --scaling -m $(MESHES)
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure

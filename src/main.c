@@ -79,7 +79,8 @@ static const char usage[] =
     "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 3.1 m/s)\n"
     "                                      against the memory floor, 1 against N threads\n"
     "      --mesh NAME                     prepared mesh or TetGen base (default bunny)\n"
-    "      --steps N                       timed steps per repeat (default 60)\n"
+    "      --steps N                       timed steps per repeat (default 60), after\n"
+    "      --warmup N                      untimed steps into the impact (default 100)\n"
     "      --repeats N                     repeats per thread count (default 3)\n"
     "      --threads N                     the N of the N-thread runs (default: all cores)\n"
     "      --criterion none|source|traction  insertion rule (default source)\n"
@@ -400,7 +401,7 @@ static int cmd_bench(int argc, char **argv)
                                        {0, 0, 0, 0}};
     const char *env = getenv("COHFRAC_MESH_DIR");
     cf_bench_options o = {.mesh = "bunny", .mesh_dir = env ? env : "build/meshes", .steps = 60,
-                          .warmup = 5, .repeats = 3, .criterion = CF_CRITERION_SOURCE,
+                          .warmup = 100, .repeats = 3, .criterion = CF_CRITERION_SOURCE,
                           .log = stdout};
     const char *scaling = NULL;
     int c, peer = 0;

@@ -181,38 +181,42 @@ double cf_pbd_effective_stiffness(double k, int iterations, int iteration_indepe
     return 1.0 - pow(1.0 - k, 1.0 / iterations);
 }
 
+/* Bar i now: its ends' predictions and inverse masses, d = p1 - p2 and |d|. */
+typedef struct {
+    double *p1, *p2, w1, w2, d[3], len;
+} bar_now;
+
+static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
+{
+    int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
+    bar_now r = {&s->p[3 * i1], &s->p[3 * i2], 1.0 / s->m[i1], 1.0 / s->m[i2], {0, 0, 0}, 0};
+    v3_sub(r.p1, r.p2, r.d);
+    r.len = v3_norm(r.d);
+    return r;
+}
+
 /* One bar of the PBD sweep. */
 static inline void project_bar(const cf_bars *b, cf_solid *s, double k, int i)
 {
-    int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-    double *p1 = &s->p[3 * i1], *p2 = &s->p[3 * i2];
-    double w1 = 1.0 / s->m[i1], w2 = 1.0 / s->m[i2];
-    double d[3];
-    v3_sub(p1, p2, d);
-    double len = v3_norm(d);
-    if (len == 0)
+    bar_now r = bar_at(b, s, i);
+    if (r.len == 0)
         return;
-    double c = k * (len - b->rest[i]) / ((w1 + w2) * len);
-    v3_axpy(-w1 * c, d, p1);
-    v3_axpy(w2 * c, d, p2);
+    double c = k * (r.len - b->rest[i]) / ((r.w1 + r.w2) * r.len);
+    v3_axpy(-r.w1 * c, r.d, r.p1);
+    v3_axpy(r.w2 * c, r.d, r.p2);
 }
 
 /* One bar of the XPBD sweep. */
 static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double scale, int i)
 {
-    int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-    double *p1 = &s->p[3 * i1], *p2 = &s->p[3 * i2];
-    double w1 = 1.0 / s->m[i1], w2 = 1.0 / s->m[i2];
-    double d[3];
-    v3_sub(p1, p2, d);
-    double len = v3_norm(d);
-    if (len == 0)
+    bar_now r = bar_at(b, s, i);
+    if (r.len == 0)
         return;
     double at = scale * b->compliance[i] / (dt * dt);
-    double dl = (-(len - b->rest[i]) - at * b->lambda[i]) / (w1 + w2 + at);
+    double dl = (-(r.len - b->rest[i]) - at * b->lambda[i]) / (r.w1 + r.w2 + at);
     b->lambda[i] += dl;
-    v3_axpy(w1 * dl / len, d, p1);
-    v3_axpy(-w2 * dl / len, d, p2);
+    v3_axpy(r.w1 * dl / r.len, r.d, r.p1);
+    v3_axpy(-r.w2 * dl / r.len, r.d, r.p2);
 }
 
 /* Colour by colour; the bars of one colour share no node, so they run in

@@ -95,6 +95,15 @@ static cf_sim *make_sim(const char *text, cf_scene *sc)
     return sim;
 }
 
+/* Advance sim to the scene's duration; a failed step fails the test. */
+static void run_to_end(cf_sim *sim)
+{
+    cf_error err = {0};
+    while (!cf_sim_done(sim))
+        if (cf_sim_advance(sim, &err) != CF_OK)
+            fail_msg("run: %s", err.msg);
+}
+
 static cf_sim *impact_sim(double duration, int threads, cf_scene *sc)
 {
     char text[2048];
@@ -168,10 +177,7 @@ static void test_determinism_hash(void **state)
     for (int r = 0; r < 2; r++) {
         cf_scene sc;
         cf_sim *sim = impact_sim(0.06, r + 1, &sc);
-        cf_error err = {0};
-        while (!cf_sim_done(sim))
-            if (cf_sim_advance(sim, &err) != CF_OK)
-                fail_msg("run: %s", err.msg);
+        run_to_end(sim);
         h[r] = cf_sim_state_hash(sim);
         cf_sim_destroy(sim);
         cf_scene_free(&sc);
@@ -211,10 +217,7 @@ static void test_determinism_hash_coloured(void **state)
         snprintf(text, sizeof text, coloured_scene, r + 1);
         cf_scene sc;
         cf_sim *sim = make_sim(text, &sc);
-        cf_error err = {0};
-        while (!cf_sim_done(sim))
-            if (cf_sim_advance(sim, &err) != CF_OK)
-                fail_msg("run: %s", err.msg);
+        run_to_end(sim);
         h[r] = cf_sim_state_hash(sim);
         coh[r] = sim->solid.n_coh;
         assert_true(sim->frag[0].bars.n >= CF_BARS_PARALLEL_MIN);
@@ -319,10 +322,7 @@ static void run_ground(const char *obstacle, cf_fragment_state *out)
     snprintf(text, sizeof text, ground_scene, obstacle);
     cf_scene sc;
     cf_sim *sim = make_sim(text, &sc);
-    cf_error err = {0};
-    while (!cf_sim_done(sim))
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+    run_to_end(sim);
     assert_int_equal(cf_sim_fragments(sim, out, 1), 1);
     cf_sim_destroy(sim);
     cf_scene_free(&sc);

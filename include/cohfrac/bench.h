@@ -34,7 +34,7 @@ typedef struct cf_bench_options {
     const char *mesh;       /* prepared mesh name or TetGen base path ["bunny"] */
     const char *mesh_dir;   /* where prepared meshes live */
     int steps;              /* timed fracture steps per repeat [60] */
-    int warmup;             /* untimed steps before them [5] */
+    int warmup;             /* untimed steps before them [100]: insertion starts */
     int repeats;            /* per thread count [3] */
     int threads;            /* N of the N-thread runs; 0: all cores */
     cf_criterion criterion; /* [CF_CRITERION_SOURCE] */
