@@ -9,13 +9,14 @@
 -- metres (the bunny is 2 m tall) and it falls 1 m (its lowest point starts
 -- at z = 1 m; from 0.5 m the small bunny does not crack).
 -- Default mesh: the coarse `bunny_small` (14,940 tets; `make run`), about
--- 10 s here.  Source scale (the source's bunny has 208,353 tets; ours
--- 203,053): --set 'bodies[1].mesh="bunny"', about 5 minutes on 2 threads
+-- 20 s here.  Source scale (the source's bunny has 208,353 tets; ours
+-- 203,053): --set 'bodies[1].mesh="bunny"', about 6 minutes on 2 threads
 -- (see the README and docs/performance.md).
 -- Expected: the bunny rebounds at the impact (fracture mode is PBD with
 -- k = 0.9 and 3 iterations, an almost rigid elastic body: the compression
 -- wave comes back) and loses many small pieces where it meets the ground:
--- bunny_small ~130 (one large body and crumbs of a few tets).
+-- bunny_small 128 (one large body and crumbs of a few tets), the
+-- source-scale bunny ~6,600.
 return {
   name = "bunny_drop",
   duration = 0.6,
