@@ -168,15 +168,16 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
     int *buf = hi - lo <= 256 ? local : malloc(3 * (size_t)(hi - lo) * sizeof(int));
     if (!buf)
         return -1;
+    /* star[i]: the slot 4 t + j of o in each tet t that holds copy n */
     int *star = buf, *parent = buf + (hi - lo), *copy_of_root = buf + 2 * (hi - lo);
     int ns = 0, rc = 0;
     for (int i = lo; i < hi; i++)
         if (s->tet[s->vt_slot[i]] == n)
-            star[ns++] = s->vt_slot[i] / 4;
+            star[ns++] = s->vt_slot[i];
     for (int i = 0; i < ns; i++)
         parent[i] = i;
     for (int i = 0; i < ns; i++) {
-        int t = star[i], j = slot_of(s, t, o);
+        int t = star[i] / 4, j = star[i] % 4;
         for (int k = 0; k < 4; k++) {
             if (k == j) /* the face opposite o does not contain o */
                 continue;
@@ -186,7 +187,7 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
                 continue;
             int other = F[0] == t ? F[2] : F[0];
             for (int q = 0; q < ns; q++)
-                if (star[q] == other) {
+                if (star[q] / 4 == other) {
                     int ra = uf_find(parent, i), rb = uf_find(parent, q);
                     if (ra != rb)
                         parent[ra > rb ? ra : rb] = ra < rb ? ra : rb;
@@ -208,13 +209,13 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
             }
             copy_of_root[r] = c;
         }
-        s->tet[4 * star[i] + slot_of(s, star[i], o)] = copy_of_root[r];
+        s->tet[star[i]] = copy_of_root[r];
     }
     /* Re-lump only the copies of o: the other nodes of these tets keep theirs. */
     for (int i = 0; i < ns; i++)
-        s->m[s->tet[4 * star[i] + slot_of(s, star[i], o)]] = 0;
+        s->m[s->tet[star[i]]] = 0;
     for (int i = 0; i < ns; i++)
-        s->m[s->tet[4 * star[i] + slot_of(s, star[i], o)]] += s->mat.rho * s->vol[star[i]] / 4.0;
+        s->m[s->tet[star[i]]] += s->mat.rho * s->vol[star[i] / 4] / 4.0;
     if (buf != local)
         free(buf);
     return rc;

@@ -111,7 +111,7 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
                 seen[a] = 1, nodes[nn++] = a;
         }
     free(seen);
-    int big = nn >= CF_BARS_PARALLEL_MIN;
+    int big = nn >= CF_NODES_PARALLEL_MIN;
 #pragma omp parallel for schedule(static) reduction(| : rc) if (big)
     for (int i = 0; i < nn; i++)
         rc |= fill_node(s, nodes[i], NULL, NULL, NULL, 0, &start[i + 1]);

@@ -12,7 +12,7 @@
  * sixth of the volume of every tet that has the edge, so that a bar is a rod
  * of section V_trib / L of the bulk material. */
 #define CF_BARS_COLORS 128        /* colours; bars beyond them go to one serial group */
-#define CF_BARS_PARALLEL_MIN 4096 /* fewer bars (or nodes to build from): one thread */
+#define CF_BARS_PARALLEL_MIN 4096 /* fewer bars: the sweep runs on one thread */
 
 typedef struct cf_bars {
     int n;

@@ -157,9 +157,6 @@ void cf_fragment_ledger_reset(cf_sim *sim, int fi);
  * default 4 cm would hold small fragments off the ground). */
 double cf_fragment_margin(const cf_sim *sim, int fi);
 
-/* Node loops of the step run on the threads from this many nodes on. */
-#define CF_NODES_PARALLEL_MIN 2048
-
 /* A rigid step is re-run at most this many times for fragments that go to
  * fracture mode during it. */
 #define CF_MAX_RESTEPS 4

@@ -14,6 +14,11 @@
 
 extern const int CF_TET_FACE[4][3];
 
+/* Loops over a fragment's nodes run on the threads from this many nodes on
+ * (force gather, bar building, the step's node loops); each node writes
+ * only its own entries, so the thread count never changes a result. */
+#define CF_NODES_PARALLEL_MIN 2048
+
 /* One extrinsic cohesive element on facet (tet[0], face[0]) | (tet[1], face[1]).
  * Node pair i joins slot[0][i] of tet[0] with slot[1][i] of tet[1]; the
  * nodes are read through the tets so they follow later duplications. */

@@ -121,7 +121,7 @@ void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9
 
 void cf_tet4_gather(cf_solid *s, const int *nodes, int nn, const double g[3])
 {
-#pragma omp parallel for schedule(static) if (nn >= CF_TET4_PARALLEL_MIN / 4)
+#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i], o = s->origin[a];
         double *fa = &s->f[3 * a];
