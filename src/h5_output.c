@@ -975,6 +975,51 @@ cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double t
 
 /* ---- hand-offs --------------------------------------------------------- */
 
+static cf_status write_parameter_impl(cf_h5 *h, const char *name, const double *v, int n,
+                                     const char *unit, cf_error *err)
+{
+    if (!name || !*name || strchr(name, '/') || n < 1)
+        return cf_error_set(err, CF_ERR_OUTPUT, "%s: parameter name '%s' is empty or holds '/'",
+                            h->path, name ? name : "");
+    hid_t params = H5Gopen2(h->file, "parameters", H5P_DEFAULT);
+    if (params < 0)
+        return h5_fail(err, h->path, "opening /parameters");
+    if (H5Lexists(params, name, H5P_DEFAULT) > 0) {
+        H5Gclose(params);
+        return cf_error_set(err, CF_ERR_OUTPUT, "%s: /parameters/%s is written already", h->path,
+                            name);
+    }
+    hsize_t dims[1] = {(hsize_t)n};
+    hid_t space = n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, dims, NULL);
+    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
+    hid_t d = H5I_INVALID_HID;
+    int ok = space >= 0 && dcpl >= 0 &&
+             (d = H5Dcreate2(params, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl,
+                             H5P_DEFAULT)) >= 0 &&
+             H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0 &&
+             write_unit(d, unit) == 0;
+    if (d >= 0)
+        H5Dclose(d);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (space >= 0)
+        H5Sclose(space);
+    H5Gclose(params);
+    return ok ? CF_OK : h5_fail(err, h->path, "writing /parameters/%s", name);
+}
+
+cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int n,
+                                const char *unit, cf_error *err)
+{
+    if (!h)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_parameter: no file");
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = write_parameter_impl(h, name, v, n, unit, err);
+    quiet_end(&q);
+    return st;
+}
+
 static cf_status add_handoff_impl(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
 {
     if (!h)

@@ -388,6 +388,45 @@ static cf_status write_fragment_infos(cf_sim *sim, int first, cf_error *err)
     return st;
 }
 
+/* What a reader needs to bound a run's outcome (tools/check_physics.py):
+ * the box around the nodes, mass, energy and fastest node at t = 0, and the
+ * fastest kinematic obstacle or prescribed node. */
+static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
+{
+    const cf_solid *s = &sim->solid;
+    const cf_scene *sc = sim->scene;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double mass = 0, v2 = 0, u = 0;
+    for (int a = 0; a < s->n_nodes; a++) {
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], s->x[3 * a + k]);
+            hi[k] = fmax(hi[k], s->x[3 * a + k]);
+        }
+        mass += s->m[a];
+        v2 = fmax(v2, v3_dot(&s->v[3 * a], &s->v[3 * a]));
+    }
+    for (int j = 0; j < sc->n_obstacles; j++) {
+        double uj[3];
+        cf_obstacle_velocity(&sc->obstacles[j], uj);
+        u = fmax(u, v3_norm(uj));
+    }
+    for (int j = 0; j < sc->n_boundaries; j++)
+        u = fmax(u, v3_norm(sc->boundaries[j].velocity));
+    double v0 = sqrt(v2);
+    cf_status st = cf_h5_write_parameter(sim->h5, "initial_lower", lo, 3, "m", err);
+    if (st == CF_OK)
+        st = cf_h5_write_parameter(sim->h5, "initial_upper", hi, 3, "m", err);
+    if (st == CF_OK)
+        st = cf_h5_write_parameter(sim->h5, "total_mass", &mass, 1, "kg", err);
+    if (st == CF_OK)
+        st = cf_h5_write_parameter(sim->h5, "initial_energy", &sim->e0, 1, "J", err);
+    if (st == CF_OK)
+        st = cf_h5_write_parameter(sim->h5, "max_initial_speed", &v0, 1, "m/s", err);
+    if (st == CF_OK)
+        st = cf_h5_write_parameter(sim->h5, "max_obstacle_speed", &u, 1, "m/s", err);
+    return st;
+}
+
 cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim **out,
                         cf_error *err)
 {
@@ -458,6 +497,8 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
     }
     if (st == CF_OK && scene->output.file[0]) {
         st = cf_h5_open(scene->output.file, scene->name, scene->resolved, &sim->h5, err);
+        if (st == CF_OK)
+            st = write_initial_bounds(sim, err);
         if (st == CF_OK)
             st = write_fragment_infos(sim, 0, err);
     }

@@ -6,6 +6,12 @@
  *   /                      attrs creator, version, units="SI", up_axis="+z",
  *                          quaternion_order="wxyz", scene_name
  *   /parameters/scene      the resolved scene (Lua text), string
+ *   /parameters/initial_lower[3], initial_upper[3] (m: the box around every
+ *                          node at t = 0), total_mass (kg), initial_energy (J:
+ *                          kinetic + strain at t = 0), max_initial_speed (m/s:
+ *                          the fastest node at t = 0), max_obstacle_speed (m/s:
+ *                          the fastest kinematic obstacle or prescribed node);
+ *                          each with a `unit` attribute
  *   /particles/fragments/<field>/{step[T] int64, time[T] float64 s, value[T][N](...)}
  *       field   value shape   meaning                         fill
  *       id          [T][N]     fragment id, -1 when not alive   -1
@@ -120,6 +126,13 @@ cf_status cf_h5_add_fragments(cf_h5 *h, const cf_frag_info *info, int n, cf_erro
  * Cheap (open datasets are kept); reaches the disk with the next flush. */
 cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double time,
                                  double value, cf_error *err);
+
+/* Write /parameters/<name>: `n` float64 values (a scalar when n = 1) with
+ * a `unit` attribute (none when unit is NULL), once per name.  What a reader
+ * needs beyond the scene text, e.g. the initial state's bounds.  A name that
+ * is empty, holds '/' or exists already gives CF_ERR_OUTPUT. */
+cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int n,
+                                const char *unit, cf_error *err);
 
 /* Append one hand-off record. */
 cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err);

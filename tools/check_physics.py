@@ -1,0 +1,136 @@
+#!/usr/bin/python3
+"""Check a cohfrac run file against physical bounds (docs/physics.md, "Plausibility").
+
+usage: check_physics.py OUT.h5 [OUT.h5 ...] [--quiet]
+
+For each file, from /parameters (written by the engine at t = 0) and the
+ledger in /observables:
+
+  speed     every fragment alive at the last frame is no faster than
+            1.1 (v0 + 2 U + sqrt(2 g H)): v0 the fastest node at t = 0
+            (max_initial_speed), U the fastest kinematic obstacle or
+            prescribed node (max_obstacle_speed; a body hit by a wall moving
+            at U leaves at most at 2U), H the fall: the top of the bodies at
+            t = 0 (initial_upper) above the lowest centre any fragment ever
+            reaches, along gravity;
+  energy    kinetic energy at every frame <= the input: initial (kinetic +
+            strain at t = 0) + gravity's work + the prescribed nodes' work
+            (when positive) + 1/2 M (2U)^2 for kinematic impactors;
+  dissipation  energy_cohesive_dissipated is never negative and never falls
+            (by more than 1e-9 of the input, round-off);
+  residual  |energy_residual| <= 1% of the input at every frame.
+
+Prints one line per check with the figure and its bound.  Exit status 0
+when every check of every file holds, 1 when one fails, 2 when a file
+cannot be read or lacks a dataset (the message names it).
+"""
+import argparse
+import sys
+
+import h5py
+import numpy as np
+
+REQUIRED_PARAMETERS = ("initial_upper", "total_mass", "initial_energy", "max_initial_speed",
+                       "max_obstacle_speed")
+REQUIRED_OBSERVABLES = ("energy_kinetic", "energy_cohesive_dissipated", "energy_residual",
+                        "work_gravity", "work_boundary")
+
+
+def gravity_of(scene):
+    """The scene's gravity vector (m/s^2) from the resolved scene text."""
+    for line in scene.splitlines():
+        line = line.strip()
+        if line.startswith("gravity") and "{" in line:
+            inner = line[line.index("{") + 1:line.index("}")]
+            return np.array([float(x) for x in inner.split(",")])
+    return np.zeros(3)
+
+
+def read(path):
+    """The figures the checks need, or raises KeyError naming what is missing."""
+    with h5py.File(path, "r") as f:
+        for n in REQUIRED_PARAMETERS:
+            if f"parameters/{n}" not in f:
+                raise KeyError(f"/parameters/{n} (written by this cohfrac at t = 0: run the scene again)")
+        for n in REQUIRED_OBSERVABLES:
+            if f"observables/{n}/value" not in f:
+                raise KeyError(f"/observables/{n}")
+        if "particles/fragments/velocity/value" not in f:
+            raise KeyError("/particles/fragments/velocity")
+        scene = f["parameters/scene"][()]
+        scene = scene.decode() if isinstance(scene, bytes) else str(scene)
+        p = {n: np.asarray(f[f"parameters/{n}"][()], dtype=float) for n in REQUIRED_PARAMETERS}
+        o = {n: np.asarray(f[f"observables/{n}/value"][()], dtype=float)
+             for n in REQUIRED_OBSERVABLES}
+        frames = len(f["particles/fragments/position/step"])
+        pos = f["particles/fragments/position/value"][:frames]
+        vel = f["particles/fragments/velocity/value"][:frames]
+    return scene, p, o, pos, vel
+
+
+def check_file(path, quiet=False):
+    scene, p, o, pos, vel = read(path)
+    g = gravity_of(scene)
+    gn = float(np.linalg.norm(g))
+    up = -g / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
+    v0 = float(p["max_initial_speed"])
+    U = float(p["max_obstacle_speed"])
+    M = float(p["total_mass"])
+    top = float(np.dot(p["initial_upper"], up)) if gn > 0 else 0.0
+    heights = pos @ up
+    lowest = float(np.nanmin(heights)) if np.isfinite(heights).any() else top
+    H = max(0.0, top - lowest) if gn > 0 else 0.0
+    v_bound = 1.1 * (v0 + 2 * U + np.sqrt(2 * gn * H))
+    speeds = np.linalg.norm(vel[-1], axis=-1) if len(vel) else np.zeros(0)
+    v_max = float(np.nanmax(speeds)) if np.isfinite(speeds).any() else 0.0
+
+    work_in = o["work_gravity"] + np.maximum(o["work_boundary"], 0.0)
+    input_e = float(p["initial_energy"]) + work_in + 0.5 * M * (2 * U) ** 2
+    input_ref = float(np.max(np.maximum(input_e, 1e-300)))
+    ke = o["energy_kinetic"]
+    ke_excess = float(np.max(ke - input_e)) if len(ke) else 0.0
+    diss = o["energy_cohesive_dissipated"]
+    diss_min = float(np.min(diss)) if len(diss) else 0.0
+    diss_drop = float(np.max(diss[:-1] - diss[1:])) if len(diss) > 1 else 0.0
+    resid = float(np.max(np.abs(o["energy_residual"]))) if len(o["energy_residual"]) else 0.0
+    tol = 1e-9 * input_ref
+
+    checks = [
+        ("speed", v_max <= v_bound,
+         f"fastest fragment at the end {v_max:.4g} m/s <= {v_bound:.4g} m/s "
+         f"(1.1 (v0 {v0:.3g} + 2U {2 * U:.3g} + sqrt(2 g H), H {H:.3g} m))"),
+        ("energy", ke_excess <= tol,
+         f"kinetic energy <= input at every frame (largest {float(np.max(ke)) if len(ke) else 0:.4g} J "
+         f"against {float(input_e[int(np.argmax(ke))]) if len(ke) else 0:.4g} J then)"),
+        ("dissipation", diss_min >= -tol and diss_drop <= tol,
+         f"cohesive dissipation never negative (min {diss_min:.3g} J) and never falls "
+         f"(largest fall {max(diss_drop, 0):.3g} J)"),
+        ("residual", resid <= 0.01 * input_ref,
+         f"ledger residual {resid:.4g} J = {100 * resid / input_ref:.3g}% of the input "
+         f"{input_ref:.4g} J (<= 1%)"),
+    ]
+    ok = all(c[1] for c in checks)
+    if not quiet or not ok:
+        print(f"{path}:")
+        for name, good, text in checks:
+            print(f"  {'ok  ' if good else 'FAIL'}  {name:<11} {text}")
+    return ok
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("files", nargs="+")
+    ap.add_argument("--quiet", action="store_true", help="print only failing files")
+    a = ap.parse_args()
+    ok = True
+    for path in a.files:
+        try:
+            ok &= check_file(path, a.quiet)
+        except (OSError, KeyError) as e:
+            print(f"check_physics.py: {path}: cannot check: {e}", file=sys.stderr)
+            return 2
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
