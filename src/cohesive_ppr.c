@@ -93,7 +93,15 @@ static double component_work(double d0, double T0, double d, double T, double t0
     return 0.5 * (T0 + T) * (d - d0);
 }
 
-int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n, double dt,
+const cf_ppr *cf_ppr_scaled(const cf_ppr *p, double w, cf_ppr *out)
+{
+    *out = *p;
+    out->sigma_max *= w, out->tau_max *= w;
+    out->delta_n /= w, out->delta_t /= w, out->dbar_n /= w, out->dbar_t /= w;
+    return out;
+}
+
+int cf_cohesive_forces(cf_solid *s, const cf_ppr *law, const int *elems, int n, double dt,
                        double kp)
 {
     int n_failed = 0;
@@ -104,6 +112,8 @@ int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n, do
         double area = mid_normal(s, ce, s->x, a, b, nrm);
         if (area == 0)
             continue;
+        cf_ppr scaled;
+        const cf_ppr *p = ce->strength == 1.0 ? law : cf_ppr_scaled(law, ce->strength, &scaled);
         for (int i = 0; i < 3; i++) {
             if (a[i] == b[i]) /* the crack has not opened at this vertex yet */
                 continue;
@@ -124,7 +134,7 @@ int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n, do
             double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
             double cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
             if (dn <= 0) { /* compression: penalty, while the faces still face each other */
-                double facing = v3_dot(d, d) <= 0.25 * area;
+                double facing = kp >= 0 && v3_dot(d, d) <= 0.25 * area;
                 Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
             }
             /* The tangential traction rises from zero with the capped
@@ -142,7 +152,9 @@ int cf_cohesive_forces(cf_solid *s, const cf_ppr *p, const int *elems, int n, do
             double *L = ce->last[i];
             ce->work[i] += area / 3.0 *
                            (component_work(L[0], L[2], dn, Tn, t0plus) + 0.5 * (L[3] + Tt) * (dtl - L[1]));
-            ce->stored[i] = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
+            double elastic = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
+            ce->dissipated[i] = fmax(ce->dissipated[i], ce->work[i] - elastic);
+            ce->stored[i] = ce->work[i] - ce->dissipated[i];
             L[0] = dn, L[1] = dtl, L[2] = Tn, L[3] = Tt;
             double fvec[3] = {0, 0, 0};
             v3_axpy(area / 3.0 * Tn, nrm, fvec);
@@ -163,10 +175,10 @@ void cf_cohesive_energy(const cf_solid *s, const int *elems, int n, double *stor
     for (int e = 0; e < count; e++) {
         const cf_cohesive *ce = &s->coh[elems ? elems[e] : e];
         for (int i = 0; i < 3; i++)
-            st += ce->stored[i], w += ce->work[i];
+            st += ce->stored[i], w += ce->dissipated[i];
     }
     *stored = st;
-    *dissipated = w - st;
+    *dissipated = w;
 }
 
 double cf_cohesive_release(cf_solid *s, const int *elems, int n)

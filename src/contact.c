@@ -243,23 +243,81 @@ void cf_node_impulses_free(cf_node_impulses *ni)
     memset(ni, 0, sizeof *ni);
 }
 
-double cf_node_impulses_flush(cf_sim *sim, cf_node_impulses *ni)
+/* Per body pushed in this rigid step: the impulses' sum, the fastest node
+ * that pushed it, the scale of its impulses and its spin before them. */
+typedef struct {
+    double J[3], vmax, beta, w0[3];
+    int hit;
+} push_sum;
+
+double cf_node_impulses_flush(cf_sim *sim, cf_node_impulses *ni, const int *nodes)
 {
-    double gained = 0;
+    int n = sim->n_frag;
+    push_sum *sum = calloc((size_t)n, sizeof *sum);
+    double gained = 0, bounce = 1.0 + sim->solid.mat.restitution;
+    for (int i = 0; sum && i < ni->n; i++) {
+        int g = ni->frag[i];
+        if (g < 0 || sim->frag[g].body < 0)
+            continue;
+        v3_axpy(-1.0, &ni->J[3 * i], sum[g].J);
+        sum[g].vmax = fmax(sum[g].vmax, v3_norm(&sim->solid.v[3 * nodes[i]]));
+        sum[g].hit = 1;
+    }
+    for (int g = 0; g < n; g++) {
+        if (!sum || !sum[g].hit)
+            continue;
+        cfb_state st;
+        cfb_get_state(sim->bullet, sim->frag[g].body, &st);
+        memcpy(sum[g].w0, st.w, sizeof st.w);
+        double Jl = v3_norm(sum[g].J), u[3];
+        for (int k = 0; k < 3; k++)
+            u[k] = sum[g].J[k] / Jl;
+        double room = bounce * sum[g].vmax - v3_dot(st.v, u), dv = Jl / sim->frag[g].mass;
+        sum[g].beta = dv > room ? fmax(0.0, room) / dv : 1.0;
+        gained -= cf_body_kinetic_energy(sim, g);
+    }
     for (int i = 0; i < ni->n; i++) {
         int g = ni->frag[i];
         if (g < 0)
             continue;
-        const cf_fragment *o = &sim->frag[g];
-        double J[3] = {-ni->J[3 * i], -ni->J[3 * i + 1], -ni->J[3 * i + 2]};
+        cf_fragment *o = &sim->frag[g];
+        double beta = sum ? sum[g].beta : 1.0;
+        double J[3] = {-beta * ni->J[3 * i], -beta * ni->J[3 * i + 1], -beta * ni->J[3 * i + 2]};
         if (o->body >= 0) {
-            double before = cf_body_kinetic_energy(sim, g);
             cfb_apply_impulse(sim->bullet, o->body, J, &ni->point[3 * i]);
-            gained += cf_body_kinetic_energy(sim, g) - before;
-            sim->frag[g].pushed += v3_norm(J);
+            o->pushed += v3_norm(J);
+        }
+        if (beta < 1.0) { /* what the body did not take stays with the node */
+            int a = nodes[i];
+            double *va = &sim->solid.v[3 * a], m = sim->solid.m[a];
+            gained -= 0.5 * m * v3_dot(va, va);
+            v3_axpy(-(1.0 - beta) / m, &ni->J[3 * i], va);
+            gained += 0.5 * m * v3_dot(va, va);
         }
         ni->frag[i] = -1;
         memset(&ni->J[3 * i], 0, 3 * sizeof(double));
     }
+    for (int g = 0; g < n; g++) { /* the spin the pushes gave, bounded likewise */
+        if (!sum || !sum[g].hit)
+            continue;
+        const cf_fragment *o = &sim->frag[g];
+        cfb_state st;
+        cfb_get_state(sim->bullet, o->body, &st);
+        double dw[3], Rb[9], wb[3], e = 0, v2 = bounce * sum[g].vmax;
+        v3_sub(st.w, sum[g].w0, dw);
+        quat_to_mat(st.quat, Rb);
+        m3_tmulv(Rb, dw, wb);
+        for (int k = 0; k < 3; k++)
+            e += 0.5 * o->principal[k] * wb[k] * wb[k];
+        double limit = 0.5 * o->mass * v2 * v2;
+        if (e > limit) {
+            double gamma = sqrt(limit / e);
+            for (int k = 0; k < 3; k++)
+                st.w[k] = sum[g].w0[k] + gamma * dw[k];
+            cfb_set_state(sim->bullet, o->body, &st);
+        }
+        gained += cf_body_kinetic_energy(sim, g);
+    }
+    free(sum);
     return gained;
 }

@@ -3,6 +3,7 @@
 #include "sim.h"
 
 #include "linalg.h"
+#include "tet4.h"
 
 #include <math.h>
 
@@ -348,6 +349,114 @@ static int take_component(cf_sim *sim, int ci, const int *tets, const int *comp,
         }
     }
     return 0;
+}
+
+static int position_of(const int *tets, int nt, int t) /* tets ascending */
+{
+    int lo = 0, hi = nt - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (tets[mid] < t)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+static int root_of(int *parent, int i)
+{
+    while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+/* Pieces of fragment f (comp[], k of them) still held together by a
+ * cohesive element with a node pair not yet failed are one piece: merge
+ * them and renumber in order of first tet.  Returns the new count, -1 out
+ * of memory. */
+static int join_by_cohesion(const cf_solid *s, const cf_fragment *f, int *comp, int k)
+{
+    int *parent = malloc((size_t)k * 2 * sizeof(int)), *label = parent + k;
+    if (!parent)
+        return -1;
+    for (int c = 0; c < k; c++)
+        parent[c] = c, label[c] = -1;
+    for (int e = 0; e < f->coh.n; e++) {
+        const cf_cohesive *ce = &s->coh[f->coh.v[e]];
+        if (ce->failed[0] && ce->failed[1] && ce->failed[2])
+            continue;
+        int a = root_of(parent, comp[position_of(f->tets, f->nt, ce->tet[0])]);
+        int b = root_of(parent, comp[position_of(f->tets, f->nt, ce->tet[1])]);
+        if (a != b)
+            parent[a > b ? a : b] = a < b ? a : b;
+    }
+    int n = 0;
+    for (int i = 0; i < f->nt; i++) {
+        int r = root_of(parent, comp[i]);
+        if (label[r] < 0)
+            label[r] = n++;
+        comp[i] = label[r];
+    }
+    free(parent);
+    return n;
+}
+
+int cf_fragment_split_fracture(cf_sim *sim, int fi, int *first)
+{
+    cf_solid *s = &sim->solid;
+    cf_fragment *f = &sim->frag[fi];
+    f->cracked = 0;
+    int nt = f->nt, *tets = f->tets;
+    int *comp = malloc((size_t)nt * sizeof(int));
+    if (!comp)
+        return -1;
+    int k = cf_label_components(s, tets, nt, comp);
+    if (k > 1)
+        k = join_by_cohesion(s, f, comp, k);
+    if (k <= 1) {
+        free(comp);
+        return k < 0 ? -1 : 0;
+    }
+    /* The parent's per-node leapfrog kinetic energy terms, by node id. */
+    int *index = malloc((size_t)s->n_nodes * sizeof(int));
+    unsigned char *seen = calloc((size_t)s->n_nodes, 1);
+    int rc = -(!index || !seen);
+    for (int i = 0; rc == 0 && i < f->nodes.n; i++)
+        index[f->nodes.v[i]] = i;
+    *first = sim->n_frag;
+    for (int c = 0; rc == 0 && c < k; c++)
+        if (cf_fragment_new(sim, fi, sim->t) < 0)
+            rc = -1;
+    for (int c = 0; rc == 0 && c < k; c++) {
+        int ci = *first + c;
+        if (take_component(sim, ci, tets, comp, nt, c, seen)) {
+            rc = -1;
+            break;
+        }
+        cf_fragment *g = &sim->frag[ci], *p = &sim->frag[fi]; /* the array may have moved */
+        cf_fragment_rest_props(sim, ci);
+        g->mode = CF_MODE_FRACTURE;
+        g->steps = p->steps, g->quiet = p->quiet, g->t_enter = p->t_enter;
+        memcpy(g->q_match, p->q_match, sizeof g->q_match);
+        g->e_strain = cf_tet4_strain_energy(s, g->tets, g->nt);
+        for (int i = 0; i < g->nodes.n; i++) {
+            int a = g->nodes.v[i];
+            g->e_kin += 0.5 * s->m[a] * v3_dot(&p->v_old[3 * index[a]], &s->v[3 * a]);
+            v3_axpy(s->m[a], &s->x[3 * a], g->mx);
+        }
+        if (collect_cohesive(sim, g) || cf_bars_build(&g->bars, s, g->tets, g->nt))
+            rc = -1;
+    }
+    if (rc == 0) {
+        f = &sim->frag[fi];
+        f->mode = CF_MODE_DEAD;
+        f->tets = NULL, f->nt = 0, f->nodes.n = 0, f->coh.n = 0;
+        cf_bars_free(&f->bars);
+        free(tets);
+    }
+    free(comp), free(index), free(seen);
+    return rc ? -1 : k;
 }
 
 double cf_fragment_margin(const cf_sim *sim, int fi)

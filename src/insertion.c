@@ -90,13 +90,14 @@ static void mark_hot_nodes(cf_solid *s, const int *tets, int nt, unsigned char v
                 s->node_mark[s->tet[4 * tets[i] + j]] = value;
 }
 
-cf_stress_check cf_insertion_bound(const cf_material *m, cf_criterion rule)
+cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule)
 {
     cf_stress_check c = {INFINITY, INFINITY};
+    double w = s->strength ? s->strength_min : 1.0; /* the weakest facet */
     if (rule == CF_CRITERION_SOURCE)
-        c.s1 = 0.9 * m->sigma_max;
+        c.s1 = 0.9 * s->mat.sigma_max * w;
     else if (rule == CF_CRITERION_TRACTION)
-        c.s1 = m->sigma_max, c.tau = m->tau_max;
+        c.s1 = s->mat.sigma_max * w, c.tau = s->mat.tau_max * w;
     return c;
 }
 
@@ -117,8 +118,9 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
             const int *F = &s->facet[4 * f];
             if (F[2] < 0 || s->cracked[f] || F[0] != ta || (s->candidate && !s->candidate[f]))
                 continue;
+            double w = s->strength ? s->strength[f] : 1.0; /* this facet's strength */
             if (rule == CF_CRITERION_SOURCE) {
-                if (source_rule(s, ta, k, 0.9 * smax) && cf_int_list_push(out, f))
+                if (source_rule(s, ta, k, 0.9 * smax * w) && cf_int_list_push(out, f))
                     rc = -1;
                 continue;
             }
@@ -133,7 +135,7 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
             double sn = v3_dot(n, t);
             double tau2 = v3_dot(t, t) - sn * sn;
             double tau = tau2 > 0 ? sqrt(tau2) : 0;
-            if ((sn >= smax || tau >= tmax) && cf_int_list_push(out, f))
+            if ((sn >= smax * w || tau >= tmax * w) && cf_int_list_push(out, f))
                 rc = -1;
         }
     }
@@ -229,6 +231,7 @@ int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes)
     cf_cohesive ce;
     memset(&ce, 0, sizeof ce);
     ce.tet[0] = ta, ce.tet[1] = tb;
+    ce.strength = s->strength ? s->strength[f] : 1.0;
     for (int i = 0; i < 3; i++) {
         int sa = CF_TET_FACE[fa][i];
         int o = s->tet0[4 * ta + sa];

@@ -14,12 +14,13 @@ typedef struct cf_int_list {
 int cf_int_list_push(cf_int_list *l, int value); /* 0, or -1 out of memory */
 
 /* The tet-level bound of `rule` for cf_tet4_forces: s1 = 0.9 sigma_max
- * (source) or sigma_max (traction), tau = tau_max (traction only).  Both
+ * (source) or sigma_max (traction), tau = tau_max (traction only), each
+ * times the weakest facet's strength factor (s->strength_min).  Both
  * rules need a principal or shear stress at or above these in at least one
  * tet next to the facet (the largest eigenvalue of a volume average is at
  * most the largest of the averaged ones), so facets away from hot tets are
  * never looked at. */
-cf_stress_check cf_insertion_bound(const cf_material *m, cf_criterion rule);
+cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
 
 /* Insertion criterion on the interior, uncracked facets of `tets` (in list
  * order, each facet seen from its lower tet), from the stresses s->sigma
@@ -28,6 +29,7 @@ cf_stress_check cf_insertion_bound(const cf_material *m, cf_criterion rule);
  * - CF_CRITERION_TRACTION: with the mean stress of the two tets and the
  *   current facet normal n, t = sigma n, sigma_n = n.t, tau = |t - sigma_n n|;
  *   the facet qualifies when sigma_n >= sigma_max or tau >= tau_max.
+ * (sigma_max and tau_max times the facet's s->strength factor throughout.)
  * - CF_CRITERION_SOURCE (the source's rule, §6.6.2): the volume-averaged
  *   nodal maximum principal stress is >= 0.9 sigma_max at all three nodes
  *   (computed only at nodes of hot tets, in s->nodal, s->node_mark).

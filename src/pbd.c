@@ -186,19 +186,25 @@ typedef struct {
     double *p1, *p2, w1, w2, d[3], len;
 } bar_now;
 
-static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
+/* Bar i on positions pos (s->p, or s->x). */
+static inline bar_now bar_on(const cf_bars *b, cf_solid *s, double *pos, int i)
 {
     int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-    bar_now r = {&s->p[3 * i1], &s->p[3 * i2], 1.0 / s->m[i1], 1.0 / s->m[i2], {0, 0, 0}, 0};
+    bar_now r = {&pos[3 * i1], &pos[3 * i2], 1.0 / s->m[i1], 1.0 / s->m[i2], {0, 0, 0}, 0};
     v3_sub(r.p1, r.p2, r.d);
     r.len = v3_norm(r.d);
     return r;
 }
 
-/* One bar of the PBD sweep. */
-static inline void project_bar(const cf_bars *b, cf_solid *s, double k, int i)
+static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
 {
-    bar_now r = bar_at(b, s, i);
+    return bar_on(b, s, s->p, i);
+}
+
+/* One bar of the PBD sweep on positions pos. */
+static inline void project_bar(const cf_bars *b, cf_solid *s, double *pos, double k, int i)
+{
+    bar_now r = bar_on(b, s, pos, i);
     if (r.len == 0)
         return;
     double c = k * (r.len - b->rest[i]) / ((r.w1 + r.w2) * r.len);
@@ -238,7 +244,21 @@ static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double s
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
 {
     if (b->n > 0)
-        SWEEP(b, project_bar(b, s, k, i))
+        SWEEP(b, project_bar(b, s, s->p, k, i))
+}
+
+/* Bar i's two ends see each other's speed. */
+static inline void neighbour_speed(const cf_bars *b, const double *v, double *cap, int i)
+{
+    int a = b->ends[2 * i], c = b->ends[2 * i + 1];
+    cap[a] = fmax(cap[a], v3_norm(&v[3 * c]));
+    cap[c] = fmax(cap[c], v3_norm(&v[3 * a]));
+}
+
+void cf_bars_neighbour_speed(const cf_bars *b, const double *v, double *cap)
+{
+    if (b->n > 0)
+        SWEEP(b, neighbour_speed(b, v, cap, i))
 }
 
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
@@ -310,14 +330,17 @@ double cf_obstacle_distance(const cf_obstacles *obs, int j, double t, const doub
     return INFINITY;
 }
 
-int cf_obstacles_project(const cf_obstacles *obs, double t, double p[3], double normal[3])
+int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], double t,
+                         double p[3], double normal[3])
 {
     int hit = -1;
     for (int j = 0; j < obs->n; j++) {
-        double nrm[3];
+        double nrm[3], nx[3];
         double dist = cf_obstacle_distance(obs, j, t, p, nrm);
         if (dist < 0) {
-            v3_axpy(-dist, nrm, p);
+            double allowed = fmin(0.0, cf_obstacle_distance(obs, j, t0, x, nx));
+            if (dist < allowed)
+                v3_axpy(allowed - dist, nrm, p);
             memcpy(normal, nrm, sizeof nrm);
             hit = j;
         }

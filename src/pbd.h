@@ -38,6 +38,10 @@ void cf_bars_free(cf_bars *b);
  * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
 
+/* cap[a] = max(cap[a], |v[c]|) for every bar (a, c), both ways (m/s): the
+ * fastest neighbour of each node.  Colour by colour, like the sweep. */
+void cf_bars_neighbour_speed(const cf_bars *b, const double *v, double *cap);
+
 /* The stiffness used per iteration: k, or with `iteration_independent`
  * k' = 1 - (1 - k)^(1/iterations) (Müller et al. 2007, §3.3), so that the
  * stiffness after all iterations does not depend on their number. */
@@ -61,10 +65,16 @@ typedef struct cf_obstacles {
     double *range;
 } cf_obstacles;
 
-/* Move p of node i out of every obstacle along the obstacle's normal by its
- * penetration depth, evaluated at time t.  Returns the index of the last
- * obstacle that was hit, or -1.  `normal` receives its outward normal. */
-int cf_obstacles_project(const cf_obstacles *obs, double t, double p[3], double normal[3]);
+/* Keep a node's prediction p (at time t) out of every obstacle, moving it
+ * along the obstacle's normal: to the surface, or, when the node was already
+ * inside at x (at time t0, the step's start), no deeper than it was then.
+ * An overlap present at the start of the step is thus never pushed out on p
+ * alone, which would turn depth/dt into velocity (energy no load put in);
+ * only the obstacle's own motion over the step moves p.  Returns the index
+ * of the last obstacle that was hit, or -1; `normal` receives its outward
+ * normal. */
+int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], double t,
+                         double p[3], double normal[3]);
 
 /* Velocity of obstacle o (m/s): planes are static, spheres and boxes move
  * at their constant velocity. */

@@ -49,7 +49,9 @@ static const char *const top_keys[] = {"name",     "duration", "gravity",   "mat
                                        "boundary", "obstacles", "solver",   "output"};
 static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
                                             "sigma_max", "alpha", "G_II", "tau_max",
-                                            "beta",  "friction", "restitution"};
+                                            "beta",  "friction", "restitution", "strength"};
+static const char *const strength_keys[] = {"distribution", "modulus", "seed"};
+static const char *const distribution_names[] = {"uniform", "weibull"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
                                         "velocity", "angular_velocity", "expansion_rate",
                                         "expansion_center", "hollow_layers"};
@@ -122,6 +124,7 @@ typedef struct range {
 } range;
 
 static const range POSITIVE = {0.0, INFINITY, 0, 0, NULL};
+static const range ANY_INTEGER = {-INFINITY, INFINITY, 1, 1, NULL};
 static const range NON_NEGATIVE = {0.0, INFINITY, 1, 0, NULL};
 static const range AT_LEAST_ONE = {1.0, INFINITY, 1, 0, NULL};
 static const range UNIT = {0.0, 1.0, 1, 1, NULL};
@@ -778,6 +781,17 @@ static cf_status resolve_surface(loader *ld, const char *key, const char *name, 
     } while (0)
 
 
+static cf_status read_strength(loader *ld, int t, cf_material *m)
+{
+    static const double modulus = 10.0;
+    TRY(check_keys(ld, t, strength_keys, COUNT(strength_keys)));
+    TRY(get_enum(ld, t, "distribution", distribution_names, COUNT(distribution_names), 0,
+                 &m->weibull));
+    TRY(get_num(ld, t, "modulus", &modulus, &POSITIVE, &m->weibull_modulus));
+    TRY(get_int(ld, t, "seed", 1, &ANY_INTEGER, &m->strength_seed));
+    return CF_OK;
+}
+
 static cf_status read_material(loader *ld, int t, cf_material *m)
 {
     static const double E = 1e6, nu = 0.3, rho = 2400.0, G_I = 22.0, sigma = 1e4, alpha = 2.0,
@@ -796,6 +810,7 @@ static cf_status read_material(loader *ld, int t, cf_material *m)
     TRY(get_num(ld, t, "beta", &m->alpha, &PPR_SHAPE, &m->beta));
     TRY(get_num(ld, t, "friction", &friction, &NON_NEGATIVE, &m->friction));
     TRY(get_num(ld, t, "restitution", &restitution, &restitution_range, &m->restitution));
+    WITH_TABLE(ld, t, "strength", read_strength(ld, lua_gettop(ld->L), m));
     return CF_OK;
 }
 
@@ -1663,6 +1678,11 @@ static char *resolved_text(const cf_scene *s)
     put_num(&b, 4, "beta", m->beta);
     put_num(&b, 4, "friction", m->friction);
     put_num(&b, 4, "restitution", m->restitution);
+    put(&b, "    strength = {\n");
+    put_str(&b, 6, "distribution", distribution_names[m->weibull]);
+    put_num(&b, 6, "modulus", m->weibull_modulus);
+    put_num(&b, 6, "seed", m->strength_seed);
+    put(&b, "    },\n");
     put(&b, "  },\n  bodies = {\n");
     for (int i = 0; i < s->n_bodies; i++) {
         const cf_body_def *d = &s->bodies[i];

@@ -595,9 +595,10 @@ void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
     l->work_obstacles = sim->flow.obstacles;
     l->contact = sim->flow.contact, l->pbd = sim->flow.pbd;
     l->damping = sim->flow.damping, l->handoff = sim->flow.handoff;
+    l->integration = sim->flow.integration;
     l->initial = sim->e0;
     l->residual = l->kinetic + l->strain + l->cohesive_stored + l->cohesive_dissipated +
-                  l->contact + l->pbd + l->damping + l->handoff -
+                  l->contact + l->pbd + l->damping + l->handoff + l->integration -
                   (l->initial + l->work_gravity + l->work_boundary + l->work_obstacles);
 }
 
@@ -701,6 +702,7 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
         {"work_boundary", l.work_boundary},
         {"work_obstacles", l.work_obstacles},
         {"energy_contact_removed", l.contact},
+        {"energy_rigid_integration_removed", l.integration},
         {"energy_pbd_removed", l.pbd},
         {"energy_damping_removed", l.damping},
         {"energy_handoff_loss", l.handoff},
@@ -853,6 +855,10 @@ static cf_status bullet_step(cf_sim *sim, double dt, cf_error *err)
         cfb_state now;
         cfb_get_state(sim->bullet, f->body, &now);
         double removed = body_energy(sim, f, &pre[fi]) - body_energy(sim, f, &now);
+        if (cfb_contact_impulse(sim->bullet, f->body) == 0) { /* free flight */
+            sim->flow.integration += removed;
+            continue;
+        }
         if (removed < 0 && any_moving) { /* a moving obstacle did work on it */
             sim->flow.obstacles -= removed;
             removed = 0;
@@ -954,7 +960,7 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
         cf_fragment *f = &sim->frag[fi];
         if (f->mode != CF_MODE_FRACTURE)
             continue;
-        sim->flow.contact -= cf_node_impulses_flush(sim, &f->push);
+        sim->flow.contact -= cf_node_impulses_flush(sim, &f->push, f->nodes.v);
         f->near.n = 0;
         char what[160];
         if (!nodes_sane(&sim->solid, f)) {
@@ -964,11 +970,17 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
                      fi);
             return diverged(sim, err, what);
         }
-        if (f->n_inverted > set->max_inverted_fraction * f->nt) {
+        /* Inverted tets counted over the fragment's whole initial body in
+         * fracture mode (one inverted tet is all of a one-tet piece). */
+        int root = cf_fragment_root(sim, fi), inv = 0, nt = 0;
+        for (int g = 0; f->n_inverted > 0 && g < n; g++)
+            if (sim->frag[g].mode == CF_MODE_FRACTURE && cf_fragment_root(sim, g) == root)
+                inv += sim->frag[g].n_inverted, nt += sim->frag[g].nt;
+        if (inv > set->max_inverted_fraction * nt) {
             snprintf(what, sizeof what,
-                     "fragment %d diverged: %d of its %d tets are inverted (more than "
-                     "solver.guard.max_inverted_fraction = %g)",
-                     fi, f->n_inverted, f->nt, set->max_inverted_fraction);
+                     "fragment %d diverged: %d of the %d tets of its body in fracture mode are "
+                     "inverted (more than solver.guard.max_inverted_fraction = %g)",
+                     fi, inv, nt, set->max_inverted_fraction);
             return diverged(sim, err, what);
         }
     }
@@ -1017,6 +1029,30 @@ static cf_status return_to_rigid(cf_sim *sim, cf_error *err)
     return CF_OK;
 }
 
+/* Fracture-only runs: fragments that cracked in this step and now fall
+ * apart become one fragment per connected piece, labelled and written like
+ * the pieces of a hybrid run's hand-off. */
+static cf_status split_fragments(cf_sim *sim, cf_error *err)
+{
+    int n = sim->n_frag;
+    for (int fi = 0; fi < n; fi++) {
+        if (sim->frag[fi].mode != CF_MODE_FRACTURE || !sim->frag[fi].cracked)
+            continue;
+        int first = sim->n_frag;
+        double th = cf_wall_time();
+        int k = cf_fragment_split_fracture(sim, fi, &first);
+        sim->prof.handoff += cf_wall_time() - th;
+        if (k < 0)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory splitting fragment %d", fi);
+        if (k > 0) {
+            cf_status st = write_fragment_infos(sim, first, err);
+            if (st != CF_OK)
+                return st;
+        }
+    }
+    return CF_OK;
+}
+
 int cf_sim_done(const cf_sim *sim) { return sim->step >= sim->n_steps; }
 
 double cf_sim_time(const cf_sim *sim) { return sim->t; }
@@ -1036,6 +1072,8 @@ cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
     sim->t = (double)sim->step * dt;
     if (st == CF_OK && sc->solver.mode == CF_RUN_HYBRID)
         st = return_to_rigid(sim, err);
+    if (st == CF_OK && sc->solver.mode == CF_RUN_FRACTURE)
+        st = split_fragments(sim, err);
     if (st == CF_OK)
         st = check_energy(sim, err);
     if (st == CF_OK && (sim->t >= sim->next_frame - 1e-9 * dt || cf_sim_done(sim))) {
@@ -1242,8 +1280,9 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
     fprintf(out, "                   initial %.6g | work: gravity %.6g, boundary %.6g, "
                  "moving obstacles %.6g\n",
             l.initial, l.work_gravity, l.work_boundary, l.work_obstacles);
-    fprintf(out, "                   removed: contact %.6g, PBD %.6g, damping %.6g, hand-off %.6g\n",
-            l.contact, l.pbd, l.damping, l.handoff);
+    fprintf(out, "                   removed: contact %.6g, PBD %.6g, damping %.6g, hand-off %.6g, "
+                 "rigid integration %.6g\n",
+            l.contact, l.pbd, l.damping, l.handoff, l.integration);
     fprintf(out, "                   residual %.4g J = %.3g of initial + work\n", l.residual,
             l.residual / scale);
     fprintf(out, "momentum           P = (%.6g, %.6g, %.6g) kg m/s, L = (%.6g, %.6g, %.6g) kg m^2/s\n",

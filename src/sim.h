@@ -31,6 +31,7 @@ typedef struct cf_fragment {
     cf_bars bars;
     cf_int_list coh;         /* its cohesive elements */
     long steps, quiet;       /* solver steps in this mode; steps since the last insertion */
+    int cracked;             /* facets inserted since the last split check (fracture-only runs) */
     double t_enter;          /* s, when fracture mode began */
     int *contact;            /* [nodes.n] obstacle in contact after the last projection, -1 */
     double *vn_pre;          /* [nodes.n] normal velocity before projection, m/s */
@@ -72,6 +73,7 @@ typedef struct cf_energy_flows {
     double damping;    /* removed by global damping */
     double handoff;    /* non-rigid kinetic + strain + cohesive stored energy
                           dropped at fracture -> rigid hand-offs */
+    double integration; /* changed by Bullet's integrator in bodies touching nothing */
 } cf_energy_flows;
 
 typedef struct cf_profile {
@@ -140,6 +142,14 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
  * velocities, or a pbd rigid fragment).  Records momentum error and
  * handoff_loss. */
 cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err);
+
+/* Fracture-only runs: split fracture-mode fragment fi into its connected
+ * components, each a new fracture-mode fragment (its tets, nodes, bars and
+ * cohesive elements; the ledger's kinetic energy, strain energy and mass
+ * moment carried over node by node, so the ledger does not jump).  Sets
+ * *first to the first new fragment and returns the number made (0: fi is
+ * one piece and stays), or -1 when out of memory. */
+int cf_fragment_split_fracture(cf_sim *sim, int fi, int *first);
 
 /* Add a Bullet body for rigid fragment fi with COM pos, rotation R (rest ->
  * current), velocity v and angular velocity w. */

@@ -2,6 +2,7 @@
 
 #include "linalg.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -130,6 +131,19 @@ static double tri_area(const double *a, const double *b, const double *c)
     return 0.5 * v3_norm(n);
 }
 
+/* A Weibull draw of scale 1 and modulus m for facet f: w = (-ln(1 - u))^(1/m),
+ * u uniform in (0, 1) from SplitMix64 of (seed, f) (Steele, Lea, Flood 2014),
+ * so that it depends on nothing but the seed and the facet. */
+static double weibull_factor(int seed, int f, double m)
+{
+    uint64_t z = (uint64_t)(uint32_t)seed * 0x9e3779b97f4a7c15ull + (uint64_t)f + 1;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    double u = ((double)(z >> 11) + 0.5) / 9007199254740992.0; /* (0, 1) */
+    return pow(-log1p(-u), 1.0 / m);
+}
+
 cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
 {
     if (s->facet)
@@ -141,6 +155,16 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     if (!s->sigma || !s->hot || !s->node_mark || !s->nodal || build_facets(s))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
                             s->n_tets);
+    s->strength_min = 1.0;
+    if (s->mat.weibull) {
+        s->strength = malloc((size_t)(s->n_facets > 0 ? s->n_facets : 1) * sizeof(float));
+        if (!s->strength)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for facet strengths");
+        for (int f = 0; f < s->n_facets; f++) {
+            s->strength[f] = (float)weibull_factor(s->mat.strength_seed, f, s->mat.weibull_modulus);
+            s->strength_min = fmin(s->strength_min, s->strength[f]);
+        }
+    }
     return CF_OK;
 }
 
@@ -172,6 +196,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     size_t c3 = (size_t)s->cap_nodes * 3 * sizeof(double);
     s->X = malloc(c3), s->x = malloc(c3), s->v = calloc(1, c3), s->p = malloc(c3), s->f = calloc(1, c3);
     s->m = calloc((size_t)s->cap_nodes, sizeof(double));
+    s->vcap = calloc((size_t)s->cap_nodes, sizeof(double));
     s->origin = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet = malloc((size_t)nt * 4 * sizeof(int));
     s->tet0 = malloc((size_t)nt * 4 * sizeof(int));
@@ -182,7 +207,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->tw = calloc((size_t)nt, sizeof(double));
     s->bc = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet_frag = malloc((size_t)nt * sizeof(int));
-    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->origin || !s->tet ||
+    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->origin || !s->tet ||
         !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
@@ -233,9 +258,9 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 
 void cf_solid_free(cf_solid *s)
 {
-    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->origin, s->tet, s->tet0,
+    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->node_mark, s->nodal, s->tf, s->tw, s->bc, s->tet_frag, s->facet,
-                    s->tet_facet, s->cracked, s->candidate, s->vt_start, s->vt_slot, s->coh};
+                    s->tet_facet, s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
     memset(s, 0, sizeof *s);
@@ -258,6 +283,7 @@ int cf_solid_copy_node(cf_solid *s, int n)
         if (grow((void **)&s->X, v3, cap) || grow((void **)&s->x, v3, cap) ||
             grow((void **)&s->v, v3, cap) || grow((void **)&s->p, v3, cap) ||
             grow((void **)&s->f, v3, cap) || grow((void **)&s->m, sizeof(double), cap) ||
+            grow((void **)&s->vcap, sizeof(double), cap) ||
             grow((void **)&s->origin, sizeof(int), cap) || grow((void **)&s->bc, sizeof(int), cap))
             return -1;
         if (s->node_mark && (grow((void **)&s->node_mark, 1, cap) ||

@@ -28,9 +28,12 @@ typedef struct cf_cohesive {
     double dn_max[3], dt_max[3]; /* PPR history: largest openings, m */
     unsigned char failed[3];     /* complete failure per node pair */
     /* Energy of each node pair (J): work absorbed so far (trapezoidal rule
-     * in the openings), and the recoverable part at the last evaluation
-     * (1/2 T Delta A/3 on the secant); dissipated = work - stored. */
-    double work[3], stored[3];
+     * in the openings); dissipated, the largest (work - 1/2 T Delta A/3) so
+     * far, so that it never falls (unloading on the secant keeps it, the
+     * facing switch of the compression penalty and the change of area move
+     * the difference into stored); stored = work - dissipated. */
+    double work[3], stored[3], dissipated[3];
+    double strength;             /* its facet's strength / sigma_max */
     double last[3][4];           /* dn, dt, Tn, Tt at the last evaluation */
     unsigned char started[3];    /* `last` holds an evaluation */
 } cf_cohesive;
@@ -43,6 +46,8 @@ typedef struct cf_solid {
     double *X;                /* [n][3] rest positions, m */
     double *x, *v, *p, *f;    /* [n][3] position m, velocity m/s, PBD prediction m, force N */
     double *m;                /* [n] lumped mass, kg */
+    double *vcap;             /* [n] scratch of the projection: the fastest bar
+                                 neighbour's predicted speed, m/s */
     int *origin;              /* [n] original vertex of each copy */
     int *bc;                  /* [n] boundary condition of the node (scene index), -1 none */
 
@@ -65,6 +70,9 @@ typedef struct cf_solid {
     int *tet_facet;           /* [nt][4] facet of face k */
     unsigned char *cracked;   /* [nf] */
     unsigned char *candidate; /* [nf] may crack (NULL: every interior facet) */
+    float *strength;          /* [nf] facet strength / sigma_max (material.strength;
+                                 NULL: 1 everywhere) */
+    double strength_min;      /* the smallest of them (1 when uniform) */
     unsigned char *node_mark; /* [cap_nodes] scratch of the source criterion, all 0 between
                                  checks (fracture state) */
     double *nodal;            /* [cap_nodes] its nodal values, Pa (fracture state) */

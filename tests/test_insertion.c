@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0};
+static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1};
 
 static void init(cf_solid *s, cf_mesh *m)
 {
@@ -194,7 +194,7 @@ static void test_bound_never_misses_a_facet(void **state)
             int *all = malloc((size_t)s.n_tets * sizeof(int)), n_hot = 0;
             for (int t = 0; t < s.n_tets; t++)
                 all[t] = t;
-            cf_stress_check bound = cf_insertion_bound(&s.mat, rules[r]);
+            cf_stress_check bound = cf_insertion_bound(&s, rules[r]);
             cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, &bound, &n_hot);
             cf_int_list a = {0}, b = {0};
             int na = cf_insertion_candidates(&s, all, s.n_tets, rules[r], n_hot, &a);

@@ -54,8 +54,11 @@ static void beam_stays_stable(void **state)
     verify_figure("mixed_mode_beam", "dt / dt_cfl of this mesh (reported)",
                   sim->dt_fracture / sim->solid.dt_cfl, 0, 0, "");
     verify_figure("mixed_mode_beam", "crack angle at the notch (reported)", angle, 30, 0, "deg");
+    /* Steps of the run (the solver steps of all its fragments, once the
+     * beam is in pieces, are more). */
+    double steps = floor(cf_sim_time(sim) / sim->dt_fracture + 0.5);
     int ok = verify_figure("mixed_mode_beam", "steps run at dt = 3e-5 s without divergence",
-                           (double)sim->steps_fracture, 300, 1e-9, "");
+                           steps, 300, 1e-9, "");
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
     assert_int_equal(st, CF_OK);

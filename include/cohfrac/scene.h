@@ -15,7 +15,17 @@
  *     E [1e6] Pa, nu [0.3], rho [2400] kg/m^3,
  *     G_I [22] N/m, sigma_max [1e4] Pa, alpha [2],
  *     G_II [=G_I] N/m, tau_max [=sigma_max] Pa, beta [=alpha],
- *     friction [0.5], restitution [0.0] }
+ *     friction [0.5], restitution [0.0],
+ *     strength = { distribution ["uniform"] | "weibull",
+ *                  modulus [10] (Weibull modulus m > 0), seed [1] (integer) } }
+ *       per-facet strength scatter: with "weibull" each interior facet f gets
+ *       sigma_max_f = sigma_max w_f, tau_max_f = tau_max w_f, w_f drawn from
+ *       the Weibull distribution P(w <= x) = 1 - exp(-x^m) (scale 1: 63% of
+ *       the facets are weaker than sigma_max), the same for a given seed and
+ *       mesh on any thread count; the facet's cohesive law keeps G_I, G_II
+ *       (its final openings scale with 1/w_f).  Weibull 1951, J Appl Mech
+ *       18:293; for dynamic fragmentation Zhou, Molinari, Ramesh 2006, IJIE
+ *       33:880.
  *   bodies = { {                          one entry per solid
  *     mesh        string: a prepared mesh name ("bunny", "bunny_small")
  *                 looked up in the mesh directory, a path to a TetGen
@@ -132,6 +142,9 @@ typedef struct cf_material {
     double sigma_max, tau_max;     /* cohesive strengths, Pa */
     double alpha, beta;            /* PPR shape parameters */
     double friction, restitution;  /* contact with obstacles */
+    int weibull;                   /* strength distribution: 0 uniform, 1 Weibull */
+    double weibull_modulus;        /* m, > 0 */
+    int strength_seed;
 } cf_material;
 
 typedef struct cf_body_def {

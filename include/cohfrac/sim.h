@@ -25,7 +25,7 @@ typedef struct cf_run_options {
 
 /* The energy ledger (J) and momenta of the whole scene at the current
  * state.  Balance: residual = kinetic + strain + cohesive_stored +
- * cohesive_dissipated + contact + pbd + damping + handoff
+ * cohesive_dissipated + contact + pbd + damping + handoff + integration
  * - (initial + work_gravity + work_boundary + work_obstacles); zero for an
  * exact integrator.  work_obstacles is the work of moving obstacles: the
  * impulse they give a node times their velocity, and for Bullet bodies the
@@ -33,11 +33,14 @@ typedef struct cf_run_options {
  * Kinetic energy of the in-house solver is the leapfrog estimate
  * 1/2 sum m v(n-1/2).v(n+1/2) at the last force evaluation; Bullet bodies'
  * is 1/2 M v^2 + 1/2 w.I w.  `contact`, `pbd`, `damping`, `handoff` are
- * energies removed since t = 0 (see DESIGN §3-§6 and docs/physics.md). */
+ * energies removed since t = 0 (see DESIGN §3-§6 and docs/physics.md);
+ * `integration` is what Bullet's integrator changed in bodies that touched
+ * nothing during a rigid step (its implicit gyroscopic term: a free
+ * spinning asymmetric body loses a little), never booked as contact. */
 typedef struct cf_ledger {
     double kinetic, strain, cohesive_stored, cohesive_dissipated;
     double work_gravity, work_boundary, work_obstacles;
-    double contact, pbd, damping, handoff;
+    double contact, pbd, damping, handoff, integration;
     double initial;            /* kinetic + strain at t = 0 */
     double residual;
     double momentum[3];        /* kg m/s */
