@@ -120,11 +120,13 @@
  *     pbd = { k_stiffness [0.9], iterations [3], k_damping [1.0],
  *             iteration_independent [false]: use k' = 1 - (1-k)^(1/iterations) }
  *     xpbd = { compliance_scale [1] }: bar compliance = scale L^2/(E V_trib)
- *     contact_stiffness [0] Pa/m: crack-face penalty K_p; 0 = the stability
- *       cap of each node pair, K_p A/3 = 1/(4 dt^2 (1/m_a + 1/m_b))
+ *     contact_stiffness [0] Pa/m: crack-face penalty K_p of explicit runs
+ *       (constraints = "none"; with PBD/XPBD the crack-contact constraint
+ *       keeps the faces apart); 0 = the stability cap of each node pair,
+ *       K_p A/3 = 1/(4 dt^2 (1/m_a + 1/m_b))
  *     guard = { max_inverted_fraction [0.01], max_energy_growth [0.5] }:
- *       stop (exit 3) when more than this fraction of a fragment's tets are
- *       inverted, or when the total energy exceeds the initial energy plus
+ *       stop (exit 3) when more than this fraction of the tets of a body's
+ *       fragments in fracture mode are inverted, or when the total energy exceeds the initial energy plus
  *       all work input by this fraction of their sum
  *     threads [0] (0: all cores)
  *   }
