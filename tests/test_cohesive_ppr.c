@@ -71,6 +71,25 @@ static void test_mode_II_work_equals_GII(void **state)
     assert_near(work(&q, 1), 50.0, 50.0 * 1e-6);
 }
 
+/* A facet of strength w sigma_max (material.strength): traction w sigma_max
+ * at zero opening, the same fracture energies in both modes and branches. */
+static void test_scaled_law_keeps_fracture_energy(void **state)
+{
+    (void)state;
+    double ws[] = {0.3, 0.8, 1.7};
+    for (int i = 0; i < 3; i++) {
+        cf_ppr base[2] = {law(22, 40, 1e4, 2e4, 2, 3), law(50, 40, 1e4, 2e4, 3, 2)}, p;
+        for (int b = 0; b < 2; b++) {
+            cf_ppr_scaled(&base[b], ws[i], &p);
+            double Tn, Tt;
+            cf_ppr_envelope(&p, 0, 0, &Tn, &Tt);
+            assert_near(Tn, ws[i] * base[b].sigma_max, 1e-9 * base[b].sigma_max);
+            assert_near(work(&p, 1), base[b].phi_n, base[b].phi_n * 1e-6);
+            assert_near(work(&p, 2), base[b].phi_t, base[b].phi_t * 1e-6);
+        }
+    }
+}
+
 /* Unloading goes linearly to the origin; reloading retraces it; failure is final. */
 static void test_unloading_and_failure(void **state)
 {
@@ -100,6 +119,7 @@ int main(void)
         cmocka_unit_test(test_mode_I_work_equals_GI),
         cmocka_unit_test(test_mode_II_work_equals_GII),
         cmocka_unit_test(test_unloading_and_failure),
+        cmocka_unit_test(test_scaled_law_keeps_fracture_energy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
