@@ -220,3 +220,26 @@ void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
         }
     }
 }
+
+void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double normal[3],
+                       double *area, double *opening, double *sliding, int *failed)
+{
+    const cf_cohesive *ce = &s->coh[e];
+    int a[3], b[3];
+    *area = mid_normal(s, ce, s->x, a, b, normal);
+    *opening = *sliding = 0;
+    *failed = ce->failed[0] && ce->failed[1] && ce->failed[2];
+    centroid[0] = centroid[1] = centroid[2] = 0;
+    for (int i = 0; i < 3; i++) {
+        double d[3], mid[3];
+        v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
+        double dn = v3_dot(d, normal);
+        for (int k = 0; k < 3; k++) {
+            mid[k] = 0.5 * (s->x[3 * a[i] + k] + s->x[3 * b[i] + k]);
+            centroid[k] += mid[k] / 3.0;
+            d[k] -= dn * normal[k];
+        }
+        *opening += dn / 3.0;
+        *sliding += v3_norm(d) / 3.0;
+    }
+}

@@ -67,6 +67,12 @@ void cf_cohesive_energy(const cf_solid *s, const int *elems, int n, double *stor
  * mode, whose openings reset): returns the energy dropped, J. */
 double cf_cohesive_release(cf_solid *s, const int *elems, int n);
 
+/* Where cohesive element e is now: its mid-surface centre (m), unit normal
+ * (A -> B) and area (m^2), its normal and tangential openings (m, means of
+ * its three node pairs) and whether every pair has failed. */
+void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double normal[3],
+                       double *area, double *opening, double *sliding, int *failed);
+
 /* Compression across a crack: a PBD non-penetration constraint on the
  * predicted positions s->p, Delta_n >= 0 for every open node pair, the
  * correction split by inverse masses, for pairs closer than half the facet's

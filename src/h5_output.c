@@ -89,6 +89,20 @@ static const column_def HANDOFF_COLUMNS[HO_COUNT] = {
     {"time", 1, 0, "s"},
 };
 
+/* "time" is last, as for the hand-offs. */
+enum { CR_ELEMENT, CR_CENTROID, CR_NORMAL, CR_AREA, CR_OPENING, CR_SLIDING, CR_FAILED, CR_TIME,
+       CR_COUNT };
+static const column_def CRACK_COLUMNS[CR_COUNT] = {
+    {"element", 1, 1, NULL},
+    {"centroid", 3, 0, "m"},
+    {"normal", 3, 0, NULL},
+    {"area", 1, 0, "m2"},
+    {"opening", 1, 0, "m"},
+    {"sliding", 1, 0, "m"},
+    {"failed", 1, 1, NULL},
+    {"time", 1, 0, "s"},
+};
+
 /* An observable series kept open so that appending a sample costs three
  * small writes and no lookup in the file. */
 typedef struct observable {
@@ -112,6 +126,8 @@ struct cf_h5 {
     hid_t value[FLD_COUNT];
     hid_t fragment[FR_COUNT];
     hid_t handoff[HO_COUNT];
+    hid_t crack[CR_COUNT];   /* /cracks, created by the first cf_h5_add_cracks */
+    hsize_t ncracks;
     hid_t obs_group;
 
     hsize_t nframes, ncols, nfragments, nhandoffs;
@@ -439,6 +455,8 @@ static void init_handles(cf_h5 *h)
         h->fragment[i] = H5I_INVALID_HID;
     for (int i = 0; i < HO_COUNT; ++i)
         h->handoff[i] = H5I_INVALID_HID;
+    for (int i = 0; i < CR_COUNT; ++i)
+        h->crack[i] = H5I_INVALID_HID;
 }
 
 /* Close every HDF5 object and the file; returns -1 if any close failed. */
@@ -456,6 +474,8 @@ static int close_handles(cf_h5 *h)
         close_dataset(&h->fragment[i], &failed);
     for (int i = 0; i < HO_COUNT; ++i)
         close_dataset(&h->handoff[i], &failed);
+    for (int i = 0; i < CR_COUNT; ++i)
+        close_dataset(&h->crack[i], &failed);
     close_dataset(&h->step, &failed);
     close_dataset(&h->time, &failed);
     if (h->obs_group >= 0 && H5Gclose(h->obs_group) < 0)
@@ -1039,6 +1059,60 @@ static cf_status add_handoff_impl(cf_h5 *h, const cf_handoff_record *r, cf_error
         return h5_fail(err, h->path, "flushing /handoffs");
     h->nhandoffs++;
     return CF_OK;
+}
+
+static cf_status add_cracks_impl(cf_h5 *h, const cf_crack_row *r, int n, cf_error *err)
+{
+    if (!h)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_add_cracks: no output file is open");
+    if (n < 0 || (n > 0 && !r))
+        return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': bad crack rows", h->path);
+    if (h->crack[0] < 0) {
+        cf_status st = write_row_group(h, "cracks", CRACK_COLUMNS, CR_COUNT, h->crack, err);
+        if (st != CF_OK)
+            return st;
+    }
+    if (n == 0)
+        return CF_OK;
+    /* Column by column from the rows. */
+    int *ibuf = malloc((size_t)n * sizeof(int));
+    double *dbuf = malloc((size_t)n * 3 * sizeof(double));
+    cf_status st = CF_OK;
+    for (int c = 0; st == CF_OK && ibuf && dbuf && c < CR_COUNT; ++c) {
+        for (int i = 0; i < n; ++i) {
+            const cf_crack_row *q = &r[i];
+            switch (c) {
+            case CR_ELEMENT: ibuf[i] = q->element; break;
+            case CR_FAILED: ibuf[i] = q->failed; break;
+            case CR_CENTROID: memcpy(&dbuf[3 * i], q->centroid, 3 * sizeof(double)); break;
+            case CR_NORMAL: memcpy(&dbuf[3 * i], q->normal, 3 * sizeof(double)); break;
+            case CR_AREA: dbuf[i] = q->area; break;
+            case CR_OPENING: dbuf[i] = q->opening; break;
+            case CR_SLIDING: dbuf[i] = q->sliding; break;
+            default: dbuf[i] = q->time; break;
+            }
+        }
+        const void *buf = CRACK_COLUMNS[c].integer ? (const void *)ibuf : (const void *)dbuf;
+        if (append_rows(h->crack[c], h->ncracks, (hsize_t)n, mem_type(&CRACK_COLUMNS[c]), buf) < 0)
+            st = h5_fail(err, h->path, "appending to /cracks/%s", CRACK_COLUMNS[c].name);
+    }
+    if (st == CF_OK && (!ibuf || !dbuf))
+        st = no_memory(err, h->path);
+    free(ibuf), free(dbuf);
+    if (st == CF_OK && H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+        st = h5_fail(err, h->path, "flushing /cracks");
+    if (st == CF_OK)
+        h->ncracks += (hsize_t)n;
+    return st;
+}
+
+cf_status cf_h5_add_cracks(cf_h5 *h, const cf_crack_row *rows, int n, cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = add_cracks_impl(h, rows, n, err);
+    quiet_end(&q);
+    return st;
 }
 
 cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err)

@@ -86,7 +86,7 @@ static const char *const pbd_keys[] = {"k_stiffness", "iterations", "k_damping",
                                        "iteration_independent"};
 static const char *const xpbd_keys[] = {"compliance_scale"};
 static const char *const guard_keys[] = {"max_inverted_fraction", "max_energy_growth"};
-static const char *const output_keys[] = {"file", "frame_interval"};
+static const char *const output_keys[] = {"file", "frame_interval", "cracks"};
 
 /* Enum spellings, indexed by the enum values of scene.h (primitive_names by
  * cf_primitive_type - 1: CF_PRIM_NONE has no spelling). */
@@ -1204,7 +1204,8 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     return CF_OK;
 }
 
-static cf_status read_output(loader *ld, int t, const char *name, cf_output_settings *o)
+static cf_status read_output(loader *ld, int t, const char *name, int fracture_only,
+                             cf_output_settings *o)
 {
     static const double frame_interval = 0.01;
     lua_State *L = ld->L;
@@ -1220,6 +1221,7 @@ static cf_status read_output(loader *ld, int t, const char *name, cf_output_sett
         TRY(get_str(ld, t, "file", def, o->file, sizeof o->file));
     }
     TRY(get_num(ld, t, "frame_interval", &frame_interval, &POSITIVE, &o->frame_interval));
+    TRY(get_bool(ld, t, "cracks", fracture_only, &o->cracks));
     return CF_OK;
 }
 
@@ -1300,7 +1302,9 @@ static cf_status read_scene(loader *ld, int t)
                     "need solver.mode = \"fracture\"",
                     s->n_boundaries, s->n_boundaries == 1 ? "y" : "ies",
                     mode_names[s->solver.mode]);
-    WITH_TABLE(ld, t, "output", read_output(ld, lua_gettop(L), s->name, &s->output));
+    WITH_TABLE(ld, t, "output",
+               read_output(ld, lua_gettop(L), s->name, s->solver.mode == CF_RUN_FRACTURE,
+                           &s->output));
     return CF_OK;
 }
 
@@ -1782,6 +1786,7 @@ static char *resolved_text(const cf_scene *s)
     put(&b, "  },\n  output = {\n");
     put_str(&b, 4, "file", s->output.file);
     put_num(&b, 4, "frame_interval", s->output.frame_interval);
+    put(&b, "    cracks = %s,\n", s->output.cracks ? "true" : "false");
     put(&b, "  },\n}\n");
     if (b.oom) {
         free(b.p);

@@ -663,6 +663,25 @@ int cf_sim_tet_fragment(const cf_sim *sim, int t)
     return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[sim->tet_of_user[t]] : -1;
 }
 
+/* Every cohesive element's place, opening and state now (output.cracks). */
+static cf_status write_cracks(cf_sim *sim, cf_error *err)
+{
+    const cf_solid *s = &sim->solid;
+    cf_crack_row *rows = malloc((size_t)(s->n_coh > 0 ? s->n_coh : 1) * sizeof *rows);
+    if (!rows)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory writing %d crack rows", s->n_coh);
+    for (int e = 0; e < s->n_coh; e++) {
+        cf_crack_row *r = &rows[e];
+        r->time = sim->t;
+        r->element = e;
+        cf_cohesive_state(s, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
+                          &r->failed);
+    }
+    cf_status st = cf_h5_add_cracks(sim->h5, rows, s->n_coh, err);
+    free(rows);
+    return st;
+}
+
 static cf_status write_frame(cf_sim *sim, cf_error *err)
 {
     if (!sim->h5)
@@ -721,6 +740,8 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     };
     for (size_t i = 0; i < sizeof obs / sizeof obs[0] && st == CF_OK; i++)
         st = cf_h5_write_observable(sim->h5, obs[i].name, sim->step, sim->t, obs[i].value, err);
+    if (st == CF_OK && sim->scene->output.cracks)
+        st = write_cracks(sim, err);
     sim->prof.output += cf_wall_time() - t0;
     return st;
 }

@@ -390,6 +390,52 @@ static void test_handoff_clears_obstacle_overlap(void **state)
     cf_scene_free(&sc);
 }
 
+/* scenes/expanding_bar.lua (fracture mode only): pieces alive at the end
+ * and the state hash, for a strength setting and a thread count. */
+static int expanding_bar(const char *strength, int threads, uint64_t *hash)
+{
+    char path[1024], set_strength[256], set_threads[64];
+    snprintf(path, sizeof path, "%s/scenes/expanding_bar.lua", COHFRAC_SOURCE_DIR);
+    snprintf(set_strength, sizeof set_strength, "material.strength=%s", strength);
+    snprintf(set_threads, sizeof set_threads, "solver.threads=%d", threads);
+    const char *sets[] = {set_strength, set_threads, "output.file=\"\""};
+    cf_scene sc;
+    cf_error err = {0};
+    if (cf_scene_load(path, sets, 3, COHFRAC_MESH_DIR, &sc, &err) != CF_OK)
+        fail_msg("scene: %s", err.msg);
+    cf_run_options opt = {0, 0, COHFRAC_MESH_DIR};
+    cf_sim *sim = NULL;
+    if (cf_sim_create(&sc, &opt, &sim, &err) != CF_OK)
+        fail_msg("sim: %s", err.msg);
+    run_to_end(sim);
+    int alive = 0;
+    for (int i = 0; i < sim->n_frag; i++)
+        alive += sim->frag[i].mode != CF_MODE_DEAD;
+    *hash = cf_sim_state_hash(sim);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+    return alive;
+}
+
+/* A fracture-only run falls into fragments; Weibull strength changes how
+ * many, the same for a seed on 1 and 2 threads. */
+static void test_fracture_only_fragments_and_weibull(void **state)
+{
+    (void)state;
+    uint64_t h1, h2, hu, hs;
+    const char *w1 = "{distribution='weibull', modulus=6, seed=1}";
+    int n1 = expanding_bar(w1, 1, &h1), n2 = expanding_bar(w1, 2, &h2);
+    int nu = expanding_bar("{distribution='uniform'}", 2, &hu);
+    int ns = expanding_bar("{distribution='weibull', modulus=6, seed=2}", 2, &hs);
+    printf("FIGURE expanding bar: fragments uniform %d, Weibull seed 1 %d (1 thread) %d (2 "
+           "threads), seed 2 %d\n", nu, n1, n2, ns);
+    assert_true(nu > 1 && n1 > 1);
+    assert_int_equal(n1, n2);
+    assert_true(h1 == h2);
+    assert_true(n1 != nu && h1 != hu);
+    assert_true(h1 != hs);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -399,6 +445,7 @@ int main(void)
         cmocka_unit_test(test_reentry_keeps_the_family_tree),
         cmocka_unit_test(test_mesh_obstacle_matches_plane),
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),
+        cmocka_unit_test(test_fracture_only_fragments_and_weibull),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -31,6 +31,9 @@
  *              momentum_error (relative), momentum_change[3] kg m/s and
  *              angular_momentum_change[3] kg m^2/s (after - before, about the
  *              origin), handoff_loss (J)}  one row per hand-off
+ *   /cracks/{element, centroid[3] m, normal[3], area m^2, opening m,
+ *            sliding m, failed, time s}  with output.cracks: one row per
+ *            cohesive element per frame (rows of a frame share its time)
  *   /h5md                  H5MD 1.1 metadata: attr version [1,1], author/ and
  *                          creator/ (attrs name, version), modules/units
  *   /particles/fragments/box  attrs dimension=3, boundary=["none"]*3 (H5MD)
@@ -133,6 +136,22 @@ cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double t
  * is empty, holds '/' or exists already gives CF_ERR_OUTPUT. */
 cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int n,
                                 const char *unit, cf_error *err);
+
+/* One cohesive element (crack facet) at a frame. */
+typedef struct cf_crack_row {
+    double time;             /* s, the frame's */
+    int element;             /* cohesive element index (order of insertion) */
+    double centroid[3];      /* m, mid-surface centre */
+    double normal[3];        /* unit, mid-surface normal from side A to side B */
+    double area;             /* m^2, mid-surface */
+    double opening;          /* m, normal opening, mean of its three node pairs */
+    double sliding;          /* m, tangential opening, the same mean */
+    int failed;              /* 1: every node pair has failed (a free crack face) */
+} cf_crack_row;
+
+/* Append `n` rows to /cracks (created on the first call, even with n = 0).
+ * Flushes. */
+cf_status cf_h5_add_cracks(cf_h5 *h, const cf_crack_row *rows, int n, cf_error *err);
 
 /* Append one hand-off record. */
 cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err);

@@ -130,7 +130,10 @@
  *       all work input by this fraction of their sum
  *     threads [0] (0: all cores)
  *   }
- *   output = { file ["out/<name>.h5"] ("" for none), frame_interval [0.01] s }
+ *   output = { file ["out/<name>.h5"] ("" for none), frame_interval [0.01] s,
+ *              cracks [true with solver.mode = "fracture", else false]: write
+ *              every cohesive element's centroid, normal, area, opening and
+ *              state at each frame to /cracks }
  */
 #ifndef COHFRAC_SCENE_H
 #define COHFRAC_SCENE_H
@@ -240,6 +243,7 @@ typedef struct cf_solver_settings {
 typedef struct cf_output_settings {
     char file[1024];
     double frame_interval;
+    int cracks;                  /* write /cracks at frames */
 } cf_output_settings;
 
 typedef struct cf_scene {
