@@ -269,10 +269,8 @@ double cf_node_impulses_flush(cf_sim *sim, cf_node_impulses *ni, const int *node
         cfb_state st;
         cfb_get_state(sim->bullet, sim->frag[g].body, &st);
         memcpy(sum[g].w0, st.w, sizeof st.w);
-        double Jl = v3_norm(sum[g].J), u[3];
-        for (int k = 0; k < 3; k++)
-            u[k] = sum[g].J[k] / Jl;
-        double room = bounce * sum[g].vmax - v3_dot(st.v, u), dv = Jl / sim->frag[g].mass;
+        double Jl = v3_norm(sum[g].J), dv = Jl / sim->frag[g].mass;
+        double room = Jl > 0 ? bounce * sum[g].vmax - v3_dot(st.v, sum[g].J) / Jl : dv;
         sum[g].beta = dv > room ? fmax(0.0, room) / dv : 1.0;
         gained -= cf_body_kinetic_energy(sim, g);
     }

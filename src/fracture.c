@@ -334,13 +334,15 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
     /* The momentum the cap took goes back to the whole fragment, so that the
      * projection keeps linear momentum (bars act in equal and opposite pairs;
      * the cap does not). */
-    double dP[3] = {0, 0, 0}, mass = 0;
+    double dP[3] = {0, 0, 0};
     for (int i = 0; i < nn; i++) { /* node order: the same sums for any thread count */
         removed += f->term[i];
         v3_axpy(1.0, &s->p[3 * nodes[i]], dP);
-        mass += s->m[nodes[i]];
     }
     if (v3_dot(dP, dP) > 0) {
+        double mass = 0;
+        for (int i = 0; i < nn; i++)
+            mass += s->m[nodes[i]];
         double dv[3] = {dP[0] / mass, dP[1] / mass, dP[2] / mass};
 #pragma omp parallel for schedule(static) if (par)
         for (int i = 0; i < nn; i++) {

@@ -12,7 +12,34 @@ static int find(int *parent, int i)
     return i;
 }
 
+static void join(int *parent, int i, int j)
+{
+    int a = find(parent, i), b = find(parent, j);
+    if (a != b) /* the lower list position is the root */
+        parent[a > b ? a : b] = a < b ? a : b;
+}
+
+/* Position of tet t in the ascending list tets[0..nt). */
+static int position_of(const int *tets, int nt, int t)
+{
+    int lo = 0, hi = nt - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (tets[mid] < t)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 int cf_label_components(const cf_solid *s, const int *tets, int nt, int *comp)
+{
+    return cf_label_pieces(s, tets, nt, NULL, 0, comp);
+}
+
+int cf_label_pieces(const cf_solid *s, const int *tets, int nt, const int *coh, int ncoh,
+                    int *comp)
 {
     int *parent = malloc((size_t)nt * sizeof(int));
     int *owner = malloc((size_t)s->n_nodes * sizeof(int));
@@ -28,14 +55,16 @@ int cf_label_components(const cf_solid *s, const int *tets, int nt, int *comp)
     for (int i = 0; i < nt; i++)
         for (int j = 0; j < 4; j++) {
             int n = s->tet[4 * tets[i] + j];
-            if (owner[n] < 0) {
+            if (owner[n] < 0)
                 owner[n] = i;
-                continue;
-            }
-            int a = find(parent, i), b = find(parent, owner[n]);
-            if (a != b) /* the lower list position is the root */
-                parent[a > b ? a : b] = a < b ? a : b;
+            else
+                join(parent, i, owner[n]);
         }
+    for (int e = 0; e < ncoh; e++) {
+        const cf_cohesive *ce = &s->coh[coh[e]];
+        if (!(ce->failed[0] && ce->failed[1] && ce->failed[2]))
+            join(parent, position_of(tets, nt, ce->tet[0]), position_of(tets, nt, ce->tet[1]));
+    }
     int k = 0;
     for (int i = 0; i < nt; i++) {
         int r = find(parent, i);

@@ -10,6 +10,13 @@
  * tet in the list.  Returns the number of components, or -1 out of memory. */
 int cf_label_components(const cf_solid *s, const int *tets, int nt, int *comp);
 
+/* The same, with the tets of each cohesive element coh[0..ncoh) that has a
+ * node pair not yet failed counted as joined: the pieces a fracture-mode
+ * fragment is in while its cracks still hold.  `tets` ascending, holding
+ * both tets of every listed element. */
+int cf_label_pieces(const cf_solid *s, const int *tets, int nt, const int *coh, int ncoh,
+                    int *comp);
+
 /* Mass properties of `tets` from the tet second moment (DESIGN §5):
  * per tet, int x x^T dm = (m/20)(sum_i x_i x_i^T + s s^T), s = sum_i x_i,
  * positions relative to the COM; I = tr(C) Id - C.

@@ -351,57 +351,6 @@ static int take_component(cf_sim *sim, int ci, const int *tets, const int *comp,
     return 0;
 }
 
-static int position_of(const int *tets, int nt, int t) /* tets ascending */
-{
-    int lo = 0, hi = nt - 1;
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (tets[mid] < t)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
-static int root_of(int *parent, int i)
-{
-    while (parent[i] != i)
-        i = parent[i] = parent[parent[i]];
-    return i;
-}
-
-/* Pieces of fragment f (comp[], k of them) still held together by a
- * cohesive element with a node pair not yet failed are one piece: merge
- * them and renumber in order of first tet.  Returns the new count, -1 out
- * of memory. */
-static int join_by_cohesion(const cf_solid *s, const cf_fragment *f, int *comp, int k)
-{
-    int *parent = malloc((size_t)k * 2 * sizeof(int)), *label = parent + k;
-    if (!parent)
-        return -1;
-    for (int c = 0; c < k; c++)
-        parent[c] = c, label[c] = -1;
-    for (int e = 0; e < f->coh.n; e++) {
-        const cf_cohesive *ce = &s->coh[f->coh.v[e]];
-        if (ce->failed[0] && ce->failed[1] && ce->failed[2])
-            continue;
-        int a = root_of(parent, comp[position_of(f->tets, f->nt, ce->tet[0])]);
-        int b = root_of(parent, comp[position_of(f->tets, f->nt, ce->tet[1])]);
-        if (a != b)
-            parent[a > b ? a : b] = a < b ? a : b;
-    }
-    int n = 0;
-    for (int i = 0; i < f->nt; i++) {
-        int r = root_of(parent, comp[i]);
-        if (label[r] < 0)
-            label[r] = n++;
-        comp[i] = label[r];
-    }
-    free(parent);
-    return n;
-}
-
 int cf_fragment_split_fracture(cf_sim *sim, int fi, int *first)
 {
     cf_solid *s = &sim->solid;
@@ -411,9 +360,7 @@ int cf_fragment_split_fracture(cf_sim *sim, int fi, int *first)
     int *comp = malloc((size_t)nt * sizeof(int));
     if (!comp)
         return -1;
-    int k = cf_label_components(s, tets, nt, comp);
-    if (k > 1)
-        k = join_by_cohesion(s, f, comp, k);
+    int k = cf_label_pieces(s, tets, nt, f->coh.v, f->coh.n, comp);
     if (k <= 1) {
         free(comp);
         return k < 0 ? -1 : 0;

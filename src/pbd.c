@@ -186,25 +186,19 @@ typedef struct {
     double *p1, *p2, w1, w2, d[3], len;
 } bar_now;
 
-/* Bar i on positions pos (s->p, or s->x). */
-static inline bar_now bar_on(const cf_bars *b, cf_solid *s, double *pos, int i)
+static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
 {
     int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-    bar_now r = {&pos[3 * i1], &pos[3 * i2], 1.0 / s->m[i1], 1.0 / s->m[i2], {0, 0, 0}, 0};
+    bar_now r = {&s->p[3 * i1], &s->p[3 * i2], 1.0 / s->m[i1], 1.0 / s->m[i2], {0, 0, 0}, 0};
     v3_sub(r.p1, r.p2, r.d);
     r.len = v3_norm(r.d);
     return r;
 }
 
-static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
+/* One bar of the PBD sweep. */
+static inline void project_bar(const cf_bars *b, cf_solid *s, double k, int i)
 {
-    return bar_on(b, s, s->p, i);
-}
-
-/* One bar of the PBD sweep on positions pos. */
-static inline void project_bar(const cf_bars *b, cf_solid *s, double *pos, double k, int i)
-{
-    bar_now r = bar_on(b, s, pos, i);
+    bar_now r = bar_at(b, s, i);
     if (r.len == 0)
         return;
     double c = k * (r.len - b->rest[i]) / ((r.w1 + r.w2) * r.len);
@@ -244,7 +238,7 @@ static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double s
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
 {
     if (b->n > 0)
-        SWEEP(b, project_bar(b, s, s->p, k, i))
+        SWEEP(b, project_bar(b, s, k, i))
 }
 
 /* Bar i's two ends see each other's speed. */
