@@ -9,7 +9,7 @@
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
 #include "fixtures.h"
-#include "sim.h"
+#include "world_impl.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -75,7 +75,7 @@ static const char *impact_scene =
     "  output = {file = ''},\n"
     "}\n";
 
-static cf_sim *make_sim(const char *text, cf_scene *sc)
+static cf_sim *make_sim(const char *text, cf_world_def *sc)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/scene.lua", dir);
@@ -104,7 +104,7 @@ static void run_to_end(cf_sim *sim)
             fail_msg("run: %s", err.msg);
 }
 
-static cf_sim *impact_sim(double duration, int threads, cf_scene *sc)
+static cf_sim *impact_sim(double duration, int threads, cf_world_def *sc)
 {
     char text[2048];
     snprintf(text, sizeof text, impact_scene, duration, dir, threads);
@@ -115,7 +115,7 @@ static cf_sim *impact_sim(double duration, int threads, cf_scene *sc)
 static double anvil_momentum(cf_sim *sim)
 {
     cf_fragment_state fs[256];
-    int n = cf_sim_fragments(sim, fs, 256);
+    int n = cf_world_fragments(cf_sim_world(sim), fs, 256);
     for (int i = 0; i < n && i < 256; i++)
         if (fs[i].id == 0)
             return fs[i].momentum[0];
@@ -126,7 +126,7 @@ static double anvil_momentum(cf_sim *sim)
 static int any_in_fracture_mode(cf_sim *sim)
 {
     cf_fragment_state fs[256];
-    int n = cf_sim_fragments(sim, fs, 256);
+    int n = cf_world_fragments(cf_sim_world(sim), fs, 256);
     for (int i = 0; i < n && i < 256; i++)
         if (fs[i].mode == 1)
             return 1;
@@ -139,10 +139,10 @@ static int any_in_fracture_mode(cf_sim *sim)
 static void test_momentum_across_fracture_mode_contact(void **state)
 {
     (void)state;
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = impact_sim(0.12, 0, &sc);
     cf_ledger l0, l;
-    cf_sim_ledger(sim, &l0);
+    cf_world_ledger(cf_sim_world(sim), &l0);
     double P0 = l0.momentum[0], pushed = 0, worst = 0;
     int fracture_steps = 0;
     cf_error err = {0};
@@ -154,7 +154,7 @@ static void test_momentum_across_fracture_mode_contact(void **state)
             fracture_steps++;
             pushed += anvil_momentum(sim) - before;
         }
-        cf_sim_ledger(sim, &l);
+        cf_world_ledger(cf_sim_world(sim), &l);
         for (int k = 0; k < 3; k++)
             worst = fmax(worst, fabs(l.momentum[k] - l0.momentum[k]) / P0);
     }
@@ -175,10 +175,10 @@ static void test_determinism_hash(void **state)
     (void)state;
     uint64_t h[2];
     for (int r = 0; r < 2; r++) {
-        cf_scene sc;
+        cf_world_def sc;
         cf_sim *sim = impact_sim(0.06, r + 1, &sc);
         run_to_end(sim);
-        h[r] = cf_sim_state_hash(sim);
+        h[r] = cf_world_state_hash(cf_sim_world(sim));
         cf_sim_destroy(sim);
         cf_scene_free(&sc);
     }
@@ -215,12 +215,12 @@ static void test_determinism_hash_coloured(void **state)
     for (int r = 0; r < 2; r++) {
         char text[2048];
         snprintf(text, sizeof text, coloured_scene, r + 1);
-        cf_scene sc;
+        cf_world_def sc;
         cf_sim *sim = make_sim(text, &sc);
-        assert_true(sim->frag[0].bars.n >= CF_BARS_PARALLEL_MIN); /* the coloured sweep runs */
+        assert_true(cf_sim_world(sim)->frag[0].bars.n >= CF_BARS_PARALLEL_MIN); /* the coloured sweep runs */
         run_to_end(sim);
-        h[r] = cf_sim_state_hash(sim);
-        coh[r] = sim->solid.n_coh;
+        h[r] = cf_world_state_hash(cf_sim_world(sim));
+        coh[r] = cf_sim_world(sim)->solid.n_coh;
         cf_sim_destroy(sim);
         cf_scene_free(&sc);
     }
@@ -258,7 +258,7 @@ static const char *reentry_scene =
 static void test_reentry_keeps_the_family_tree(void **state)
 {
     (void)state;
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = make_sim(reentry_scene, &sc);
     enum { CAP = 4096 };
     static int parent[CAP];
@@ -271,7 +271,7 @@ static void test_reentry_keeps_the_family_tree(void **state)
     while (!cf_sim_done(sim)) {
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("run: %s", err.msg);
-        int n = cf_sim_fragments(sim, fs, CAP);
+        int n = cf_world_fragments(cf_sim_world(sim), fs, CAP);
         assert_true(n <= CAP);
         for (int i = 0; i < n; i++) {
             assert_true(fs[i].id < CAP);
@@ -281,7 +281,7 @@ static void test_reentry_keeps_the_family_tree(void **state)
                 reentered = 1;
         }
     }
-    int n = cf_sim_fragments(sim, fs, CAP), tets = 0, grandchildren = 0;
+    int n = cf_world_fragments(cf_sim_world(sim), fs, CAP), tets = 0, grandchildren = 0;
     for (int i = 0; i < n; i++) {
         int p = fs[i].parent;
         tets += fs[i].n_tets;
@@ -298,7 +298,7 @@ static void test_reentry_keeps_the_family_tree(void **state)
            "of a split\n", n, grandchildren);
     assert_true(reentered);
     assert_true(grandchildren > 0);
-    assert_int_equal(tets, cf_sim_tet_count(sim));
+    assert_int_equal(tets, cf_world_tet_count(cf_sim_world(sim)));
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
 }
@@ -320,10 +320,10 @@ static void run_ground(const char *obstacle, cf_fragment_state *out)
 {
     char text[2048];
     snprintf(text, sizeof text, ground_scene, obstacle);
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = make_sim(text, &sc);
     run_to_end(sim);
-    assert_int_equal(cf_sim_fragments(sim, out, 1), 1);
+    assert_int_equal(cf_world_fragments(cf_sim_world(sim), out, 1), 1);
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
 }
@@ -369,7 +369,7 @@ static const char *overlap_scene =
 static void test_handoff_clears_obstacle_overlap(void **state)
 {
     (void)state;
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = make_sim(overlap_scene, &sc);
     cf_error err = {0};
     double ke_max = 0;
@@ -378,7 +378,7 @@ static void test_handoff_clears_obstacle_overlap(void **state)
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("run: %s", err.msg);
         cf_ledger l;
-        cf_sim_ledger(sim, &l);
+        cf_world_ledger(cf_sim_world(sim), &l);
         ke_max = fmax(ke_max, l.kinetic);
         entered |= any_in_fracture_mode(sim);
     }
@@ -399,7 +399,7 @@ static int expanding_bar(const char *strength, int threads, uint64_t *hash)
     snprintf(set_strength, sizeof set_strength, "material.strength=%s", strength);
     snprintf(set_threads, sizeof set_threads, "solver.threads=%d", threads);
     const char *sets[] = {set_strength, set_threads, "output.file=\"\""};
-    cf_scene sc;
+    cf_world_def sc;
     cf_error err = {0};
     if (cf_scene_load(path, sets, 3, COHFRAC_MESH_DIR, &sc, &err) != CF_OK)
         fail_msg("scene: %s", err.msg);
@@ -409,9 +409,9 @@ static int expanding_bar(const char *strength, int threads, uint64_t *hash)
         fail_msg("sim: %s", err.msg);
     run_to_end(sim);
     int alive = 0;
-    for (int i = 0; i < sim->n_frag; i++)
-        alive += sim->frag[i].mode != CF_MODE_DEAD;
-    *hash = cf_sim_state_hash(sim);
+    for (int i = 0; i < cf_sim_world(sim)->n_frag; i++)
+        alive += cf_sim_world(sim)->frag[i].mode != CF_MODE_DEAD;
+    *hash = cf_world_state_hash(cf_sim_world(sim));
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
     return alive;

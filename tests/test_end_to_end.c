@@ -8,8 +8,10 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
 #include "check.h"
-#include "sim.h"
+#include "world_impl.h"
 
 #include <stdio.h>
 
@@ -21,7 +23,7 @@ static void test_small_bunny_drop_breaks(void **state)
         "duration=0.6",
         "output.file=\"" COHFRAC_BINARY_DIR "/e2e/bunny_small_drop.h5\"",
     };
-    cf_scene sc;
+    cf_world_def sc;
     cf_error err = {0};
     cf_status st = cf_scene_load(COHFRAC_SOURCE_DIR "/scenes/bunny_drop.lua", sets, 3,
                                  COHFRAC_MESH_DIR, &sc, &err);
@@ -36,12 +38,12 @@ static void test_small_bunny_drop_breaks(void **state)
         fail_msg("%s", err.msg);
     cf_sim_print_summary(sim, stdout);
     int alive = 0;
-    for (int i = 0; i < sim->n_frag; i++)
-        alive += sim->frag[i].mode != CF_MODE_DEAD;
+    for (int i = 0; i < cf_sim_world(sim)->n_frag; i++)
+        alive += cf_sim_world(sim)->frag[i].mode != CF_MODE_DEAD;
     assert_true(alive >= 2);
-    assert_true(sim->solid.n_coh > 0);
-    assert_true(sim->n_handoffs >= 2); /* rigid -> fracture -> rigid */
-    assert_true(sim->max_momentum_error <= 1e-9);
+    assert_true(cf_sim_world(sim)->solid.n_coh > 0);
+    assert_true(cf_sim_world(sim)->n_handoffs >= 2); /* rigid -> fracture -> rigid */
+    assert_true(cf_sim_world(sim)->max_momentum_error <= 1e-9);
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
 }

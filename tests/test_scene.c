@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
 #include "cohfrac/scene.h"
 
 #include <lauxlib.h>
@@ -103,14 +105,14 @@ static int teardown(void **state)
 }
 
 /* Write `text` as scene.lua and load it. */
-static cf_status load_text(const char *text, const char *const *ov, int n_ov, cf_scene *s,
+static cf_status load_text(const char *text, const char *const *ov, int n_ov, cf_world_def *s,
                            cf_error *e)
 {
     write_file("scene.lua", text);
     return cf_scene_load(at("scene.lua"), ov, n_ov, mesh_dir, s, e);
 }
 
-static void load_ok(const char *text, const char *const *ov, int n_ov, cf_scene *s)
+static void load_ok(const char *text, const char *const *ov, int n_ov, cf_world_def *s)
 {
     cf_error e = {0};
     cf_status st = load_text(text, ov, n_ov, s, &e);
@@ -118,9 +120,9 @@ static void load_ok(const char *text, const char *const *ov, int n_ov, cf_scene 
         fail_msg("expected success, got %s: %s\nscene:\n%s", cf_status_name(st), e.msg, text);
 }
 
-static int is_empty(const cf_scene *s)
+static int is_empty(const cf_world_def *s)
 {
-    static const cf_scene zero;
+    static const cf_world_def zero;
     return memcmp(s, &zero, sizeof zero) == 0;
 }
 
@@ -129,7 +131,7 @@ static int is_empty(const cf_scene *s)
 static void expect_error(const char *text, const char *const *ov, int n_ov, cf_status code,
                          const char *needle)
 {
-    cf_scene s;
+    cf_world_def s;
     cf_error e = {0};
     cf_status st = load_text(text, ov, n_ov, &s, &e);
     if (st != code || e.code != code || !strstr(e.msg, needle))
@@ -166,7 +168,7 @@ static void assert_mesh(const char *got, const char *rel)
 
 static void test_defaults_minimal(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     (void)state;
     load_ok("return { " MIN_BODY " }", NULL, 0, &s);
 
@@ -264,7 +266,7 @@ static const char FULL_SCENE[] =
 
 static void test_full_scene(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     const double h = sqrt(0.5);
     (void)state;
     load_ok(FULL_SCENE, NULL, 0, &s);
@@ -331,7 +333,7 @@ static void test_full_scene(void **state)
 /* G_II, tau_max, beta follow G_I, sigma_max, alpha; output.file follows name. */
 static void test_derived_defaults(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     (void)state;
     load_ok("return { name = 'beam', material = { G_I = 5, sigma_max = 7, alpha = 3 }, " MIN_BODY
             " }",
@@ -351,7 +353,7 @@ static void test_mesh_paths(void **state)
     char text[1200];
     (void)state;
     for (int i = 0; spellings[i]; i++) {
-        cf_scene s;
+        cf_world_def s;
         const char *m = spellings[i];
         /* A bare "cube" would be a prepared mesh name: give it a directory. */
         snprintf(text, sizeof text, "return { bodies = { { mesh = '%s%s' } } }",
@@ -361,7 +363,7 @@ static void test_mesh_paths(void **state)
         cf_scene_free(&s);
     }
     {
-        cf_scene s;
+        cf_world_def s;
         snprintf(text, sizeof text, "return { bodies = { { mesh = '%s/sub/part' } } }", tmp);
         load_ok(text, NULL, 0, &s);
         assert_mesh(s.bodies[0].mesh, "sub/part");
@@ -371,7 +373,7 @@ static void test_mesh_paths(void **state)
 
 static void test_prepared_mesh(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     (void)state;
     load_ok("return { bodies = { { mesh = 'bunny' } } }", NULL, 0, &s);
     assert_mesh(s.bodies[0].mesh, "meshes/bunny");
@@ -410,7 +412,7 @@ static const char NEW_KEYS_SCENE[] =
 
 static void test_new_keys(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     const cf_primitive *p;
     const cf_boundary *b;
     (void)state;
@@ -504,7 +506,7 @@ static void test_new_keys(void **state)
  * tolerances, boundary axes and body, and the other constraint modes. */
 static void test_new_defaults(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     (void)state;
     load_ok("return { bodies = { { mesh = { type = 'box', size = {1, 1, 1} } } },\n"
             "  boundary = { { region = { type = 'plane', point = {0,0,0}, normal = {0,1,0} },\n"
@@ -558,7 +560,7 @@ static void test_overrides(void **state)
         "name = 'a=b'",                  /* '=' inside the value */
         "material.E = 2 * 1e5",          /* any expression */
     };
-    cf_scene s;
+    cf_world_def s;
     (void)state;
     load_ok("return { solver = { dt_rigid = 1 }, " MIN_BODY " }", ov, 8, &s);
     assert_double_equal(s.solver.dt_rigid, 2e-3, 0);
@@ -602,7 +604,7 @@ static const char SHELL_KEYS_SCENE[] =
 
 /* ---------------------------------------------------------------- round trip */
 
-static void assert_same_scene(const cf_scene *a, const cf_scene *b)
+static void assert_same_scene(const cf_world_def *a, const cf_world_def *b)
 {
     assert_string_equal(a->name, b->name);
     assert_memory_equal(&a->duration, &b->duration, sizeof a->duration);
@@ -706,7 +708,7 @@ static void assert_same_scene(const cf_scene *a, const cf_scene *b)
  * mesh directory): the same scene, bit for bit, and the same text. */
 static void round_trip(const char *text, const char *const *ov, int n_ov)
 {
-    cf_scene a, b;
+    cf_world_def a, b;
     cf_error e = {0};
     load_ok(text, ov, n_ov, &a);
     write_file("sub/resolved.lua", a.resolved);
@@ -758,7 +760,7 @@ static void test_round_trip(void **state)
 
 static void test_shell_obstacle_keys(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     const cf_obstacle *o;
     (void)state;
     load_ok(SHELL_KEYS_SCENE, NULL, 0, &s);
@@ -908,7 +910,7 @@ static void test_error_shell_obstacle_keys(void **state)
 
 static void test_sandbox_libraries(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     (void)state;
     load_ok("local t = {'a', 'b'}; table.insert(t, 'c')\n"
             "return { name = string.format('%s%d', table.concat(t), math.floor(2.5)),\n"
@@ -942,7 +944,7 @@ static int dump_writer(lua_State *L, const void *p, size_t size, void *ud)
 
 static void test_bytecode_rejected(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     cf_error e = {0};
     lua_State *L = luaL_newstate();
     FILE *f;
@@ -965,7 +967,7 @@ static void test_bytecode_rejected(void **state)
 
 static void test_error_file_open(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     cf_error e = {0};
     (void)state;
     assert_int_equal(cf_scene_load(at("missing.lua"), NULL, 0, mesh_dir, &s, &e),
@@ -1343,7 +1345,7 @@ static void test_error_override(void **state)
 /* A NULL error record is allowed; the scene still comes back empty. */
 static void test_error_without_record(void **state)
 {
-    cf_scene s;
+    cf_world_def s;
     (void)state;
     write_file("scene.lua", "return { }");
     assert_int_equal(cf_scene_load(at("scene.lua"), NULL, 0, mesh_dir, &s, NULL),

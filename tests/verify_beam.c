@@ -12,7 +12,9 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "verify.h"
 
 /* Angle from vertical (degrees) of the line through the notch tip (xt, zt)
@@ -39,7 +41,7 @@ static void beam_stays_stable(void **state)
 {
     (void)state;
     verify_begin("mixed_mode_beam");
-    cf_scene sc;
+    cf_world_def sc;
     const char *sets[] = {"bodies[1].mesh.mesh_size=0.012", NULL};
     cf_sim *sim = verify_open("mixed_mode_beam.lua", sets, &sc);
     cf_error err;
@@ -48,15 +50,15 @@ static void beam_stays_stable(void **state)
         printf("mixed_mode_beam: %s\n", err.msg);
     const cf_primitive *b = &sc.bodies[0].primitive;
     double xt = b->notch[2], zt = -0.5 * b->size[2] + b->notch[0];
-    double angle = fabs(crack_angle(&sim->solid, xt, zt, 20));
-    printf("mixed_mode_beam: %ld steps, %d tets, %d cohesive elements\n", sim->steps_fracture,
-           sim->solid.n_tets, sim->solid.n_coh);
+    double angle = fabs(crack_angle(&cf_sim_world(sim)->solid, xt, zt, 20));
+    printf("mixed_mode_beam: %ld steps, %d tets, %d cohesive elements\n", cf_sim_world(sim)->steps_fracture,
+           cf_sim_world(sim)->solid.n_tets, cf_sim_world(sim)->solid.n_coh);
     verify_figure("mixed_mode_beam", "dt / dt_cfl of this mesh (reported)",
-                  sim->dt_fracture / sim->solid.dt_cfl, 0, 0, "");
+                  cf_sim_world(sim)->dt_fracture / cf_sim_world(sim)->solid.dt_cfl, 0, 0, "");
     verify_figure("mixed_mode_beam", "crack angle at the notch (reported)", angle, 30, 0, "deg");
     /* Steps of the run (the solver steps of all its fragments, once the
      * beam is in pieces, are more). */
-    double steps = floor(cf_sim_time(sim) / sim->dt_fracture + 0.5);
+    double steps = floor(cf_world_time(cf_sim_world(sim)) / cf_sim_world(sim)->dt_fracture + 0.5);
     int ok = verify_figure("mixed_mode_beam", "steps run at dt = 3e-5 s without divergence",
                            steps, 300, 1e-9, "");
     cf_sim_destroy(sim);

@@ -11,21 +11,23 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "verify.h"
 
 static void apex_ratio_is_e_squared(void **state)
 {
     (void)state;
     verify_begin("bounce");
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = verify_open("bounce.lua", NULL, &sc);
     cf_error err;
     double com[3], R[9], v[3], w[3];
-    cf_fragment_pose(sim, 0, com, R, v, w);
+    cf_fragment_pose(cf_sim_world(sim), 0, com, R, v, w);
     double bottom = INFINITY;
-    for (int i = 0; i < sim->solid.n_nodes; i++)
-        bottom = fmin(bottom, sim->solid.x[3 * i + 2]);
+    for (int i = 0; i < cf_sim_world(sim)->solid.n_nodes; i++)
+        bottom = fmin(bottom, cf_sim_world(sim)->solid.x[3 * i + 2]);
     double z0 = com[2], g = -sc.gravity[2], z_contact = INFINITY, apex = -INFINITY;
     double z_rest = z0 - bottom; /* the plane is z = 0 */
     double fall_err = 0, vz_prev = 0;
@@ -33,8 +35,8 @@ static void apex_ratio_is_e_squared(void **state)
     while (!cf_sim_done(sim) && phase < 2) {
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("%s", err.msg);
-        cf_fragment_pose(sim, 0, com, R, v, w);
-        double t = cf_sim_time(sim);
+        cf_fragment_pose(cf_sim_world(sim), 0, com, R, v, w);
+        double t = cf_world_time(cf_sim_world(sim));
         if (phase == 0 && v[2] > 0)
             phase = 1;
         if (phase == 0) {

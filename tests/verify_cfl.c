@@ -8,14 +8,16 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "verify.h"
 
 /* Run wave_bar.lua at dt = fraction dt_cfl; returns the status and the
  * simulated time reached. */
 static cf_status run_at(const char *fraction, double *t_end, double *growth)
 {
-    cf_scene sc;
+    cf_world_def sc;
     char set[64];
     snprintf(set, sizeof set, "solver.cfl_fraction=%s", fraction);
     const char *sets[] = {set, "duration=0.03", NULL};
@@ -25,8 +27,8 @@ static cf_status run_at(const char *fraction, double *t_end, double *growth)
     if (st != CF_OK)
         printf("dt = %s dt_cfl: %s\n", fraction, err.msg);
     cf_ledger l;
-    cf_sim_ledger(sim, &l);
-    *t_end = cf_sim_time(sim);
+    cf_world_ledger(cf_sim_world(sim), &l);
+    *t_end = cf_world_time(cf_sim_world(sim));
     *growth = (l.kinetic + l.strain) / (l.initial + l.work_boundary);
     cf_sim_destroy(sim);
     cf_scene_free(&sc);

@@ -9,13 +9,15 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "verify.h"
 
 static double drift(const cf_sim *sim, const double P0[3])
 {
     cf_ledger l;
-    cf_sim_ledger(sim, &l);
+    cf_world_ledger(cf_sim_world(sim), &l);
     double d[3] = {l.momentum[0] - P0[0], l.momentum[1] - P0[1], l.momentum[2] - P0[2]};
     return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) /
            sqrt(P0[0] * P0[0] + P0[1] * P0[1] + P0[2] * P0[2]);
@@ -25,27 +27,27 @@ static void momentum_to_round_off(void **state)
 {
     (void)state;
     verify_begin("momentum");
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = verify_open("momentum.lua", NULL, &sc);
     cf_error err;
     cf_ledger l;
-    cf_sim_ledger(sim, &l);
+    cf_world_ledger(cf_sim_world(sim), &l);
     double P0[3] = {l.momentum[0], l.momentum[1], l.momentum[2]}, worst_fracture = 0;
-    int nodes0 = sim->solid.n_nodes;
+    int nodes0 = cf_sim_world(sim)->solid.n_nodes;
     while (!cf_sim_done(sim)) {
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("%s", err.msg);
         worst_fracture = fmax(worst_fracture, drift(sim, P0));
     }
-    int n_coh = sim->solid.n_coh, copies = sim->solid.n_nodes - nodes0;
+    int n_coh = cf_sim_world(sim)->solid.n_coh, copies = cf_sim_world(sim)->solid.n_nodes - nodes0;
     /* Hand the torn block to rigid mode (pbd rigid backend: no Bullet world
      * in this scene) and fly on. */
-    if (cf_handoff_to_rigid(sim, 0, &err) != CF_OK)
+    if (cf_handoff_to_rigid(cf_sim_world(sim), 0, &err) != CF_OK)
         fail_msg("%s", err.msg);
     double after_handoff = drift(sim, P0), worst_rigid = 0;
-    int pieces = sim->n_frag - 1;
+    int pieces = cf_sim_world(sim)->n_frag - 1;
     for (int k = 0; k < 50; k++) {
-        sim->n_steps++;
+        cf_sim_world(sim)->n_steps++;
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("%s", err.msg);
         worst_rigid = fmax(worst_rigid, drift(sim, P0));

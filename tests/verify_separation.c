@@ -11,13 +11,15 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "verify.h"
 
 static void separate(const char *scene, const char *name, double G, double area)
 {
     verify_begin(name);
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = verify_open(scene, NULL, &sc);
     cf_error err;
     cf_ledger l;
@@ -25,17 +27,17 @@ static void separate(const char *scene, const char *name, double G, double area)
     while (!cf_sim_done(sim)) {
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("%s", err.msg);
-        cf_sim_ledger(sim, &l);
+        cf_world_ledger(cf_sim_world(sim), &l);
         double e = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated;
         peak = fmax(peak, fmax(e, l.initial + l.work_boundary));
         resid = fmax(resid, fabs(l.residual));
     }
     int pairs = 0, failed = 0;
-    for (int c = 0; c < sim->solid.n_coh; c++)
+    for (int c = 0; c < cf_sim_world(sim)->solid.n_coh; c++)
         for (int i = 0; i < 3; i++)
-            pairs++, failed += sim->solid.coh[c].failed[i] != 0;
+            pairs++, failed += cf_sim_world(sim)->solid.coh[c].failed[i] != 0;
     printf("%s: %d cohesive elements, %d of %d node pairs failed, boundary work %.6g J\n", name,
-           sim->solid.n_coh, failed, pairs, l.work_boundary);
+           cf_sim_world(sim)->solid.n_coh, failed, pairs, l.work_boundary);
     assert_int_equal(failed, pairs);
     int ok = verify_figure(name, "dissipated energy", l.cohesive_dissipated, G * area, 0.01, "J");
     ok &= verify_figure(name, "ledger residual / peak energy", resid / peak, 0, 0.01, "");

@@ -21,7 +21,9 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "verify.h"
 
 typedef struct {
@@ -34,14 +36,14 @@ static spin_result spin(const char *backend, const char *dt)
     snprintf(b, sizeof b, "solver.rigid_backend=\"%s\"", backend);
     snprintf(d, sizeof d, "solver.dt_rigid=%s", dt);
     const char *sets[] = {b, d, NULL};
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = verify_open("free_spin.lua", sets, &sc);
     cf_ledger l0, l;
-    cf_sim_ledger(sim, &l0);
+    cf_world_ledger(cf_sim_world(sim), &l0);
     cf_error err;
     if (cf_sim_run(sim, &err) != CF_OK)
         fail_msg("%s", err.msg);
-    cf_sim_ledger(sim, &l);
+    cf_world_ledger(cf_sim_world(sim), &l);
     double dL[3];
     for (int k = 0; k < 3; k++)
         dL[k] = l.angular_momentum[k] - l0.angular_momentum[k];

@@ -9,31 +9,33 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "verify.h"
 
 static void energy_is_conserved(void **state)
 {
     (void)state;
     verify_begin("vibration");
-    cf_scene sc;
+    cf_world_def sc;
     const char *sets[] = {"duration=2.9", NULL};
     cf_sim *sim = verify_open("vibration.lua", sets, &sc);
     cf_error err;
     cf_ledger l;
-    cf_sim_ledger(sim, &l);
+    cf_world_ledger(cf_sim_world(sim), &l);
     double e0 = l.initial, drift = 0, resid = 0, peak = e0;
     while (!cf_sim_done(sim)) {
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("%s", err.msg);
-        cf_sim_ledger(sim, &l);
+        cf_world_ledger(cf_sim_world(sim), &l);
         double e = l.kinetic + l.strain;
         drift = fmax(drift, fabs(e - e0) / e0);
         peak = fmax(peak, e);
         resid = fmax(resid, fabs(l.residual));
     }
-    long steps = sim->steps_fracture;
-    double ratio = sim->dt_fracture / sim->solid.dt_cfl;
+    long steps = cf_sim_world(sim)->steps_fracture;
+    double ratio = cf_sim_world(sim)->dt_fracture / cf_sim_world(sim)->solid.dt_cfl;
     printf("vibration: %ld explicit steps at dt/dt_cfl = %.3f, E0 = %.6g J\n", steps, ratio, e0);
     assert_true(steps >= 10000);
     int ok = verify_figure("vibration", "max |E - E0| / E0 over 10,000 steps", drift, 0, 1e-3, "");

@@ -9,14 +9,16 @@
 
 #include <cmocka.h>
 
-#include "sim.h"
+#include "cohfrac/sim.h"
+#include "cohfrac/scene.h"
+#include "world_impl.h"
 #include "tet4.h"
 #include "verify.h"
 
 /* Mean axial stress (Pa) of the tets whose centroid lies in [x0, x1]. */
 static double gauge_stress(const cf_sim *sim, double x0, double x1)
 {
-    const cf_solid *s = &sim->solid;
+    const cf_solid *s = &cf_sim_world(sim)->solid;
     double sum = 0, vol = 0;
     for (int t = 0; t < s->n_tets; t++) {
         double c = 0;
@@ -24,7 +26,7 @@ static double gauge_stress(const cf_sim *sim, double x0, double x1)
             c += 0.25 * s->X[3 * s->tet[4 * t + j]];
         if (c >= x0 && c <= x1) {
             double sig[9];
-            cf_tet4_stress(s, t, sim->scene->solver.elasticity, sig);
+            cf_tet4_stress(s, t, cf_sim_world(sim)->scene->solver.elasticity, sig);
             sum += sig[0] * s->vol[t], vol += s->vol[t];
         }
     }
@@ -35,7 +37,7 @@ static void front_speed_and_stress(void **state)
 {
     (void)state;
     verify_begin("wave_bar");
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = verify_open("wave_bar.lua", NULL, &sc);
     const cf_material *m = &sc.material;
     double c0 = sqrt(m->E / m->rho), v0 = sc.boundaries[0].velocity[0];
@@ -46,7 +48,7 @@ static void front_speed_and_stress(void **state)
     while (!cf_sim_done(sim)) {
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("%s", err.msg);
-        double t = cf_sim_time(sim), sg = gauge_stress(sim, gauge - 0.02, gauge + 0.02);
+        double t = cf_world_time(cf_sim_world(sim)), sg = gauge_stress(sim, gauge - 0.02, gauge + 0.02);
         /* arrival: the stress crosses half its plateau value */
         if (t_arrive < 0 && sg <= 0.5 * sigma_ref)
             t_arrive = t_prev + (t - t_prev) * (0.5 * sigma_ref - s_prev) / (sg - s_prev);
@@ -56,7 +58,7 @@ static void front_speed_and_stress(void **state)
         t_prev = t, s_prev = sg;
     }
     printf("wave_bar: c0 = %g m/s, dt/dt_cfl = %.3f, %d plateau samples\n", c0,
-           sim->dt_fracture / sim->solid.dt_cfl,
+           cf_sim_world(sim)->dt_fracture / cf_sim_world(sim)->solid.dt_cfl,
            n_plateau);
     assert_true(t_arrive > 0 && n_plateau > 0);
     int ok = verify_figure("wave_bar", "front arrival time at 0.75 L", t_arrive, d / c0, 0.03, "s");

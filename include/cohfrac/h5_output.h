@@ -74,6 +74,7 @@
 #define COHFRAC_H5_OUTPUT_H
 
 #include "cohfrac/error.h"
+#include "cohfrac/world.h"
 
 typedef struct cf_h5 cf_h5;
 
@@ -86,30 +87,6 @@ typedef struct cf_frag_frame {
     double v[3];             /* m/s */
     double w[3];             /* rad/s */
 } cf_frag_frame;
-
-/* A newly born fragment (initial body or product of a split). */
-typedef struct cf_frag_info {
-    int id;
-    int parent;              /* -1 for an initial body */
-    double birth_time;       /* s */
-    double mass;             /* kg */
-    int n_tets;
-    double inertia_principal[3]; /* kg m^2 */
-    int n_hulls;             /* convex hulls of its Bullet shape, 0 none */
-    double hull_volume_error;/* hull volume / tet volume - 1 */
-    double decomposition_time; /* s of wall time */
-} cf_frag_info;
-
-/* One hand-off between modes. */
-typedef struct cf_handoff_record {
-    double time;             /* s */
-    int fragment;            /* the fragment that changed mode (the parent for a split) */
-    int direction;           /* 0 rigid -> fracture, 1 fracture -> rigid */
-    double momentum_error;   /* |P_after - P_before| / |P_before| */
-    double momentum_change[3];         /* P_after - P_before, kg m/s */
-    double angular_momentum_change[3]; /* L_after - L_before about the origin, kg m^2/s */
-    double handoff_loss;     /* J: kinetic energy not carried by rigid motion */
-} cf_handoff_record;
 
 /* Create (truncate) `path` and write the root attributes and the scene text.
  * The parent directory is created if missing.  Also writes `<path minus .h5>.xdmf`
@@ -136,18 +113,6 @@ cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double t
  * is empty, holds '/' or exists already gives CF_ERR_OUTPUT. */
 cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int n,
                                 const char *unit, cf_error *err);
-
-/* One cohesive element (crack facet) at a frame. */
-typedef struct cf_crack_row {
-    double time;             /* s, the frame's */
-    int element;             /* cohesive element index (order of insertion) */
-    double centroid[3];      /* m, mid-surface centre */
-    double normal[3];        /* unit, mid-surface normal from side A to side B */
-    double area;             /* m^2, mid-surface */
-    double opening;          /* m, normal opening, mean of its three node pairs */
-    double sliding;          /* m, tangential opening, the same mean */
-    int failed;              /* 1: every node pair has failed (a free crack face) */
-} cf_crack_row;
 
 /* Append `n` rows to /cracks (created on the first call, even with n = 0).
  * Flushes. */

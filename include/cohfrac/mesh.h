@@ -1,5 +1,6 @@
-/* cohfrac — Tet4 volume meshes: the TetGen .node/.ele and Gmsh .msh
- * loaders, meshed primitives and the checks.
+/* cohfrac — mesh preparation: the TetGen .node/.ele and Gmsh .msh
+ * loaders, meshed primitives, hollowing and the checks.  The mesh type
+ * itself (cf_mesh) is the engine's, in cohfrac/tetmesh.h.
  *
  * A cf_mesh is a linear tetrahedral mesh in SI units (metres).  Tets are
  * positively oriented: det[x1-x0, x2-x0, x3-x0] > 0 (DESIGN §2).
@@ -8,48 +9,8 @@
 #define COHFRAC_MESH_H
 
 #include "cohfrac/error.h"
-
-/* A named node set (a Gmsh physical group, any dimension): the nodes of
- * every element of the group, 0-based, ascending, no repeats.  A group named
- * in $PhysicalNames but without elements has n_nodes = 0, nodes = NULL.
- * Names longer than 63 characters are cut. */
-typedef struct cf_mesh_group {
-    char name[64];
-    int dim;      /* 0 point, 1 curve, 2 surface, 3 volume */
-    int n_nodes;
-    int *nodes;   /* [n_nodes] */
-} cf_mesh_group;
-
-typedef struct cf_mesh {
-    int n_nodes;
-    int n_tets;
-    double *x; /* [n_nodes][3] node positions, m */
-    int *tets; /* [n_tets][4] 0-based node indices */
-    int n_groups;
-    cf_mesh_group *groups; /* [n_groups] named node sets (Gmsh files only) */
-} cf_mesh;
-
-/* Meshed primitives (scene bodies with `mesh = {type = ...}`), m. */
-typedef enum {
-    CF_PRIM_NONE = 0,
-    CF_PRIM_BOX,           /* structured, in-engine: size, cells, tets_per_cell */
-    CF_PRIM_SPHERE,        /* gmsh: radius, mesh_size */
-    CF_PRIM_HOLLOW_SPHERE, /* gmsh: radius (outer), thickness, mesh_size */
-    CF_PRIM_PLATE,         /* gmsh: size (x, y, thickness z), mesh_size */
-    CF_PRIM_NOTCHED_BEAM   /* gmsh: size (length x, width y, height z), notch, mesh_size */
-} cf_primitive_type;
-
-typedef struct cf_primitive {
-    cf_primitive_type type;
-    double size[3];     /* box, plate, notched beam: edge lengths along x, y, z, m */
-    int cells[3];       /* box: cells along x, y, z */
-    int tets_per_cell;  /* box: 5 or 6 */
-    double radius;      /* sphere, hollow sphere: outer radius, m */
-    double thickness;   /* hollow sphere: shell thickness, m */
-    double notch[3];    /* notched beam: depth (from the bottom face, z), width (x),
-                           offset of the notch centre from mid-span (x), m */
-    double mesh_size;   /* gmsh characteristic element length, m */
-} cf_primitive;
+#include "cohfrac/tetmesh.h"
+#include "cohfrac/types.h"
 
 /* Load TetGen files `<base>.node` and `<base>.ele` (`base` may also be given
  * with either extension).  Accepts 0- or 1-based numbering (taken from the
@@ -144,8 +105,5 @@ cf_status cf_mesh_primitive(const cf_primitive *p, const char *cache_dir, cf_mes
  * layers < 1, when nothing would be removed (every tet is within `layers`
  * of the boundary: a coarse mesh) or nothing kept (no tets); CF_ERR_NOMEM. */
 cf_status cf_mesh_hollow(cf_mesh *m, int layers, cf_error *err);
-
-/* Release the arrays and zero `m` (NULL or an empty mesh is fine). */
-void cf_mesh_free(cf_mesh *m);
 
 #endif

@@ -1,4 +1,5 @@
-/* cohfrac — scenes: a Lua 5.4 script that returns a table.
+/* cohfrac — scenes: a Lua 5.4 script that returns a table, read into the
+ * engine's world definition (cohfrac/world.h).
  *
  * The script runs sandboxed (base functions without dofile/loadfile/load of
  * bytecode, plus string, table and math; no io, os, package, debug).  The
@@ -139,129 +140,7 @@
 #define COHFRAC_SCENE_H
 
 #include "cohfrac/error.h"
-#include "cohfrac/mesh.h"
-
-typedef struct cf_material {
-    double E, nu, rho;             /* Pa, -, kg/m^3 */
-    double G_I, G_II;              /* fracture energies phi_n, phi_t, N/m */
-    double sigma_max, tau_max;     /* cohesive strengths, Pa */
-    double alpha, beta;            /* PPR shape parameters */
-    double friction, restitution;  /* contact with obstacles */
-    int weibull;                   /* strength distribution: 0 uniform, 1 Weibull */
-    double weibull_modulus;        /* m, > 0 */
-    int strength_seed;
-} cf_material;
-
-typedef struct cf_body_def {
-    char mesh[1024];           /* resolved path: TetGen base (no extension) or a
-                                  .msh file; "" for a primitive */
-    cf_primitive primitive;    /* type CF_PRIM_NONE when `mesh` is a file */
-    double scale;
-    double position[3];        /* m, where the bounding-box centre goes */
-    double orientation[4];     /* w,x,y,z, normalised */
-    double velocity[3];        /* m/s */
-    double angular_velocity[3];/* rad/s */
-    double expansion_rate[3];  /* 1/s, per axis */
-    int has_expansion_center;  /* 0: the body's centre of mass */
-    double expansion_center[3];/* m */
-    int hollow_layers;         /* > 0: keep only the tets within this many tet
-                                  layers of the surface (a hollow shell); 0 solid */
-} cf_body_def;
-
-typedef enum { CF_REGION_BOX, CF_REGION_PLANE, CF_REGION_GROUP } cf_region_type;
-
-typedef struct cf_boundary {
-    cf_region_type type;
-    double min[3], max[3];       /* box, m */
-    double point[3], normal[3];  /* plane (normal normalised) */
-    double tolerance;            /* plane, m */
-    char group[64];              /* Gmsh physical group name */
-    int body;                    /* 0-based body index, -1 for every body */
-    int axes;                    /* prescribed components: bit 0 x, 1 y, 2 z */
-    double velocity[3];          /* m/s (zero when fixed) */
-} cf_boundary;
-
-typedef enum {
-    CF_OBSTACLE_PLANE,
-    CF_OBSTACLE_SPHERE,
-    CF_OBSTACLE_BOX,
-    CF_OBSTACLE_MESH
-} cf_obstacle_type;
-
-typedef struct cf_obstacle {
-    cf_obstacle_type type;
-    double point[3], normal[3];  /* plane (normal normalised) */
-    double center[3];            /* sphere, box: at t = 0 */
-    double radius;               /* sphere, m */
-    double half_extents[3];      /* box (axis-aligned), m */
-    double velocity[3];          /* sphere, box: constant, m/s */
-    char file[1024];             /* mesh: resolved path of a closed or open
-                                    triangle surface (.obj/.off/.stl) */
-    double scale;                /* mesh: applied first */
-    double orientation[4];       /* mesh: w,x,y,z, normalised, then */
-    double position[3];          /* mesh: where the file's origin goes, m */
-    double friction, restitution;/* factors on the material's values (the
-                                    pair's coefficient is their product) */
-} cf_obstacle;
-
-typedef enum { CF_RUN_HYBRID, CF_RUN_FRACTURE } cf_run_mode;
-typedef enum { CF_RIGID_BULLET, CF_RIGID_PBD } cf_rigid_backend;
-typedef enum { CF_ELASTICITY_COROTATIONAL, CF_ELASTICITY_LINEAR } cf_elasticity;
-typedef enum { CF_CRITERION_TRACTION, CF_CRITERION_SOURCE, CF_CRITERION_NONE } cf_criterion;
-typedef enum { CF_CONSTRAINTS_PBD, CF_CONSTRAINTS_XPBD, CF_CONSTRAINTS_NONE } cf_constraints;
-
-typedef struct cf_solver_settings {
-    cf_run_mode mode;
-    cf_rigid_backend rigid_backend;
-    double dt_rigid;
-    int rigid_substeps;
-    double dt_fracture;
-    double cfl_fraction;          /* > 0: dt_fracture = cfl_fraction dt_cfl */
-    int check_interval;
-    int quiet_steps;
-    double max_fracture_time;
-    double impact_threshold;
-    int ccd;                      /* Bullet continuous collision detection */
-    double sleep_linear, sleep_angular; /* m/s, rad/s; 0, 0: no sleeping */
-    cf_elasticity elasticity;
-    cf_criterion criterion;
-    int has_crack_plane;
-    double crack_plane_point[3], crack_plane_normal[3]; /* normal normalised */
-    double crack_plane_tolerance;                    /* m */
-    cf_constraints constraints;
-    double k_stiffness;
-    int iterations;
-    double k_damping;
-    int iteration_independent;
-    double compliance_scale;
-    double contact_stiffness;     /* Pa/m, 0 = stability cap */
-    double max_inverted_fraction;
-    double max_energy_growth;
-    int threads;
-} cf_solver_settings;
-
-typedef struct cf_output_settings {
-    char file[1024];
-    double frame_interval;
-    int cracks;                  /* write /cracks at frames */
-} cf_output_settings;
-
-typedef struct cf_scene {
-    char name[128];
-    double duration;
-    double gravity[3];
-    cf_material material;
-    int n_bodies;
-    cf_body_def *bodies;
-    int n_obstacles;
-    cf_obstacle *obstacles;
-    int n_boundaries;
-    cf_boundary *boundaries;
-    cf_solver_settings solver;
-    cf_output_settings output;
-    char *resolved; /* the resolved scene as Lua text (every key, defaults filled,
-                       mesh paths absolute); loading it again gives this scene */
-} cf_scene;
+#include "cohfrac/types.h"
 
 /* Load and validate a scene script.  `overrides` are "key.path=value"
  * strings applied before validation.  Prepared mesh names are looked up in
@@ -272,16 +151,16 @@ typedef struct cf_scene {
  * CF_ERR_SCENE_VALUE (key path, value, allowed range), CF_ERR_SCENE_OVERRIDE.
  * On error `out` is left empty. */
 cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
-                        const char *mesh_dir, cf_scene *out, cf_error *err);
+                        const char *mesh_dir, cf_world_def *out, cf_error *err);
 
 /* The same for a scene script held in memory: `name` stands for the file in
  * messages, and relative paths start at the working directory.  Errors as
  * cf_scene_load, without CF_ERR_FILE_OPEN for the script itself. */
 cf_status cf_scene_load_text(const char *name, const char *text, const char *const *overrides,
-                             int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err);
+                             int n_overrides, const char *mesh_dir, cf_world_def *out, cf_error *err);
 
 /* Free what cf_scene_load allocated and zero *s.  NULL and an already
  * freed (zeroed) scene are fine. */
-void cf_scene_free(cf_scene *s);
+void cf_scene_free(cf_world_def *s);
 
 #endif

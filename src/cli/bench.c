@@ -65,7 +65,7 @@ static double median(double *v, int n)
 /* The bench scene for `mesh` under `criterion`: the half height of the
  * mesh along its y axis (z once rotated) puts its lowest point on the plane. */
 static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_criterion criterion,
-                            cf_scene *sc, cf_error *err)
+                            cf_world_def *sc, cf_error *err)
 {
     static const char *fmt =
         "return {\n"
@@ -109,7 +109,7 @@ typedef struct sample {
 } sample;
 
 /* One repeat: build the world, `warmup` steps, then `steps` timed ones. */
-static cf_status time_steps(const cf_bench_options *o, const cf_scene *sc, int threads,
+static cf_status time_steps(const cf_bench_options *o, const cf_world_def *sc, int threads,
                             sample *out, cf_error *err)
 {
     cf_run_options ro = {.progress = 0, .threads = threads, .mesh_dir = o->mesh_dir};
@@ -119,13 +119,13 @@ static cf_status time_steps(const cf_bench_options *o, const cf_scene *sc, int t
         st = cf_sim_advance(sim, err);
     cf_step_stats a, b;
     if (st == CF_OK)
-        cf_sim_step_stats(sim, &a);
+        cf_world_step_stats(cf_sim_world(sim), &a);
     double w0 = cf_wall_time(), c0 = cpu_time();
     for (int k = 0; st == CF_OK && k < o->steps; k++)
         st = cf_sim_advance(sim, err);
     double wall = cf_wall_time() - w0, cpu = cpu_time() - c0;
     if (st == CF_OK) {
-        cf_sim_step_stats(sim, &b);
+        cf_world_step_stats(cf_sim_world(sim), &b);
         double n = (double)(b.fracture_steps - a.fracture_steps);
         out->ms = 1e3 * wall / n, out->cpu_ms = 1e3 * cpu / n;
         out->stress = 1e3 * (b.stress - a.stress) / n;
@@ -144,7 +144,7 @@ static cf_status time_steps(const cf_bench_options *o, const cf_scene *sc, int t
 
 /* The peer on the same mesh, steps and dt: its ms per step (min), or a
  * negative number when it failed (the log is kept and named). */
-static double run_peer(const cf_bench_options *o, const cf_scene *sc, cf_error *err)
+static double run_peer(const cf_bench_options *o, const cf_world_def *sc, cf_error *err)
 {
     char log[] = "/tmp/cohfrac_peer_XXXXXX", steps[32], dt[32];
     int fd = mkstemp(log);
@@ -206,7 +206,7 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
     int nt = o->threads > 0 ? o->threads : omp_get_num_procs();
     int reps = o->repeats < 1 ? 1 : o->repeats > 64 ? 64 : o->repeats;
     FILE *log = o->log;
-    cf_scene sc;
+    cf_world_def sc;
     cf_status st = make_scene(o, o->mesh, o->criterion, &sc, err);
     if (st != CF_OK)
         return st;
@@ -301,7 +301,7 @@ cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes,
                      "  %-28s %9s %9s %11s %13s\n",
                 nt, o->steps, reps, "mesh", "tets", "step ms", "ns/tet-step", "memory B/tet");
     for (int i = 0; i < n; i++) {
-        cf_scene sc;
+        cf_world_def sc;
         cf_status st = make_scene(o, meshes[i], CF_CRITERION_NONE, &sc, err);
         double best = INFINITY;
         sample s;

@@ -6,7 +6,7 @@
  *      text chunks only);
  *   2. apply the `key.path=value` overrides to the returned table;
  *   3. walk the table against the schema in cohfrac/scene.h, in schema order,
- *      filling a cf_scene and every default;
+ *      filling a cf_world_def and every default;
  *   4. print the filled scene back as Lua text (`resolved`).
  *
  * Steps 2 and 3 run inside lua_pcall so that a Lua memory error cannot
@@ -149,7 +149,7 @@ typedef struct loader {
     const char *mesh_dir; /* where prepared meshes live; may be NULL */
     const char *const *overrides;
     int n_overrides;
-    cf_scene *s;
+    cf_world_def *s;
     cf_error *err;
     cf_status status;   /* result of the protected part */
     char path[512];     /* key path of the table being read, e.g. "solver.pbd" */
@@ -1229,7 +1229,7 @@ static cf_status read_scene(loader *ld, int t)
 {
     static const double duration = 1.0;
     lua_State *L = ld->L;
-    cf_scene *s = ld->s;
+    cf_world_def *s = ld->s;
     int n, li;
 
     TRY(check_keys(ld, t, top_keys, COUNT(top_keys)));
@@ -1661,7 +1661,7 @@ static void put_boundary(text *b, const cf_boundary *d)
 }
 
 /* The whole scene as Lua text in schema order; NULL when out of memory. */
-static char *resolved_text(const cf_scene *s)
+static char *resolved_text(const cf_world_def *s)
 {
     text b = {0};
     const cf_material *m = &s->material;
@@ -1858,7 +1858,7 @@ static cf_status load(loader *ld)
 /* The loader behind cf_scene_load and cf_scene_load_text: `text` NULL
  * reads the file `path`, otherwise `path` only names the text in messages. */
 static cf_status load_scene(const char *path, const char *text, const char *const *overrides,
-                            int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err)
+                            int n_overrides, const char *mesh_dir, cf_world_def *out, cf_error *err)
 {
     loader ld;
     const char *slash;
@@ -1896,19 +1896,19 @@ static cf_status load_scene(const char *path, const char *text, const char *cons
 }
 
 cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
-                        const char *mesh_dir, cf_scene *out, cf_error *err)
+                        const char *mesh_dir, cf_world_def *out, cf_error *err)
 {
     return load_scene(path, NULL, overrides, n_overrides, mesh_dir, out, err);
 }
 
 cf_status cf_scene_load_text(const char *name, const char *text, const char *const *overrides,
-                             int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err)
+                             int n_overrides, const char *mesh_dir, cf_world_def *out, cf_error *err)
 {
     assert(text);
     return load_scene(name, text, overrides, n_overrides, mesh_dir, out, err);
 }
 
-void cf_scene_free(cf_scene *s)
+void cf_scene_free(cf_world_def *s)
 {
     if (!s)
         return;

@@ -4,7 +4,7 @@
 
 #include "cf_fcl.h"
 #include "linalg.h"
-#include "sim.h"
+#include "world_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -171,7 +171,7 @@ static int move(cf_solid *s, moved_nodes *mv, const cf_fragment *f, int i, int a
 
 /* Every node of fragment fa inside box_b and behind fb's surface, projected
  * out with it (the constraint of contact.h).  Returns 0, or -1. */
-static int push_out(cf_sim *sim, const cf_fragment *fa, const cf_fragment *fb,
+static int push_out(cf_world *sim, const cf_fragment *fa, const cf_fragment *fb,
                     cf_frag_surface *sb, const double box_b[6], double h, moved_nodes *mv)
 {
     cf_solid *s = &sim->solid;
@@ -210,7 +210,7 @@ static int push_out(cf_sim *sim, const cf_fragment *fa, const cf_fragment *fb,
     return 0;
 }
 
-int cf_body_contact_needed(const cf_sim *sim)
+int cf_body_contact_needed(const cf_world *sim)
 {
     int first_root = -1;
     for (int fi = 0; fi < sim->n_frag; fi++) {
@@ -224,7 +224,7 @@ int cf_body_contact_needed(const cf_sim *sim)
     return 0;
 }
 
-int cf_body_contact(cf_sim *sim, double h, double *removed)
+int cf_body_contact(cf_world *sim, double h, double *removed)
 {
     *removed = 0;
     int n = sim->n_frag;

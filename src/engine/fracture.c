@@ -1,5 +1,5 @@
 /* The in-house solver step (source Table 6.2, DESIGN §3), per fragment. */
-#include "sim.h"
+#include "world_impl.h"
 
 #include "linalg.h"
 #include "tet4.h"
@@ -34,7 +34,7 @@ static int ensure_scratch(cf_fragment *f)
 }
 
 /* Extrinsic insertion on every facet that qualifies at this check. */
-static cf_status check_and_insert(cf_sim *sim, cf_fragment *f, int n_hot, int *inserted)
+static cf_status check_and_insert(cf_world *sim, cf_fragment *f, int n_hot, int *inserted)
 {
     cf_solid *s = &sim->solid;
     double t0 = cf_wall_time();
@@ -55,7 +55,7 @@ static cf_status check_and_insert(cf_sim *sim, cf_fragment *f, int n_hot, int *i
 
 /* Friction and restitution of nodes in contact, relative to the obstacle.
  * Returns the kinetic energy this removes, J. */
-static double contact_velocities(cf_sim *sim, cf_fragment *f, double t)
+static double contact_velocities(cf_world *sim, cf_fragment *f, double t)
 {
     cf_solid *s = &sim->solid;
     double removed = 0;
@@ -100,7 +100,7 @@ static double contact_velocities(cf_sim *sim, cf_fragment *f, double t)
  * into the prediction p = x + dt v when `on_p` is set.  Returns the work of
  * the reaction that restores p (J): the impulse m dp/dt times the node's
  * prescribed velocity. */
-static double impose_boundary(cf_sim *sim, int a, double dt, int on_p)
+static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
 {
     cf_solid *s = &sim->solid;
     const cf_boundary *bc = &sim->scene->boundaries[s->bc[a]];
@@ -119,7 +119,7 @@ static double impose_boundary(cf_sim *sim, int a, double dt, int on_p)
 }
 
 /* f = f_ext - f_int + f_coh at x_n; strain energy and inverted tets. */
-static cf_status forces(cf_sim *sim, cf_fragment *f, double dt, int fracture)
+static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->scene->solver;
@@ -165,7 +165,7 @@ static cf_status forces(cf_sim *sim, cf_fragment *f, double dt, int fracture)
 
 /* v <- v + dt M^-1 f, prescribed velocities, global damping (pbd rigid
  * mode); the ledger's kinetic energy and the boundary and damping work. */
-static void update_velocities(cf_sim *sim, cf_fragment *f, double dt, int fracture)
+static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int fracture)
 {
     cf_solid *s = &sim->solid;
     const int *nodes = f->nodes.v;
@@ -210,7 +210,7 @@ static void update_velocities(cf_sim *sim, cf_fragment *f, double dt, int fractu
 /* The obstacles and rigid neighbours' hulls on node i's prediction at
  * t_next; records its contact and approach speed.  Returns the work of
  * moving obstacles on it in this pass, J. */
-static double obstacle_node(cf_sim *sim, cf_fragment *f, int i, double t_next, double dt)
+static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next, double dt)
 {
     cf_solid *s = &sim->solid;
     int a = f->nodes.v[i];
@@ -247,7 +247,7 @@ static double obstacle_node(cf_sim *sim, cf_fragment *f, int i, double t_next, d
 
 /* Prediction p = x + dt v, then the constraint projection: bars (PBD or
  * XPBD), crack-face contact, obstacles, prescribed nodes. */
-static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int fracture)
+static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int fracture)
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->scene->solver;
@@ -363,7 +363,7 @@ static void project(cf_sim *sim, cf_fragment *f, double t_next, double dt, int f
         sim->flow.contact += removed + w_obs;
 }
 
-cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
+cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture)
 {
     cf_fragment *f = &sim->frag[fi];
     cf_status st = forces(sim, f, dt, fracture);
@@ -379,7 +379,7 @@ cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture)
     f->steps++;
     return CF_OK;
 }
-int cf_pbd_impact(const cf_sim *sim, int fi, double dt)
+int cf_pbd_impact(const cf_world *sim, int fi, double dt)
 {
     const cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;

@@ -1,17 +1,5 @@
-/* cohfrac — command-line front end.
- *
- *   cohfrac run SCENE.lua [--set key.path=value]... [--mesh-dir DIR]
- *               [--output FILE] [--threads N] [--quiet]
- *   cohfrac compare SCENE.lua [--set key.path=value]... [-o DIR] [-j N]
- *                   [-m MESH_DIR] [-q]
- *   cohfrac mesh SURFACE.{obj,off,stl} -o OUT [--target-tets N]
- *   cohfrac study SCENE.lua --vary key.path=v1,v2,... [--vary ...]
- *                 [--reference key.path=value]... [--set key.path=value]...
- *                 [-o DIR] [-j JOBS] [-t THREADS] [-m MESH_DIR] [--tolerance F] [-q]
- *   cohfrac stability [--quick] [-o DIR] [-q]
- *   cohfrac bench [--mesh NAME] [--steps N] [--repeats N] [--threads N]
- *                 [--criterion none|source|traction] [--peer] [--scaling[=LIST]]
- *   cohfrac --help | --version
+/* cohfrac — command-line front end: run, compare, mesh, study, stability,
+ * bench (each documented by `cohfrac SUB --help`, the table below).
  *
  * Exit codes: 0 success, 1 usage, 2 bad input (mesh, surface, scene),
  * 3 diverged, 4 output not written, 5 external program or memory failure
@@ -35,61 +23,89 @@
 #define COHFRAC_VERSION "0.0.0"
 #endif
 
-static const char usage[] =
-    "usage:\n"
-    "  cohfrac run SCENE.lua [options]     run a scene, write its HDF5 output\n"
-    "      -s, --set KEY.PATH=VALUE        override a scene key (Lua value), repeatable\n"
-    "      -m, --mesh-dir DIR              where prepared meshes live (default build/meshes,\n"
-    "                                      or $COHFRAC_MESH_DIR)\n"
-    "      -o, --output FILE               output file (same as --set output.file=\"FILE\")\n"
-    "      -j, --threads N                 threads for element loops (default: all cores)\n"
-    "      -q, --quiet                     no progress display\n"
-    "  cohfrac compare SCENE.lua [options] run the scene with both rigid backends (bullet,\n"
-    "                                      pbd) in lockstep; write compare.md, compare.csv,\n"
-    "                                      fragments.csv, compare.png; print the headline\n"
-    "      -s, --set KEY.PATH=VALUE        override a scene key (Lua value), repeatable\n"
-    "      -o, --output DIR                report directory (default build/compare/<scene name>)\n"
-    "      -m, --mesh-dir DIR              as for 'run'\n"
-    "      -j, --threads N                 threads for element loops (default: all cores)\n"
-    "      -q, --quiet                     no progress display\n"
-    "  cohfrac mesh SURFACE -o OUT [--target-tets N]\n"
-    "                                      repair a closed surface (OBJ/OFF/STL), run tetgen,\n"
-    "                                      write OUT.node/OUT.ele (cached)\n"
-    "  cohfrac study SCENE.lua --vary KEY.PATH=V1,V2,... [options]\n"
-    "                                      run every combination of the varied settings and\n"
-    "                                      a reference; error against run time: study.md,\n"
-    "                                      study.csv, study.png (runs cached in OUT/runs/)\n"
-    "      -V, --vary KEY.PATH=V1,V2,...   a varied key and its Lua values, repeatable\n"
-    "      -r, --reference KEY.PATH=VALUE  the reference's overrides, repeatable (default:\n"
-    "                                      solver.constraints=\"none\" solver.cfl_fraction=0.5)\n"
-    "      -s, --set KEY.PATH=VALUE        override for every case, repeatable\n"
-    "      -o, --output DIR                report directory (default build/studies/<scene name>)\n"
-    "      -j, --jobs N                    cases run at a time (default 1)\n"
-    "      -t, --threads N                 threads per case (default cores / jobs)\n"
-    "      -m, --mesh-dir DIR              as for 'run'\n"
-    "          --tolerance F               trajectory error of the verdict (default 0.05)\n"
-    "      -q, --quiet                     no line per finished case\n"
-    "  cohfrac stability [--quick] [-o DIR] [-q]\n"
-    "                                      stability map of fracture mode over E, dt/dt_cfl,\n"
-    "                                      constraints, impact speed and mesh quality; write\n"
-    "                                      stability.md, stability.csv, stability.png\n"
-    "      --quick                         the corners only (under a minute)\n"
-    "      -o, --output DIR                report directory (default build/stability)\n"
-    "      -q, --quiet                     no line per case\n"
-    "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 3.1 m/s)\n"
-    "                                      against the memory floor, 1 against N threads\n"
-    "      --mesh NAME                     prepared mesh or TetGen base (default bunny)\n"
-    "      --steps N                       timed steps per repeat (default 60), after\n"
-    "      --warmup N                      untimed steps into the impact (default 100)\n"
-    "      --repeats N                     repeats per thread count (default 3)\n"
-    "      --threads N                     the N of the N-thread runs (default: all cores)\n"
-    "      --criterion none|source|traction  insertion rule (default source)\n"
-    "      --peer                          also step Bullet's btSoftBody on the same mesh\n"
-    "      --scaling[=M1,M2,...]           step time and memory per tet over meshes (default\n"
-    "                                      bunny_small,bunny_50k,bunny,bunny_800k)\n"
-    "      -m, --mesh-dir DIR              as for 'run'\n"
-    "  cohfrac --help | --version\n"
+/* Each subcommand's help: `cohfrac SUB --help` prints its entry, `cohfrac
+ * --help` all of them.  One meaning per option letter across subcommands:
+ * -s set, -m mesh directory, -o output, -t threads, -j jobs (study), -q
+ * quiet, -V vary, -r reference, -h help. */
+static const struct {
+    const char *name, *help;
+} commands[] = {
+    {"run",
+     "  cohfrac run SCENE.lua [options]     run a scene, write its HDF5 output\n"
+     "      -s, --set KEY.PATH=VALUE        override a scene key (Lua value), repeatable\n"
+     "      -m, --mesh-dir DIR              where prepared meshes live (default: $COHFRAC_MESH_DIR,\n"
+     "                                      else the build's mesh directory)\n"
+     "      -o, --output FILE               output file, relative to the working directory\n"
+     "                                      (default: the scene's output.file, relative to the\n"
+     "                                      scene file: out/<name>.h5 beside the scene)\n"
+     "      -t, --threads N                 threads for element loops (default: all cores)\n"
+     "      -q, --quiet                     no progress display\n"},
+    {"compare",
+     "  cohfrac compare SCENE.lua [options] run the scene with both rigid backends (bullet,\n"
+     "                                      pbd) in lockstep; write compare.md, compare.csv,\n"
+     "                                      fragments.csv, compare.png; print the headline\n"
+     "      -s, --set KEY.PATH=VALUE        override a scene key (Lua value), repeatable\n"
+     "      -o, --output DIR                report directory (default build/compare/<scene name>)\n"
+     "      -m, --mesh-dir DIR              as for 'run'\n"
+     "      -t, --threads N                 threads for element loops (default: all cores)\n"
+     "      -q, --quiet                     no progress display\n"},
+    {"mesh",
+     "  cohfrac mesh SURFACE -o OUT [options]\n"
+     "                                      repair a closed surface (OBJ/OFF/STL), run tetgen,\n"
+     "                                      write OUT.node/OUT.ele (cached)\n"
+     "      -o, --output OUT                the TetGen base to write (OUT.node, OUT.ele)\n"
+     "          --target-tets N             about this many tets (default: tetgen's own)\n"
+     "      -q, --quiet                     no progress lines\n"},
+    {"study",
+     "  cohfrac study SCENE.lua --vary KEY.PATH=V1,V2,... [options]\n"
+     "                                      run every combination of the varied settings and\n"
+     "                                      a reference; error against run time: study.md,\n"
+     "                                      study.csv, study.png (runs cached in OUT/runs/)\n"
+     "      -V, --vary KEY.PATH=V1,V2,...   a varied key and its Lua values, repeatable\n"
+     "      -r, --reference KEY.PATH=VALUE  the reference's overrides, repeatable (default:\n"
+     "                                      solver.constraints=\"none\" solver.cfl_fraction=0.5)\n"
+     "      -s, --set KEY.PATH=VALUE        override for every case, repeatable\n"
+     "      -o, --output DIR                report directory (default build/studies/<scene name>)\n"
+     "      -j, --jobs N                    cases run at a time (default 1)\n"
+     "      -t, --threads N                 threads per case (default cores / jobs)\n"
+     "      -m, --mesh-dir DIR              as for 'run'\n"
+     "          --tolerance F               trajectory error of the verdict (default 0.05)\n"
+     "      -q, --quiet                     no line per finished case\n"},
+    {"stability",
+     "  cohfrac stability [--quick] [-o DIR] [-q]\n"
+     "                                      stability map of fracture mode over E, dt/dt_cfl,\n"
+     "                                      constraints, impact speed and mesh quality; write\n"
+     "                                      stability.md, stability.csv, stability.png\n"
+     "      --quick                         the corners only (under a minute)\n"
+     "      -o, --output DIR                report directory (default build/stability)\n"
+     "      -q, --quiet                     no line per case\n"},
+    {"bench",
+     "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 3.1 m/s)\n"
+     "                                      against the memory floor, 1 against N threads\n"
+     "      --mesh NAME                     prepared mesh or TetGen base (default bunny)\n"
+     "      --steps N                       timed steps per repeat (default 60), after\n"
+     "      --warmup N                      untimed steps into the impact (default 100)\n"
+     "      --repeats N                     repeats per thread count (default 3)\n"
+     "      -t, --threads N                 the N of the N-thread runs (default: all cores)\n"
+     "      --criterion none|source|traction  insertion rule (default source)\n"
+     "      --peer                          also step Bullet's btSoftBody on the same mesh\n"
+     "      --scaling[=M1,M2,...]           step time and memory per tet over meshes (default\n"
+     "                                      bunny_small,bunny_50k,bunny,bunny_800k)\n"
+     "      -m, --mesh-dir DIR              as for 'run'\n"},
+};
+
+static const char tail[] =
+    "  cohfrac --help | --version          (also after any subcommand: cohfrac run --help)\n"
     "exit codes: 0 ok, 1 usage, 2 bad input, 3 diverged, 4 output failed, 5 external/memory\n";
+
+static void print_usage(FILE *out, const char *only)
+{
+    fputs("usage:\n", out);
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (!only || !strcmp(only, commands[i].name))
+            fputs(commands[i].help, out);
+    fputs(tail, out);
+}
 
 static int fail(const cf_error *e)
 {
@@ -97,9 +113,13 @@ static int fail(const cf_error *e)
     return cf_status_exit_code(e->code);
 }
 
+/* The subcommand being parsed, for usage errors. */
+static const char *current = NULL;
+
 static int usage_error(const char *msg)
 {
-    fprintf(stderr, "cohfrac: %s\n%s", msg, usage);
+    fprintf(stderr, "cohfrac: %s\n", msg);
+    print_usage(stderr, current);
     return cf_status_exit_code(CF_ERR_USAGE);
 }
 
@@ -112,7 +132,7 @@ static int cmd_mesh(int argc, char **argv)
     cf_mesh_prep_opts o = {0};
     o.verbose = 1;
     int c;
-    while ((c = getopt_long(argc, argv, "o:t:q", lo, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:q", lo, NULL)) != -1) {
         switch (c) {
         case 'o': o.output = optarg; break;
         case 't': o.target_tets = atoi(optarg); break;
@@ -186,22 +206,21 @@ static int parse_scene_args(int argc, char **argv, const char *cmd, scene_args *
     static const struct option lo[] = {{"set", required_argument, 0, 's'},
                                        {"mesh-dir", required_argument, 0, 'm'},
                                        {"output", required_argument, 0, 'o'},
-                                       {"threads", required_argument, 0, 'j'},
+                                       {"threads", required_argument, 0, 't'},
                                        {"quiet", no_argument, 0, 'q'},
                                        {0, 0, 0, 0}};
     char msg[64];
-    const char *env = getenv("COHFRAC_MESH_DIR");
     memset(a, 0, sizeof *a);
     a->sets = calloc((size_t)argc + 2, sizeof *a->sets);
-    a->mesh_dir = env ? env : "build/meshes";
+    a->mesh_dir = cf_default_mesh_dir();
     a->progress = 1;
     int c;
-    while ((c = getopt_long(argc, argv, "s:m:o:j:q", lo, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "s:m:o:t:q", lo, NULL)) != -1) {
         switch (c) {
         case 's': a->sets[a->n_sets++] = optarg; break;
         case 'm': a->mesh_dir = optarg; break;
         case 'o': a->output = optarg, a->output_at = a->n_sets; break;
-        case 'j': a->threads = atoi(optarg); break;
+        case 't': a->threads = atoi(optarg); break;
         case 'q': a->progress = 0; break;
         default:
             snprintf(msg, sizeof msg, "bad option for '%s'", cmd);
@@ -234,7 +253,7 @@ static int cmd_run(int argc, char **argv)
         return rc;
     }
     cf_error err = {0};
-    cf_scene scene;
+    cf_world_def scene;
     cf_sim *sim = NULL;
     cf_run_options opt = {.progress = a.progress, .threads = a.threads, .mesh_dir = a.mesh_dir};
     if (cf_scene_load(a.scene, a.sets, a.n_sets, a.mesh_dir, &scene, &err) != CF_OK) {
@@ -313,9 +332,8 @@ static int cmd_study(int argc, char **argv)
     const char **vary = calloc((size_t)argc, sizeof *vary);
     const char **ref = calloc((size_t)argc, sizeof *ref);
     const char **sets = calloc((size_t)argc, sizeof *sets);
-    const char *env = getenv("COHFRAC_MESH_DIR");
     cf_study_options o = {.progress = 1, .plot = 1, .jobs = 1};
-    o.mesh_dir = env ? env : "build/meshes";
+    o.mesh_dir = cf_default_mesh_dir();
     int c, rc = 0;
     while (rc == 0 && (c = getopt_long(argc, argv, "V:r:s:o:j:t:m:q", lo, NULL)) != -1) {
         switch (c) {
@@ -388,30 +406,29 @@ static int count_arg(const char *opt, const char *text, int lo)
 
 static int cmd_bench(int argc, char **argv)
 {
-    enum { O_MESH = 256, O_STEPS, O_REPEATS, O_THREADS, O_CRITERION, O_PEER, O_SCALING, O_WARMUP };
+    enum { O_MESH = 256, O_STEPS, O_REPEATS, O_CRITERION, O_PEER, O_SCALING, O_WARMUP };
     static const struct option lo[] = {{"mesh", required_argument, 0, O_MESH},
                                        {"steps", required_argument, 0, O_STEPS},
                                        {"warmup", required_argument, 0, O_WARMUP},
                                        {"repeats", required_argument, 0, O_REPEATS},
-                                       {"threads", required_argument, 0, O_THREADS},
+                                       {"threads", required_argument, 0, 't'},
                                        {"criterion", required_argument, 0, O_CRITERION},
                                        {"peer", no_argument, 0, O_PEER},
                                        {"scaling", optional_argument, 0, O_SCALING},
                                        {"mesh-dir", required_argument, 0, 'm'},
                                        {0, 0, 0, 0}};
-    const char *env = getenv("COHFRAC_MESH_DIR");
-    cf_bench_options o = {.mesh = "bunny", .mesh_dir = env ? env : "build/meshes", .steps = 60,
+    cf_bench_options o = {.mesh = "bunny", .mesh_dir = cf_default_mesh_dir(), .steps = 60,
                           .warmup = 100, .repeats = 3, .criterion = CF_CRITERION_SOURCE,
                           .log = stdout};
     const char *scaling = NULL;
     int c, peer = 0;
-    while ((c = getopt_long(argc, argv, "m:", lo, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "m:t:", lo, NULL)) != -1) {
         switch (c) {
         case O_MESH: o.mesh = optarg; break;
         case O_STEPS: o.steps = count_arg("--steps", optarg, 1); break;
         case O_WARMUP: o.warmup = count_arg("--warmup", optarg, 0); break;
         case O_REPEATS: o.repeats = count_arg("--repeats", optarg, 1); break;
-        case O_THREADS: o.threads = count_arg("--threads", optarg, 1); break;
+        case 't': o.threads = count_arg("--threads", optarg, 1); break;
         case O_CRITERION:
             if (!strcmp(optarg, "none")) o.criterion = CF_CRITERION_NONE;
             else if (!strcmp(optarg, "source")) o.criterion = CF_CRITERION_SOURCE;
@@ -449,29 +466,41 @@ static int cmd_bench(int argc, char **argv)
     return cf_bench_run(&o, &r, &err) == CF_OK ? 0 : fail(&err);
 }
 
+/* --help / -h or --version among a subcommand's arguments (before "--"). */
+static int asks(int argc, char **argv, const char *a, const char *b)
+{
+    for (int i = 1; i < argc && strcmp(argv[i], "--"); i++)
+        if (!strcmp(argv[i], a) || (b && !strcmp(argv[i], b)))
+            return 1;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    static const struct {
+        const char *name;
+        int (*run)(int, char **);
+    } table[] = {{"run", cmd_run},         {"compare", cmd_compare},     {"mesh", cmd_mesh},
+                 {"study", cmd_study},     {"stability", cmd_stability}, {"bench", cmd_bench}};
     if (argc < 2)
         return usage_error("no command given");
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
-        fputs(usage, stdout);
+        print_usage(stdout, argc > 2 ? argv[2] : NULL);
         return 0;
     }
-    if (!strcmp(argv[1], "--version")) {
+    if (asks(argc, argv, "--version", NULL)) {
         printf("cohfrac %s\n", COHFRAC_VERSION);
         return 0;
     }
-    if (!strcmp(argv[1], "run"))
-        return cmd_run(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "compare"))
-        return cmd_compare(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "mesh"))
-        return cmd_mesh(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "study"))
-        return cmd_study(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "stability"))
-        return cmd_stability(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "bench"))
-        return cmd_bench(argc - 1, argv + 1);
+    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++) {
+        if (strcmp(argv[1], table[i].name))
+            continue;
+        current = table[i].name;
+        if (asks(argc - 1, argv + 1, "--help", "-h")) {
+            print_usage(stdout, current);
+            return 0;
+        }
+        return table[i].run(argc - 1, argv + 1);
+    }
     return usage_error("unknown command");
 }

@@ -9,8 +9,8 @@
 #ifndef COHFRAC_SOLID_H
 #define COHFRAC_SOLID_H
 
-#include "cohfrac/mesh.h"
-#include "cohfrac/scene.h"
+#include "cohfrac/tetmesh.h"
+#include "cohfrac/types.h"
 
 extern const int CF_TET_FACE[4][3];
 
@@ -100,13 +100,6 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
 /* Crack area, m^2: the rest area of every facet whose cohesive element has
  * failed completely (all three node pairs), one side counted. */
 double cf_solid_crack_area(const cf_solid *s);
-
-/* The boundary faces of a set of Tet4: the faces that no other tet of the
- * set uses (same three nodes), in the vertex order of CF_TET_FACE (outward
- * for a positive tet).  tet_nodes [.][4] node indices; list [nt] the tets
- * of the set, or NULL for tets 0..nt-1; faces gets [n][3] node indices and
- * needs room for 4 nt faces.  Returns n, or -1 out of memory. */
-int cf_boundary_faces(const int *tet_nodes, const int *list, int nt, int *faces);
 
 /* Append a copy of node n (same X, x, v, p; mass 0).  Returns the new index
  * or -1 when out of memory. */

@@ -5,7 +5,7 @@
 #ifndef COHFRAC_RENUMBER_H
 #define COHFRAC_RENUMBER_H
 
-#include "cohfrac/mesh.h"
+#include "cohfrac/tetmesh.h"
 
 /* Renumber mesh m in place: nodes by the Morton code of their position in
  * the mesh's bounding box (21 bits per axis), tets by (tet_body, Morton code

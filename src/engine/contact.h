@@ -10,7 +10,7 @@
 #ifndef COHFRAC_CONTACT_H
 #define COHFRAC_CONTACT_H
 
-typedef struct cf_sim cf_sim;
+typedef struct cf_world cf_world;
 typedef struct cff_mesh cff_mesh;
 
 /* Whether boxes [lo0, hi0] and [lo1, hi1] (m) overlap, touching included;
@@ -42,12 +42,12 @@ typedef struct cf_node_impulses {
 /* The world box of every fragment's Bullet body, once per rigid step:
  * (*boxes)[n_frag][6] = lo, hi (m); an empty box for fragments without a
  * rigid body.  Grows *boxes as needed.  Returns 0, or -1 out of memory. */
-int cf_body_boxes(cf_sim *sim, double **boxes);
+int cf_body_boxes(cf_world *sim, double **boxes);
 
 /* Hulls of every rigid Bullet fragment whose box (from cf_body_boxes)
  * overlaps fragment fi's node box grown by `pad` m.  Returns 0, or -1 out
  * of memory. */
-int cf_hull_set_gather(cf_sim *sim, int fi, double pad, const double *boxes, cf_hull_set *hs);
+int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, cf_hull_set *hs);
 void cf_hull_set_free(cf_hull_set *hs);
 
 /* Push the predicted position p of a node at x out of every hull of hs
@@ -81,7 +81,7 @@ void cf_node_impulses_free(cf_node_impulses *ni);
  * part of a node's impulse its body does not take is taken back from the
  * node's velocity, so that linear momentum is kept; the spin's bound is not
  * given back (angular momentum is not kept where it acts). */
-double cf_node_impulses_flush(cf_sim *sim, cf_node_impulses *ni, const int *nodes);
+double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes);
 
 /* The boundary of a fracture-mode fragment as a deforming triangle mesh:
  * the faces of its tets used by one of its tets only (crack faces opened by
@@ -103,7 +103,7 @@ void cf_frag_surface_free(cf_frag_surface *fs);
 /* Whether fracture-mode fragments of two initial bodies exist, so that
  * cf_body_contact has work: asked once per rigid step (sub-steps change no
  * fragment's mode). */
-int cf_body_contact_needed(const cf_sim *sim);
+int cf_body_contact_needed(const cf_world *sim);
 
 /* Contact between fracture-mode fragments of different initial bodies
  * (fragments of one body do not collide with each other, as in Bullet),
@@ -127,6 +127,6 @@ int cf_body_contact_needed(const cf_sim *sim);
  * partly into strain energy; so that the energy ledger balances.  Returns
  * 0, or -1 out of memory or on an FCL error (a message in
  * cff_last_error(); "out of memory" is not set there). */
-int cf_body_contact(cf_sim *sim, double h, double *removed);
+int cf_body_contact(cf_world *sim, double h, double *removed);
 
 #endif

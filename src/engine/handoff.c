@@ -1,17 +1,16 @@
 /* Hand-off between rigid mode (Bullet, or the pbd rigid backend) and
  * fracture mode (DESIGN §5). */
-#include "sim.h"
+#include "world_impl.h"
 
 #include "linalg.h"
 #include "tet4.h"
 
 #include <math.h>
 
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-int cf_fragment_new(cf_sim *sim, int parent, double birth_time)
+int cf_fragment_new(cf_world *sim, int parent, double birth_time)
 {
     if (sim->n_frag == sim->cap_frag) {
         int cap = sim->cap_frag ? 2 * sim->cap_frag : 16;
@@ -30,7 +29,7 @@ int cf_fragment_new(cf_sim *sim, int parent, double birth_time)
     return sim->n_frag++;
 }
 
-int cf_fragment_root(const cf_sim *sim, int fi)
+int cf_fragment_root(const cf_world *sim, int fi)
 {
     while (sim->frag[fi].parent >= 0)
         fi = sim->frag[fi].parent;
@@ -42,7 +41,7 @@ int cf_fragment_root(const cf_sim *sim, int fi)
  * hand-off preserves linear and angular momentum and never adds kinetic
  * energy (the tet second moment of DESIGN §5 would give a single tet 1/5 of
  * its lumped inertia, and the rigid spin 5 times the energy). */
-void cf_fragment_rest_props(cf_sim *sim, int fi)
+void cf_fragment_rest_props(cf_world *sim, int fi)
 {
     cf_fragment *f = &sim->frag[fi];
     cf_mass_props mp;
@@ -56,7 +55,7 @@ void cf_fragment_rest_props(cf_sim *sim, int fi)
 
 /* Convex decomposition of fragment fi (DESIGN §5), kept in the principal
  * frame for Bullet and for fracture-mode contact. */
-static int decompose_fragment(cf_sim *sim, cf_fragment *f)
+static int decompose_fragment(cf_world *sim, cf_fragment *f)
 {
     double t0 = cf_wall_time();
     cf_hulls_free(&f->hulls);
@@ -75,7 +74,7 @@ static int decompose_fragment(cf_sim *sim, cf_fragment *f)
 }
 
 /* Rotation of the Bullet body frame: rest->current R times principal axes Q. */
-cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const double R[9],
+cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const double R[9],
                                const double v[3], const double w[3], cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
@@ -105,7 +104,7 @@ cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const d
     return CF_OK;
 }
 
-void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[3], double w[3])
+void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double v[3], double w[3])
 {
     cf_fragment *f = &sim->frag[fi];
     if (f->body >= 0) {
@@ -127,7 +126,7 @@ void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[
     cf_nodes_angular_velocity(&sim->solid, f->nodes.v, f->nodes.n, ns.com, ns.L, w);
 }
 
-void cf_fragment_ledger_reset(cf_sim *sim, int fi)
+void cf_fragment_ledger_reset(cf_world *sim, int fi)
 {
     cf_fragment *f = &sim->frag[fi];
     cf_node_state ns;
@@ -136,14 +135,6 @@ void cf_fragment_ledger_reset(cf_sim *sim, int fi)
     f->e_strain = 0;
     for (int k = 0; k < 3; k++)
         f->mx[k] = ns.M * ns.com[k];
-}
-
-static int count_dead(const cf_sim *sim)
-{
-    int n = 0;
-    for (int i = 0; i < sim->n_frag; i++)
-        n += sim->frag[i].mode == CF_MODE_DEAD;
-    return n;
 }
 
 void cf_body_spin(const cf_fragment *f, const cfb_state *st, double Iw[3])
@@ -167,7 +158,7 @@ void cf_body_momenta(const cf_fragment *f, const cfb_state *st, double P[3], dou
     }
 }
 
-void cf_fragment_momenta(const cf_sim *sim, int fi, double P[3], double L[3])
+void cf_fragment_momenta(const cf_world *sim, int fi, double P[3], double L[3])
 {
     const cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;
@@ -188,7 +179,7 @@ void cf_fragment_momenta(const cf_sim *sim, int fi, double P[3], double L[3])
 }
 
 /* Log a hand-off of fragment fi: momenta before (P0, L0) and after (P1, L1). */
-static cf_status record_handoff(cf_sim *sim, int fi, int direction, const double P0[3],
+static cf_status record_handoff(cf_world *sim, int fi, int direction, const double P0[3],
                                 const double L0[3], const double P1[3], const double L1[3],
                                 double loss, cf_error *err)
 {
@@ -201,18 +192,11 @@ static cf_status record_handoff(cf_sim *sim, int fi, int direction, const double
     if (r.momentum_error > sim->max_momentum_error)
         sim->max_momentum_error = r.momentum_error;
     sim->total_handoff_loss += loss;
-    if (sim->opt.progress)
-        fprintf(stderr, "hand-off t=%.4f s: fragment %d %s, linear momentum error %.2e, "
-                        "handoff_loss %.4g J, %d fragments alive\n",
-                sim->t, fi, direction ? "fracture -> rigid" : "rigid -> fracture",
-                r.momentum_error, loss, sim->n_frag - count_dead(sim));
-    if (!sim->h5)
-        return CF_OK;
-    return cf_h5_add_handoff(sim->h5, &r, err);
+    return cf_world_push_handoff(sim, &r, err);
 }
 
 /* Fragment's cohesive elements: those whose two tets both belong to it. */
-static int collect_cohesive(cf_sim *sim, cf_fragment *f)
+static int collect_cohesive(cf_world *sim, cf_fragment *f)
 {
     const cf_solid *s = &sim->solid;
     int id = (int)(f - sim->frag);
@@ -261,7 +245,7 @@ static void place_rigid(cf_solid *s, const cf_fragment *f, const double com[3], 
  * projection would otherwise push the overlap out at dt_fracture, and the
  * bars would carry that push to the whole fragment as velocity: 2 mm over a
  * 5 us step is a rebound at metres per second. */
-static void clear_obstacles(cf_sim *sim, const cf_fragment *f)
+static void clear_obstacles(cf_world *sim, const cf_fragment *f)
 {
     cf_solid *s = &sim->solid;
     for (int j = 0; j < sim->obs.n; j++) {
@@ -279,7 +263,7 @@ static void clear_obstacles(cf_sim *sim, const cf_fragment *f)
     }
 }
 
-cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_error *err)
+cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
     cf_solid *s = &sim->solid;
@@ -321,7 +305,7 @@ cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_er
 }
 
 /* Give the new fragment `ci` the tets of component `c` and their nodes. */
-static int take_component(cf_sim *sim, int ci, const int *tets, const int *comp, int nt, int c,
+static int take_component(cf_world *sim, int ci, const int *tets, const int *comp, int nt, int c,
                           unsigned char *seen)
 {
     cf_fragment *f = &sim->frag[ci];
@@ -351,7 +335,7 @@ static int take_component(cf_sim *sim, int ci, const int *tets, const int *comp,
     return 0;
 }
 
-int cf_fragment_split_fracture(cf_sim *sim, int fi, int *first)
+int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
 {
     cf_solid *s = &sim->solid;
     cf_fragment *f = &sim->frag[fi];
@@ -406,12 +390,12 @@ int cf_fragment_split_fracture(cf_sim *sim, int fi, int *first)
     return rc ? -1 : k;
 }
 
-double cf_fragment_margin(const cf_sim *sim, int fi)
+double cf_fragment_margin(const cf_world *sim, int fi)
 {
     return 1e-3 * cbrt(sim->frag[fi].mass / sim->solid.mat.rho);
 }
 
-cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err)
+cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
 {
     cf_solid *s = &sim->solid;
     cf_fragment *f = &sim->frag[fi];

@@ -4,18 +4,17 @@
  * is rolled back to the start of the step and re-done in fracture mode,
  * sub-cycled at dt_fracture; a fracture-mode fragment quiet for quiet_steps
  * steps is split into its components and handed back to rigid mode. */
-#include "sim.h"
+#include "world_impl.h"
 #include "hash.h"
 
-#include "cohfrac/surface.h"
 #include "linalg.h"
 #include "renumber.h"
 
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 /* Place a body's mesh: x' = position + scale R (x - bbox centre). */
 static void place_mesh(cf_mesh *m, const cf_body_def *b)
@@ -50,7 +49,7 @@ static int in_region(const cf_boundary *c, const double x[3])
 
 /* The boundary condition of each node of body b (mesh m, placed): the last
  * matching entry of the scene's list wins.  Counts the nodes per entry. */
-static cf_status body_boundary(const cf_scene *sc, int b, const cf_mesh *m, int *bc, int *count,
+static cf_status body_boundary(const cf_world_def *sc, int b, const cf_mesh *m, int *bc, int *count,
                                cf_error *err)
 {
     for (int c = 0; c < sc->n_boundaries; c++) {
@@ -80,32 +79,38 @@ static cf_status body_boundary(const cf_scene *sc, int b, const cf_mesh *m, int 
     return CF_OK;
 }
 
-static cf_status load_mesh(const cf_body_def *bd, const char *mesh_dir, cf_mesh *m, cf_error *err)
+/* A copy of body b's mesh (the world places and renumbers its own). */
+static cf_status copy_mesh(const cf_body_def *bd, int b, cf_mesh *m, cf_error *err)
 {
-    cf_status st = bd->primitive.type != CF_PRIM_NONE
-                       ? cf_mesh_primitive(&bd->primitive, mesh_dir ? mesh_dir : "build/meshes",
-                                           m, err)
-                       : cf_mesh_load(bd->mesh, m, err);
-    /* bodies[i].hollow_layers: keep a shell of tets along the surface. */
-    if (st == CF_OK && bd->hollow_layers > 0) {
-        st = cf_mesh_hollow(m, bd->hollow_layers, err);
-        if (st != CF_OK) {
-            if (err) {
-                char why[sizeof err->msg];
-                memcpy(why, err->msg, sizeof why);
-                cf_error_set(err, st, "hollow_layers = %d on %s: %s", bd->hollow_layers,
-                             bd->mesh[0] ? bd->mesh : "the body's primitive mesh", why);
-            }
-            cf_mesh_free(m);
-        }
+    const cf_mesh *src = bd->tet_mesh;
+    memset(m, 0, sizeof *m);
+    m->n_nodes = src->n_nodes, m->n_tets = src->n_tets;
+    m->x = malloc((size_t)src->n_nodes * 3 * sizeof(double));
+    m->tets = malloc((size_t)src->n_tets * 4 * sizeof(int));
+    m->groups = src->n_groups ? calloc((size_t)src->n_groups, sizeof *m->groups) : NULL;
+    int ok = m->x && m->tets && (m->groups || !src->n_groups);
+    for (int g = 0; ok && g < src->n_groups; g++) {
+        m->groups[g] = src->groups[g];
+        m->groups[g].nodes = malloc(((size_t)src->groups[g].n_nodes + 1) * sizeof(int));
+        ok = m->groups[g].nodes != NULL;
+        if (ok)
+            memcpy(m->groups[g].nodes, src->groups[g].nodes,
+                   (size_t)src->groups[g].n_nodes * sizeof(int));
+        m->n_groups = g + 1;
     }
-    return st;
+    if (!ok) {
+        cf_mesh_free(m);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory copying body %d's mesh", b + 1);
+    }
+    memcpy(m->x, src->x, (size_t)src->n_nodes * 3 * sizeof(double));
+    memcpy(m->tets, src->tets, (size_t)src->n_tets * 4 * sizeof(int));
+    return CF_OK;
 }
 
 /* All bodies' meshes, placed and concatenated; body[t] is each tet's body,
  * bc[n] each node's boundary condition (-1 none). */
-static cf_status load_bodies(const cf_scene *sc, const char *mesh_dir, cf_mesh *all, int **body,
-                             int **bc, cf_error *err)
+static cf_status load_bodies(const cf_world_def *sc, cf_mesh *all, int **body, int **bc,
+                             cf_error *err)
 {
     memset(all, 0, sizeof *all);
     *body = NULL, *bc = NULL;
@@ -113,7 +118,7 @@ static cf_status load_bodies(const cf_scene *sc, const char *mesh_dir, cf_mesh *
     cf_status st = count ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     for (int b = 0; b < sc->n_bodies && st == CF_OK; b++) {
         cf_mesh m;
-        st = load_mesh(&sc->bodies[b], mesh_dir, &m, err);
+        st = copy_mesh(&sc->bodies[b], b, &m, err);
         if (st != CF_OK)
             break;
         place_mesh(&m, &sc->bodies[b]);
@@ -170,7 +175,7 @@ static int node_body(const cf_solid *s, const int *body, int a)
 
 /* With a crack plane, only the interior facets on it may crack: mark the
  * others as not candidates. */
-static cf_status select_crack_plane(cf_sim *sim, cf_error *err)
+static cf_status select_crack_plane(cf_world *sim, cf_error *err)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     cf_solid *s = &sim->solid;
@@ -200,7 +205,8 @@ static cf_status select_crack_plane(cf_sim *sim, cf_error *err)
 }
 
 /* Initial fragments: the connected components of each body. */
-static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *err)
+static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, const int *body,
+                                        cf_error *err)
 {
     cf_solid *s = &sim->solid;
     int nt = s->n_tets;
@@ -232,8 +238,8 @@ static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *
     free(all), free(comp), free(seen);
 
     /* Initial velocity field: v = v_b + w_b x (x - x_com) + rate (.) (x - x_e). */
-    for (int b = 0; b < sim->scene->n_bodies; b++) {
-        const cf_body_def *bd = &sim->scene->bodies[b];
+    for (int b = 0; b < def->n_bodies; b++) {
+        const cf_body_def *bd = &def->bodies[b];
         double M = 0, com[3] = {0, 0, 0}, xe[3];
         for (int a = 0; a < s->n_nodes; a++)
             if (node_body(s, body, a) == b) {
@@ -266,7 +272,7 @@ static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *
             f->t_enter = 0;
         }
         if (sim->bullet) {
-            const cf_body_def *bd = &sim->scene->bodies[body[f->tets[0]]];
+            const cf_body_def *bd = &def->bodies[body[f->tets[0]]];
             cf_node_state ns;
             cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &ns);
             double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -281,34 +287,29 @@ static cf_status make_initial_fragments(cf_sim *sim, const int *body, cf_error *
     return CF_OK;
 }
 
-/* A mesh obstacle's surface placed in the world: x' = position + scale R x. */
-static cf_status load_obstacle_mesh(const cf_obstacle *o, int j, cf_surface *srf, cf_error *err)
+/* A mesh obstacle's surface placed in the world: x' = position + scale R x,
+ * [n_vertices][3] (NULL when out of memory). */
+static double *place_obstacle_mesh(const cf_obstacle *o)
 {
-    cf_status st = cf_surface_load(o->file, srf, err);
-    if (st != CF_OK)
-        return st;
-    double R[9];
+    double R[9], *v = malloc(((size_t)o->n_vertices * 3 + 1) * sizeof(double));
+    if (!v)
+        return NULL;
     quat_to_mat(o->orientation, R);
-    for (int i = 0; i < srf->n_verts; i++) {
+    for (int i = 0; i < o->n_vertices; i++) {
         double y[3];
-        m3_mulv(R, &srf->v[3 * i], y);
+        m3_mulv(R, &o->vertices[3 * i], y);
         for (int k = 0; k < 3; k++)
-            srf->v[3 * i + k] = o->position[k] + o->scale * y[k];
+            v[3 * i + k] = o->position[k] + o->scale * y[k];
     }
-    if (srf->n_tris == 0) {
-        cf_surface_free(srf);
-        return cf_error_set(err, CF_ERR_SCENE_VALUE, "obstacles[%d].file %s has no triangle",
-                            j + 1, o->file);
-    }
-    return CF_OK;
+    return v;
 }
 
 /* Mesh obstacles for the in-house solver (FCL), and every obstacle for
  * Bullet when there is a Bullet world.  Nodes count as inside a mesh down
  * to 5% of its size behind the surface. */
-static cf_status add_obstacles(cf_sim *sim, cf_error *err)
+static cf_status add_obstacles(cf_world *sim, const cf_world_def *def, cf_error *err)
 {
-    const cf_scene *sc = sim->scene;
+    const cf_world_def *sc = sim->scene;
     int n = sc->n_obstacles;
     sim->obs.n = n;
     sim->obs.o = sc->obstacles;
@@ -327,19 +328,18 @@ static cf_status add_obstacles(cf_sim *sim, cf_error *err)
         sim->obstacle_moving[j] = o->type != CF_OBSTACLE_PLANE && o->type != CF_OBSTACLE_MESH &&
                                   v3_dot(o->velocity, o->velocity) > 0;
         if (o->type == CF_OBSTACLE_MESH) {
-            cf_surface srf;
-            cf_status st = load_obstacle_mesh(o, j, &srf, err);
-            if (st != CF_OK)
-                return st;
-            double lo[3], hi[3], diag[3];
-            points_bbox(srf.v, srf.n_verts, lo, hi);
+            o = &def->obstacles[j]; /* the caller's: the world keeps no surface */
+            double *v = place_obstacle_mesh(o), lo[3], hi[3], diag[3];
+            if (!v)
+                return cf_error_set(err, CF_ERR_NOMEM, "out of memory for obstacle %d", j + 1);
+            points_bbox(v, o->n_vertices, lo, hi);
             v3_sub(hi, lo, diag);
             sim->obs.range[j] = 0.05 * v3_norm(diag);
-            sim->obs.mesh[j] = cff_mesh_create(srf.v, srf.n_verts, srf.tri, srf.n_tris);
+            sim->obs.mesh[j] = cff_mesh_create(v, o->n_vertices, o->triangles, o->n_triangles);
             if (sim->obs.mesh[j] && sim->bullet)
-                id = cfb_add_trimesh(sim->bullet, srf.v, srf.n_verts, srf.tri, srf.n_tris,
-                                     o->friction, o->restitution);
-            cf_surface_free(&srf);
+                id = cfb_add_trimesh(sim->bullet, v, o->n_vertices, o->triangles,
+                                     o->n_triangles, o->friction, o->restitution);
+            free(v);
             if (!sim->obs.mesh[j])
                 return cf_error_set(err, CF_ERR_EXTERNAL, "FCL refused obstacle %d (%s): %s",
                                     j + 1, o->file, cff_last_error());
@@ -363,89 +363,164 @@ static cf_status add_obstacles(cf_sim *sim, cf_error *err)
     return CF_OK;
 }
 
-static cf_status write_fragment_infos(cf_sim *sim, int first, cf_error *err)
+/* Append an event (the array grows; out of memory drops it and says so). */
+static cf_status push_event(cf_world *sim, const cf_event *e, cf_error *err)
 {
-    if (!sim->h5 || first >= sim->n_frag)
-        return CF_OK;
-    int n = sim->n_frag - first;
-    cf_frag_info *info = calloc((size_t)n, sizeof *info);
-    if (!info)
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-    for (int i = 0; i < n; i++) {
-        const cf_fragment *f = &sim->frag[first + i];
-        info[i].id = first + i;
-        info[i].parent = f->parent;
-        info[i].birth_time = f->birth_time;
-        info[i].mass = f->mass;
-        info[i].n_tets = f->nt;
-        memcpy(info[i].inertia_principal, f->principal, sizeof f->principal);
-        info[i].n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
-        info[i].hull_volume_error = cf_hulls_error(&f->hulls);
-        info[i].decomposition_time = f->decompose_time;
+    if (sim->n_ev == sim->cap_ev) {
+        int cap = sim->cap_ev ? 2 * sim->cap_ev : 16;
+        cf_event *ev = realloc(sim->ev, (size_t)cap * sizeof *ev);
+        if (!ev)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory recording an event");
+        sim->ev = ev, sim->cap_ev = cap;
     }
-    cf_status st = cf_h5_add_fragments(sim->h5, info, n, err);
-    free(info);
-    return st;
+    sim->ev[sim->n_ev++] = *e;
+    return CF_OK;
+}
+
+static int alive_fragments(const cf_world *sim, int *in_fracture)
+{
+    int n = 0, nf = 0;
+    for (int i = 0; i < sim->n_frag; i++) {
+        n += sim->frag[i].mode != CF_MODE_DEAD;
+        nf += sim->frag[i].mode == CF_MODE_FRACTURE;
+    }
+    if (in_fracture)
+        *in_fracture = nf;
+    return n;
+}
+
+cf_status cf_world_push_handoff(cf_world *sim, const cf_handoff_record *r, cf_error *err)
+{
+    cf_event e = {.type = CF_EVENT_HANDOFF, .time = sim->t, .first = r->fragment, .count = 1,
+                  .alive = alive_fragments(sim, NULL), .handoff = *r};
+    return push_event(sim, &e, err);
+}
+
+/* Fragments first .. n_frag - 1 were born. */
+static cf_status fragments_born(cf_world *sim, int first, cf_error *err)
+{
+    if (first >= sim->n_frag)
+        return CF_OK;
+    cf_event e = {.type = CF_EVENT_FRAGMENTS, .time = sim->t, .first = first,
+                  .count = sim->n_frag - first, .alive = alive_fragments(sim, NULL)};
+    return push_event(sim, &e, err);
+}
+
+const cf_event *cf_world_events(const cf_world *sim, int *n)
+{
+    *n = sim->n_ev;
+    return sim->ev;
+}
+
+void cf_world_clear_events(cf_world *sim) { sim->n_ev = 0; }
+
+int cf_world_fragments_ever(const cf_world *sim) { return sim->n_frag; }
+
+int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
+{
+    if (id < 0 || id >= sim->n_frag)
+        return -1;
+    const cf_fragment *f = &sim->frag[id];
+    memset(o, 0, sizeof *o);
+    o->id = id;
+    o->parent = f->parent;
+    o->birth_time = f->birth_time;
+    o->mass = f->mass;
+    o->n_tets = f->nt;
+    memcpy(o->inertia_principal, f->principal, sizeof f->principal);
+    o->n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
+    o->hull_volume_error = cf_hulls_error(&f->hulls);
+    o->decomposition_time = f->decompose_time;
+    return 0;
 }
 
 /* What a reader needs to bound a run's outcome (tools/check_physics.py):
  * the box around the nodes, mass, energy and fastest node at t = 0, and the
- * fastest kinematic obstacle or prescribed node. */
-static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
+ * fastest kinematic obstacle or prescribed node; taken at create. */
+static void initial_bounds(cf_world *sim)
 {
     const cf_solid *s = &sim->solid;
-    const cf_scene *sc = sim->scene;
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double mass = 0, v2 = 0, u = 0;
+    const cf_world_def *sc = sim->scene;
+    cf_initial_bounds *b = &sim->bounds;
+    double v2 = 0;
+    for (int k = 0; k < 3; k++)
+        b->lower[k] = INFINITY, b->upper[k] = -INFINITY;
+    b->mass = 0, b->max_obstacle_speed = 0;
     for (int a = 0; a < s->n_nodes; a++) {
         for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], s->x[3 * a + k]);
-            hi[k] = fmax(hi[k], s->x[3 * a + k]);
+            b->lower[k] = fmin(b->lower[k], s->x[3 * a + k]);
+            b->upper[k] = fmax(b->upper[k], s->x[3 * a + k]);
         }
-        mass += s->m[a];
+        b->mass += s->m[a];
         v2 = fmax(v2, v3_dot(&s->v[3 * a], &s->v[3 * a]));
     }
     for (int j = 0; j < sc->n_obstacles; j++) {
         double uj[3];
         cf_obstacle_velocity(&sc->obstacles[j], uj);
-        u = fmax(u, v3_norm(uj));
+        b->max_obstacle_speed = fmax(b->max_obstacle_speed, v3_norm(uj));
     }
     for (int j = 0; j < sc->n_boundaries; j++)
-        u = fmax(u, v3_norm(sc->boundaries[j].velocity));
-    double v0 = sqrt(v2);
-    cf_status st = cf_h5_write_parameter(sim->h5, "initial_lower", lo, 3, "m", err);
-    if (st == CF_OK)
-        st = cf_h5_write_parameter(sim->h5, "initial_upper", hi, 3, "m", err);
-    if (st == CF_OK)
-        st = cf_h5_write_parameter(sim->h5, "total_mass", &mass, 1, "kg", err);
-    if (st == CF_OK)
-        st = cf_h5_write_parameter(sim->h5, "initial_energy", &sim->e0, 1, "J", err);
-    if (st == CF_OK)
-        st = cf_h5_write_parameter(sim->h5, "max_initial_speed", &v0, 1, "m/s", err);
-    if (st == CF_OK)
-        st = cf_h5_write_parameter(sim->h5, "max_obstacle_speed", &u, 1, "m/s", err);
-    return st;
+        b->max_obstacle_speed = fmax(b->max_obstacle_speed, v3_norm(sc->boundaries[j].velocity));
+    b->max_speed = sqrt(v2);
+    b->energy = sim->e0;
 }
 
-cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim **out,
-                        cf_error *err)
+void cf_world_initial_bounds(const cf_world *sim, cf_initial_bounds *out) { *out = sim->bounds; }
+
+/* A copy of n items of `size` bytes (NULL for none; *fail set when out
+ * of memory). */
+static void *copy_array(const void *src, int n, size_t size, int *fail)
+{
+    if (n <= 0 || !src)
+        return NULL;
+    void *d = malloc((size_t)n * size);
+    if (d)
+        memcpy(d, src, (size_t)n * size);
+    else
+        *fail = 1;
+    return d;
+}
+
+/* The world's own copy of the definition: settings, obstacles and
+ * boundary conditions (the bodies and meshes are used up at create; the
+ * world never reads the caller's definition after create). */
+static cf_status copy_def(cf_world *sim, const cf_world_def *def, cf_error *err)
+{
+    int fail = 0;
+    sim->def = *def;
+    sim->def.bodies = NULL, sim->def.n_bodies = 0;
+    sim->def.resolved = NULL;
+    sim->def.obstacles = copy_array(def->obstacles, def->n_obstacles, sizeof *def->obstacles, &fail);
+    sim->def.boundaries = copy_array(def->boundaries, def->n_boundaries, sizeof *def->boundaries,
+                                     &fail);
+    sim->scene = &sim->def;
+    for (int j = 0; sim->def.obstacles && j < def->n_obstacles; j++) /* FCL and Bullet copy them */
+        sim->def.obstacles[j].vertices = NULL, sim->def.obstacles[j].triangles = NULL;
+    return fail ? cf_error_set(err, CF_ERR_NOMEM, "out of memory copying the world definition")
+                : CF_OK;
+}
+
+cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err)
 {
     *out = NULL;
-    cf_sim *sim = calloc(1, sizeof *sim);
+    cf_status st = cf_world_def_check(def, err);
+    if (st != CF_OK)
+        return st;
+    cf_world *sim = calloc(1, sizeof *sim);
     if (!sim)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-    sim->scene = scene;
-    sim->opt = *opt;
+    st = copy_def(sim, def, err);
+    const cf_world_def *scene = sim->scene;
     sim->wall_start = cf_wall_time();
     sim->bullet_base = cfb_allocated_bytes();
-    int threads = opt->threads > 0 ? opt->threads : scene->solver.threads;
-    if (threads > 0)
-        omp_set_num_threads(threads);
+    if (scene->solver.threads > 0)
+        omp_set_num_threads(scene->solver.threads);
     cf_ppr_init(&sim->ppr, &scene->material);
 
-    cf_mesh all;
+    cf_mesh all = {0};
     int *body = NULL, *bc = NULL;
-    cf_status st = load_bodies(scene, opt->mesh_dir, &all, &body, &bc, err);
+    if (st == CF_OK)
+        st = load_bodies(def, &all, &body, &bc, err);
     if (st == CF_OK) {
         int *user = malloc((size_t)all.n_tets * sizeof(int));
         sim->tet_of_user = malloc((size_t)all.n_tets * sizeof(int));
@@ -483,39 +558,32 @@ cf_status cf_sim_create(const cf_scene *scene, const cf_run_options *opt, cf_sim
             cfb_set_sleeping(sim->bullet, scene->solver.sleep_linear, scene->solver.sleep_angular);
     }
     if (st == CF_OK)
-        st = add_obstacles(sim, err);
+        st = add_obstacles(sim, def, err);
     if (st == CF_OK)
         st = select_crack_plane(sim, err);
     if (st == CF_OK)
-        st = make_initial_fragments(sim, body, err);
+        st = make_initial_fragments(sim, def, body, err);
     free(body);
     if (st == CF_OK) { /* the ledger's reference state */
         cf_ledger l;
-        cf_sim_ledger(sim, &l);
+        cf_world_ledger(sim, &l);
         sim->e0 = l.kinetic + l.strain;
         memcpy(sim->mx0, l.mass_moment, sizeof sim->mx0);
-    }
-    if (st == CF_OK && scene->output.file[0]) {
-        st = cf_h5_open(scene->output.file, scene->name, scene->resolved, &sim->h5, err);
-        if (st == CF_OK)
-            st = write_initial_bounds(sim, err);
-        if (st == CF_OK)
-            st = write_fragment_infos(sim, 0, err);
+        initial_bounds(sim);
+        st = fragments_born(sim, 0, err);
     }
     if (st != CF_OK) {
-        cf_sim_destroy(sim);
+        cf_world_destroy(sim);
         return st;
     }
     *out = sim;
     return CF_OK;
 }
 
-void cf_sim_destroy(cf_sim *sim)
+void cf_world_destroy(cf_world *sim)
 {
     if (!sim)
         return;
-    if (sim->h5)
-        cf_h5_close(sim->h5, NULL);
     for (int i = 0; i < sim->n_frag; i++) {
         cf_fragment *f = &sim->frag[i];
         free(f->tets), free(f->nodes.v), free(f->coh.v), free(f->contact), free(f->vn_pre);
@@ -530,7 +598,8 @@ void cf_sim_destroy(cf_sim *sim)
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
         cff_mesh_destroy(sim->obs.mesh[j]);
     free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
-    free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user);
+    free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
+    free(sim->def.obstacles), free(sim->def.boundaries);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
     cf_solid_free(&sim->solid);
@@ -549,7 +618,7 @@ static double state_kinetic_energy(const cf_fragment *f, const cfb_state *st)
     return e;
 }
 
-double cf_body_kinetic_energy(const cf_sim *sim, int fi)
+double cf_body_kinetic_energy(const cf_world *sim, int fi)
 {
     cfb_state st;
     cfb_get_state(sim->bullet, sim->frag[fi].body, &st);
@@ -558,12 +627,12 @@ double cf_body_kinetic_energy(const cf_sim *sim, int fi)
 
 /* Kinetic energy minus gravity's potential work: what a Bullet body keeps
  * in free flight, J. */
-static double body_energy(const cf_sim *sim, const cf_fragment *f, const cfb_state *st)
+static double body_energy(const cf_world *sim, const cf_fragment *f, const cfb_state *st)
 {
     return state_kinetic_energy(f, st) - f->mass * v3_dot(sim->scene->gravity, st->pos);
 }
 
-void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
+void cf_world_ledger(const cf_world *sim, cf_ledger *l)
 {
     const cf_solid *s = &sim->solid;
     memset(l, 0, sizeof *l);
@@ -602,7 +671,7 @@ void cf_sim_ledger(const cf_sim *sim, cf_ledger *l)
                   (l->initial + l->work_gravity + l->work_boundary + l->work_obstacles);
 }
 
-int cf_sim_fragments(cf_sim *sim, cf_fragment_state *out, int cap)
+int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
 {
     int n = 0;
     for (int fi = 0; fi < sim->n_frag; fi++) {
@@ -640,7 +709,7 @@ int cf_sim_fragments(cf_sim *sim, cf_fragment_state *out, int cap)
     return n;
 }
 
-double cf_sim_fragment_support(cf_sim *sim, int id, const double d[3])
+double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
 {
     if (id < 0 || id >= sim->n_frag || sim->frag[id].mode == CF_MODE_DEAD)
         return 0;
@@ -656,136 +725,25 @@ double cf_sim_fragment_support(cf_sim *sim, int id, const double d[3])
     return f->nodes.n ? best : 0;
 }
 
-int cf_sim_tet_count(const cf_sim *sim) { return sim->solid.n_tets; }
+int cf_world_tet_count(const cf_world *sim) { return sim->solid.n_tets; }
 
-int cf_sim_tet_fragment(const cf_sim *sim, int t)
+int cf_world_tet_fragment(const cf_world *sim, int t)
 {
     return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[sim->tet_of_user[t]] : -1;
 }
 
-/* Every cohesive element's place, opening and state now (output.cracks). */
-static cf_status write_cracks(cf_sim *sim, cf_error *err)
+int cf_world_cohesive_count(const cf_world *sim) { return sim->solid.n_coh; }
+
+void cf_world_crack(const cf_world *sim, int e, cf_crack_row *r)
 {
-    const cf_solid *s = &sim->solid;
-    cf_crack_row *rows = malloc((size_t)(s->n_coh > 0 ? s->n_coh : 1) * sizeof *rows);
-    if (!rows)
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory writing %d crack rows", s->n_coh);
-    for (int e = 0; e < s->n_coh; e++) {
-        cf_crack_row *r = &rows[e];
-        r->time = sim->t;
-        r->element = e;
-        cf_cohesive_state(s, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
-                          &r->failed);
-    }
-    cf_status st = cf_h5_add_cracks(sim->h5, rows, s->n_coh, err);
-    free(rows);
-    return st;
+    memset(r, 0, sizeof *r);
+    r->time = sim->t;
+    r->element = e;
+    cf_cohesive_state(&sim->solid, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
+                      &r->failed);
 }
 
-static cf_status write_frame(cf_sim *sim, cf_error *err)
-{
-    if (!sim->h5)
-        return CF_OK;
-    double t0 = cf_wall_time();
-    cf_frag_frame *fr = malloc((size_t)sim->n_frag * sizeof *fr);
-    if (!fr)
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-    int n = 0, n_fracture = 0;
-    for (int fi = 0; fi < sim->n_frag; fi++) {
-        cf_fragment *f = &sim->frag[fi];
-        if (f->mode == CF_MODE_DEAD)
-            continue;
-        double R[9];
-        cf_frag_frame *o = &fr[n++];
-        o->id = fi;
-        o->mode = f->mode;
-        cf_fragment_pose(sim, fi, o->com, R, o->v, o->w);
-        mat_to_quat(R, o->quat);
-        n_fracture += f->mode == CF_MODE_FRACTURE;
-    }
-    cf_status st = cf_h5_write_frame(sim->h5, sim->step, sim->t, fr, n, err);
-    free(fr);
-    unsigned long long mem = cf_h5_memory(sim->h5);
-    sim->output_peak = mem > sim->output_peak ? mem : sim->output_peak;
-    cf_ledger l;
-    cf_sim_ledger(sim, &l);
-    const struct {
-        const char *name;
-        double value;
-    } obs[] = {
-        {"energy_kinetic", l.kinetic},
-        {"energy_strain", l.strain},
-        {"energy_cohesive_stored", l.cohesive_stored},
-        {"energy_cohesive_dissipated", l.cohesive_dissipated},
-        {"work_gravity", l.work_gravity},
-        {"work_boundary", l.work_boundary},
-        {"work_obstacles", l.work_obstacles},
-        {"energy_contact_removed", l.contact},
-        {"energy_rigid_integration_removed", l.integration},
-        {"energy_pbd_removed", l.pbd},
-        {"energy_damping_removed", l.damping},
-        {"energy_handoff_loss", l.handoff},
-        {"energy_residual", l.residual},
-        {"momentum_x", l.momentum[0]},
-        {"momentum_y", l.momentum[1]},
-        {"momentum_z", l.momentum[2]},
-        {"angular_momentum_x", l.angular_momentum[0]},
-        {"angular_momentum_y", l.angular_momentum[1]},
-        {"angular_momentum_z", l.angular_momentum[2]},
-        {"fragment_count", n},
-        {"cohesive_elements", sim->solid.n_coh},
-        {"crack_area", cf_solid_crack_area(&sim->solid)},
-        {"fragments_in_fracture_mode", n_fracture},
-        {"handoff_momentum_error_max", sim->max_momentum_error},
-    };
-    for (size_t i = 0; i < sizeof obs / sizeof obs[0] && st == CF_OK; i++)
-        st = cf_h5_write_observable(sim->h5, obs[i].name, sim->step, sim->t, obs[i].value, err);
-    if (st == CF_OK && sim->scene->output.cracks)
-        st = write_cracks(sim, err);
-    sim->prof.output += cf_wall_time() - t0;
-    return st;
-}
-
-static int alive_fragments(const cf_sim *sim, int *in_fracture)
-{
-    int n = 0, nf = 0;
-    for (int i = 0; i < sim->n_frag; i++) {
-        n += sim->frag[i].mode != CF_MODE_DEAD;
-        nf += sim->frag[i].mode == CF_MODE_FRACTURE;
-    }
-    if (in_fracture)
-        *in_fracture = nf;
-    return n;
-}
-
-static void progress(cf_sim *sim, int final)
-{
-    if (!sim->opt.progress)
-        return;
-    double now = cf_wall_time(), el = now - sim->wall_start;
-    int tty = isatty(STDERR_FILENO);
-    if (!final && now - sim->last_progress < (tty ? 0.2 : 10.0))
-        return;
-    sim->last_progress = now;
-    double frac = sim->t / sim->scene->duration;
-    double eta = frac > 0 ? el * (1 - frac) / frac : 0;
-    int nf, n = alive_fragments(sim, &nf);
-    const char *mode = nf ? "fracture" : "rigid";
-    if (tty) {
-        char bar[31];
-        int fill = (int)(30 * frac);
-        for (int i = 0; i < 30; i++)
-            bar[i] = i < fill ? '#' : '.';
-        bar[30] = 0;
-        fprintf(stderr, "\r[%s] t=%.4f/%.4g s  %-8s  fragments %d  cohesive %d  ETA %.0f s   ",
-                bar, sim->t, sim->scene->duration, mode, n, sim->solid.n_coh, eta);
-        if (final)
-            fputc('\n', stderr);
-    } else {
-        fprintf(stderr, "t=%.4f/%.4g s (%3.0f%%)  %s  fragments %d  cohesive %d  ETA %.0f s\n",
-                sim->t, sim->scene->duration, 100 * frac, mode, n, sim->solid.n_coh, eta);
-    }
-}
+double cf_world_crack_area(const cf_world *sim) { return cf_solid_crack_area(&sim->solid); }
 
 /* Divergence: a non-finite position or a node faster than 1e5 m/s. */
 static int nodes_sane(const cf_solid *s, const cf_fragment *f)
@@ -800,7 +758,7 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 
 /* A fragment with no uncracked interior facet (a single tet, say) cannot
  * break further: an impact leaves it in rigid mode. */
-static int can_break(const cf_sim *sim, const cf_fragment *f)
+static int can_break(const cf_world *sim, const cf_fragment *f)
 {
     const cf_solid *s = &sim->solid;
     if (sim->scene->solver.criterion == CF_CRITERION_NONE)
@@ -816,7 +774,7 @@ static int can_break(const cf_sim *sim, const cf_fragment *f)
 
 /* Rigid fragment fi is hit: Bullet's contact impulse plus the pushes of
  * fracture-mode nodes, per unit mass, pass the impact threshold. */
-static int impact(const cf_sim *sim, const cf_fragment *f)
+static int impact(const cf_world *sim, const cf_fragment *f)
 {
     double dv = (cfb_contact_impulse(sim->bullet, f->body) + f->pushed) / f->mass;
     return dv > sim->scene->solver.impact_threshold && can_break(sim, f);
@@ -827,7 +785,7 @@ static int impact(const cf_sim *sim, const cf_fragment *f)
  * then re-run from that start for every other body, so that none keeps the
  * contact response of a fragment that is now sub-cycled instead (momentum is
  * exchanged with it through its nodes). */
-static cf_status bullet_step(cf_sim *sim, double dt, cf_error *err)
+static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     int n = sim->n_frag, no = sim->scene->n_obstacles;
@@ -892,7 +850,7 @@ static cf_status bullet_step(cf_sim *sim, double dt, cf_error *err)
 }
 
 /* Advance the rigid fragments by one rigid step; detect impacts. */
-static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
+static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
 {
     if (sim->bullet)
         return bullet_step(sim, dt, err);
@@ -914,7 +872,7 @@ static cf_status rigid_step(cf_sim *sim, double dt, cf_error *err)
     return CF_OK;
 }
 
-static cf_status diverged(const cf_sim *sim, cf_error *err, const char *what)
+static cf_status diverged(const cf_world *sim, cf_error *err, const char *what)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     const char *fix = set->constraints == CF_CONSTRAINTS_NONE
@@ -930,7 +888,7 @@ static cf_status diverged(const cf_sim *sim, cf_error *err, const char *what)
 
 /* How far beyond fragment fi's nodes a rigid body can be touched during a
  * rigid step of dt: the fastest node's travel, plus gravity's. */
-static double contact_pad(const cf_sim *sim, int fi, double dt)
+static double contact_pad(const cf_world *sim, int fi, double dt)
 {
     const cf_fragment *f = &sim->frag[fi];
     double v2 = 0;
@@ -944,7 +902,7 @@ static double contact_pad(const cf_sim *sim, int fi, double dt)
 /* Sub-cycle every fracture-mode fragment through the rigid step, all of
  * them in step so that fragments of different bodies meet in contact after
  * each sub-step. */
-static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
+static cf_status fracture_steps(cf_world *sim, double dt, cf_error *err)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     long n_sub = lround(ceil(dt / sim->dt_fracture - 1e-9)); /* h <= dt_fracture */
@@ -1010,10 +968,10 @@ static cf_status fracture_steps(cf_sim *sim, double dt, cf_error *err)
 
 /* Energy growth with no work input: kinetic + strain + cohesive energy
  * above (1 + max_energy_growth) times what was put in. */
-static cf_status check_energy(cf_sim *sim, cf_error *err)
+static cf_status check_energy(cf_world *sim, cf_error *err)
 {
     cf_ledger l;
-    cf_sim_ledger(sim, &l);
+    cf_world_ledger(sim, &l);
     double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated;
     double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
                    fmax(0.0, l.work_obstacles);
@@ -1028,7 +986,7 @@ static cf_status check_energy(cf_sim *sim, cf_error *err)
 }
 
 /* Fracture-mode fragments that have been quiet long enough go back to rigid mode. */
-static cf_status return_to_rigid(cf_sim *sim, cf_error *err)
+static cf_status return_to_rigid(cf_world *sim, cf_error *err)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     int n = sim->n_frag;
@@ -1043,7 +1001,7 @@ static cf_status return_to_rigid(cf_sim *sim, cf_error *err)
         cf_status st = cf_handoff_to_rigid(sim, fi, err);
         sim->prof.handoff += cf_wall_time() - th;
         if (st == CF_OK)
-            st = write_fragment_infos(sim, first_new, err);
+            st = fragments_born(sim, first_new, err);
         if (st != CF_OK)
             return st;
     }
@@ -1053,7 +1011,7 @@ static cf_status return_to_rigid(cf_sim *sim, cf_error *err)
 /* Fracture-only runs: fragments that cracked in this step and now fall
  * apart become one fragment per connected piece, labelled and written like
  * the pieces of a hybrid run's hand-off. */
-static cf_status split_fragments(cf_sim *sim, cf_error *err)
+static cf_status split_fragments(cf_world *sim, cf_error *err)
 {
     int n = sim->n_frag;
     for (int fi = 0; fi < n; fi++) {
@@ -1066,7 +1024,7 @@ static cf_status split_fragments(cf_sim *sim, cf_error *err)
         if (k < 0)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory splitting fragment %d", fi);
         if (k > 0) {
-            cf_status st = write_fragment_infos(sim, first, err);
+            cf_status st = fragments_born(sim, first, err);
             if (st != CF_OK)
                 return st;
         }
@@ -1074,61 +1032,47 @@ static cf_status split_fragments(cf_sim *sim, cf_error *err)
     return CF_OK;
 }
 
-int cf_sim_done(const cf_sim *sim) { return sim->step >= sim->n_steps; }
+const cf_world_def *cf_world_definition(const cf_world *sim) { return &sim->def; }
 
-double cf_sim_time(const cf_sim *sim) { return sim->t; }
+int cf_world_done(const cf_world *sim) { return sim->step >= sim->n_steps; }
 
-double cf_sim_dt_fracture(const cf_sim *sim) { return sim->dt_fracture; }
+long cf_world_step_count(const cf_world *sim) { return sim->step; }
 
-double cf_sim_dt_cfl(const cf_sim *sim) { return sim->solid.dt_cfl; }
+long cf_world_steps_total(const cf_world *sim) { return sim->n_steps; }
 
-cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
+double cf_world_dt_outer(const cf_world *sim) { return sim->dt_outer; }
+
+double cf_world_time(const cf_world *sim) { return sim->t; }
+
+double cf_world_dt_fracture(const cf_world *sim) { return sim->dt_fracture; }
+
+double cf_world_dt_cfl(const cf_world *sim) { return sim->solid.dt_cfl; }
+
+cf_status cf_world_step(cf_world *sim, cf_error *err)
 {
-    const cf_scene *sc = sim->scene;
+    const cf_world_def *sc = sim->scene;
     double dt = sim->dt_outer;
+    int n_coh = sim->solid.n_coh;
     cf_status st = rigid_step(sim, dt, err);
     if (st == CF_OK)
         st = fracture_steps(sim, dt, err);
     sim->step++;
     sim->t = (double)sim->step * dt;
+    if (st == CF_OK && sim->solid.n_coh > n_coh) {
+        cf_event e = {.type = CF_EVENT_INSERTIONS, .time = sim->t, .first = n_coh,
+                      .count = sim->solid.n_coh - n_coh, .alive = alive_fragments(sim, NULL)};
+        st = push_event(sim, &e, err);
+    }
     if (st == CF_OK && sc->solver.mode == CF_RUN_HYBRID)
         st = return_to_rigid(sim, err);
     if (st == CF_OK && sc->solver.mode == CF_RUN_FRACTURE)
         st = split_fragments(sim, err);
     if (st == CF_OK)
         st = check_energy(sim, err);
-    if (st == CF_OK && (sim->t >= sim->next_frame - 1e-9 * dt || cf_sim_done(sim))) {
-        st = write_frame(sim, err);
-        while (sim->next_frame <= sim->t + 1e-9 * dt)
-            sim->next_frame += sc->output.frame_interval;
-    }
-    progress(sim, 0);
     return st;
 }
 
-cf_status cf_sim_run(cf_sim *sim, cf_error *err)
-{
-    const cf_scene *sc = sim->scene;
-    if (sim->opt.progress)
-        fprintf(stderr, "cohfrac: %d nodes, %d tets, %d fragment(s); dt_cfl = %.4g s, "
-                        "dt_fracture/dt_cfl = %.4g, dt_rigid/dt_cfl = %.4g\n",
-                sim->solid.n_nodes, sim->solid.n_tets, sim->n_frag, sim->solid.dt_cfl,
-                sim->dt_fracture / sim->solid.dt_cfl, sim->dt_outer / sim->solid.dt_cfl);
-    cf_status st = write_frame(sim, err);
-    sim->next_frame = sc->output.frame_interval;
-    while (st == CF_OK && !cf_sim_done(sim))
-        st = cf_sim_advance(sim, err);
-    progress(sim, 1);
-    cf_error cerr;
-    if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK && st == CF_OK) {
-        *err = cerr;
-        st = cerr.code;
-    }
-    sim->h5 = NULL;
-    return st;
-}
-
-uint64_t cf_sim_state_hash(const cf_sim *sim)
+uint64_t cf_world_state_hash(const cf_world *sim)
 {
     const cf_solid *s = &sim->solid;
     uint64_t h = CF_FNV1A_SEED;
@@ -1154,31 +1098,43 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Convex decomposition of the rigid fragments alive now: hull-volume error
- * median and worst, and its share of the wall time. */
-static void print_hull_summary(const cf_sim *sim, FILE *out, double wall)
+void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
 {
+    const cf_profile *p = &sim->prof;
+    memset(o, 0, sizeof *o);
+    o->tets = sim->solid.n_tets, o->nodes_input = sim->solid.n_verts0;
+    o->nodes = sim->solid.n_nodes;
+    o->dt_fracture = sim->dt_fracture, o->dt_cfl = sim->solid.dt_cfl, o->dt_outer = sim->dt_outer;
+    o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
+    o->threads = omp_get_max_threads();
+    o->alive = alive_fragments(sim, &o->in_fracture);
+    o->ever = sim->n_frag;
+    o->cohesive = sim->solid.n_coh;
+    o->handoffs = sim->n_handoffs;
+    o->max_momentum_error = sim->max_momentum_error, o->handoff_loss = sim->total_handoff_loss;
+    o->rigid = p->rigid, o->stress = p->stress, o->insertion = p->insertion;
+    o->forces = p->forces, o->pbd = p->pbd, o->bodies = p->bodies, o->handoff = p->handoff;
+    o->decompose = p->decompose;
+    /* Convex decomposition of the rigid fragments alive now: median and worst error. */
     double *e = malloc((size_t)(sim->n_frag + 1) * sizeof(double));
-    int n = 0, hulls = 0;
+    int n = 0;
     for (int fi = 0; e && fi < sim->n_frag; fi++) {
         const cf_fragment *f = &sim->frag[fi];
         if (f->mode == CF_MODE_RIGID && f->body >= 0) {
             e[n++] = cf_hulls_error(&f->hulls);
-            hulls += f->hulls.n_hulls;
+            o->hulls += f->hulls.n_hulls;
         }
     }
     if (n > 0) {
         qsort(e, (size_t)n, sizeof *e, by_value);
-        double median = n % 2 ? e[n / 2] : 0.5 * (e[n / 2 - 1] + e[n / 2]);
-        fprintf(out, "convex hulls       %d over %d rigid fragments; hull volume / tet volume - 1: "
-                     "median %.3g, worst %.3g; decomposition %.2f s (%.1f%% of wall time)\n",
-                hulls, n, median, e[n - 1], sim->prof.decompose,
-                100 * sim->prof.decompose / fmax(wall, 1e-300));
+        o->hull_error_median = n % 2 ? e[n / 2] : 0.5 * (e[n / 2 - 1] + e[n / 2]);
+        o->hull_error_worst = e[n - 1];
     }
+    o->rigid_with_hulls = n;
     free(e);
 }
 
-void cf_sim_memory(const cf_sim *sim, cf_memory *m)
+void cf_world_memory(const cf_world *sim, cf_memory *m)
 {
     const cf_solid *s = &sim->solid;
     const unsigned long long D = sizeof(double), I = sizeof(int);
@@ -1210,10 +1166,9 @@ void cf_sim_memory(const cf_sim *sim, cf_memory *m)
         m->collision += cff_mesh_bytes(fs->mesh) +
                         (unsigned long long)fs->nv * (I + 3 * D) + 3ull * fs->ntri * I;
     }
-    m->output = sim->output_peak;
 }
 
-void cf_sim_step_stats(const cf_sim *sim, cf_step_stats *o)
+void cf_world_step_stats(const cf_world *sim, cf_step_stats *o)
 {
     const cf_solver_settings *set = &sim->scene->solver;
     memset(o, 0, sizeof *o);
@@ -1238,88 +1193,4 @@ double cf_step_traffic(const cf_step_stats *st)
     double bar = (st->xpbd ? 40.0 : 16.0) * st->iterations;
     return tet * st->tets + node * st->nodes + bar * st->bars +
            2.0 * sizeof(cf_cohesive) * st->cohesive;
-}
-
-static void print_memory(const cf_sim *sim, FILE *out)
-{
-    cf_memory m;
-    cf_sim_memory(sim, &m);
-    const struct {
-        const char *name;
-        unsigned long long bytes;
-    } part[] = {{"solid", m.solid},       {"fracture state", m.fracture},
-                {"cohesive", m.cohesive}, {"fragments", m.fragments},
-                {"Bullet world", m.bullet}, {"FCL meshes", m.collision},
-                {"HDF5 output", m.output}};
-    fprintf(out, "memory (MiB)      ");
-    for (size_t i = 0; i < sizeof part / sizeof part[0]; i++) {
-        fprintf(out, "%s%s ", i ? " | " : "", part[i].name);
-        if (part[i].bytes)
-            fprintf(out, "%.3g", part[i].bytes / 1048576.0);
-        else
-            fputs("none", out);
-    }
-    fputc('\n', out);
-}
-
-void cf_sim_print_summary(const cf_sim *sim, FILE *out)
-{
-    const cf_scene *sc = sim->scene;
-    const cf_profile *p = &sim->prof;
-    int nf, n = alive_fragments(sim, &nf);
-    double wall = cf_wall_time() - sim->wall_start;
-    fprintf(out, "\n== cohfrac summary: %s ==\n", sc->name);
-    static const char *constraints[] = {"pbd", "xpbd", "none"};
-    fprintf(out, "simulated time     %.4g s in %ld rigid steps (dt_rigid %.3g s, backend %s)\n",
-            sim->t, sim->step, sim->dt_outer,
-            sc->solver.mode == CF_RUN_FRACTURE ? "none: fracture mode only"
-            : sc->solver.rigid_backend == CF_RIGID_BULLET ? "bullet" : "pbd");
-    fprintf(out, "constraints        %s\n", constraints[sc->solver.constraints]);
-    fprintf(out, "mesh               %d tets, %d nodes (%d after duplication)\n",
-            sim->solid.n_tets, sim->solid.n_verts0, sim->solid.n_nodes);
-    fprintf(out, "time step          dt_fracture %.3g s = %.4g dt_cfl (dt_cfl %.4g s)\n",
-            sim->dt_fracture, sim->dt_fracture / sim->solid.dt_cfl, sim->solid.dt_cfl);
-    fprintf(out, "steps per mode     rigid %ld, fracture %ld (threads %d)\n", sim->steps_rigid,
-            sim->steps_fracture, omp_get_max_threads());
-    fprintf(out, "fragments          %d alive (%d in fracture mode), %d ever\n", n, nf,
-            sim->n_frag);
-    fprintf(out, "cohesive elements  %d\n", sim->solid.n_coh);
-    fprintf(out, "hand-offs          %d, max linear momentum error %.3g (relative), "
-                 "handoff_loss %.4g J\n",
-            sim->n_handoffs, sim->max_momentum_error, sim->total_handoff_loss);
-    print_hull_summary(sim, out, wall);
-    print_memory(sim, out);
-    double staged = p->rigid + p->stress + p->insertion + p->forces + p->pbd + p->bodies +
-                    p->handoff + p->output;
-    cf_ledger l;
-    cf_sim_ledger(sim, &l);
-    double scale = fmax(fabs(l.initial) + fabs(l.work_gravity) + fabs(l.work_boundary) +
-                            fabs(l.work_obstacles), 1e-300);
-    fprintf(out, "energy ledger (J)  kinetic %.6g | strain %.6g | cohesive stored %.6g | "
-                 "cohesive dissipated %.6g\n",
-            l.kinetic, l.strain, l.cohesive_stored, l.cohesive_dissipated);
-    fprintf(out, "                   initial %.6g | work: gravity %.6g, boundary %.6g, "
-                 "moving obstacles %.6g\n",
-            l.initial, l.work_gravity, l.work_boundary, l.work_obstacles);
-    fprintf(out, "                   removed: contact %.6g, PBD %.6g, damping %.6g, hand-off %.6g, "
-                 "rigid integration %.6g\n",
-            l.contact, l.pbd, l.damping, l.handoff, l.integration);
-    fprintf(out, "                   residual %.4g J = %.3g of initial + work\n", l.residual,
-            l.residual / scale);
-    fprintf(out, "momentum           P = (%.6g, %.6g, %.6g) kg m/s, L = (%.6g, %.6g, %.6g) kg m^2/s\n",
-            l.momentum[0], l.momentum[1], l.momentum[2], l.angular_momentum[0],
-            l.angular_momentum[1], l.angular_momentum[2]);
-    fprintf(out, "state hash         %016llx (FNV-1a of the final state)\n",
-            (unsigned long long)cf_sim_state_hash(sim));
-    fprintf(out, "wall time          %.2f s\n", wall);
-    fprintf(out, "  rigid step %.2f s | stress %.2f s | insertion %.2f s | forces %.2f s | "
-                 "PBD %.2f s | contact between bodies %.2f s | hand-off %.2f s | output %.2f s | "
-                 "other %.2f s\n",
-            p->rigid, p->stress, p->insertion, p->forces, p->pbd, p->bodies, p->handoff,
-            p->output, wall - staged);
-    if (sim->steps_fracture > 0)
-        fprintf(out, "per fracture step  %.3f ms\n",
-                1e3 * (p->stress + p->insertion + p->forces + p->pbd) / (double)sim->steps_fracture);
-    if (sc->output.file[0])
-        fprintf(out, "output             %s\n", sc->output.file);
 }

@@ -167,7 +167,7 @@ static int case_overrides(const cf_stability_case *c, double dt, char ov[][160])
     return n;
 }
 
-static cf_status make_sim(const char *scene, const cf_stability_case *c, double dt, cf_scene *sc,
+static cf_status make_sim(const char *scene, const cf_stability_case *c, double dt, cf_world_def *sc,
                           cf_sim **sim, cf_error *err)
 {
     char ov[12][160];
@@ -200,11 +200,11 @@ static const char *guard_reason(const char *msg)
 /* Centre of mass of every fragment together, m; 0 when there is none. */
 static int system_com(cf_sim *sim, double com[3])
 {
-    int n = cf_sim_fragments(sim, NULL, 0);
+    int n = cf_world_fragments(cf_sim_world(sim), NULL, 0);
     cf_fragment_state *f = n > 0 ? malloc((size_t)n * sizeof *f) : NULL;
     if (!f)
         return 0;
-    n = cf_sim_fragments(sim, f, n);
+    n = cf_world_fragments(cf_sim_world(sim), f, n);
     double m = 0;
     com[0] = com[1] = com[2] = 0;
     for (int i = 0; i < n; i++) {
@@ -221,12 +221,12 @@ static int system_com(cf_sim *sim, double com[3])
 static cf_status run_case(const char *scene, cf_stability_case *c, cf_error *err)
 {
     double t0 = cf_wall_time();
-    cf_scene sc;
+    cf_world_def sc;
     cf_sim *sim = NULL;
     cf_status st = make_sim(scene, c, 0, &sc, &sim, err);
     if (st != CF_OK)
         return st;
-    c->dt = cf_sim_dt_fracture(sim);
+    c->dt = cf_world_dt_fracture(cf_sim_world(sim));
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
     if ((st = make_sim(scene, c, c->dt, &sc, &sim, err)) != CF_OK)
@@ -239,7 +239,7 @@ static cf_status run_case(const char *scene, cf_stability_case *c, cf_error *err
         cf_error e = {0};
         st = cf_sim_advance(sim, &e);
         cf_ledger l;
-        cf_sim_ledger(sim, &l);
+        cf_world_ledger(cf_sim_world(sim), &l);
         if (l.initial > 0 && isfinite(l.kinetic + l.strain))
             c->energy_ratio = fmax(c->energy_ratio, (l.kinetic + l.strain) / l.initial);
         const char *why = NULL;

@@ -8,7 +8,7 @@
  * their old order (so node groups stay ascending).
  */
 #include "cohfrac/mesh.h"
-#include "solid.h"
+#include "cohfrac/tetmesh.h"
 
 #include <limits.h>
 #include <stdlib.h>

@@ -2,6 +2,7 @@
  * (include/cohfrac/study.h). */
 #define _GNU_SOURCE
 #include "cohfrac/study.h"
+#include "cohfrac/surface.h"
 
 #include "clock.h"
 #include "cohfrac/scene.h"
@@ -121,7 +122,7 @@ static cf_status resolve_case(const cf_study_options *o, job *j, cf_study_case *
     for (int i = 0; i < j->n_sets; i++)
         all[o->n_overrides + i] = j->sets[i];
     all[n - 1] = "output.file=\"\"";
-    cf_scene sc;
+    cf_world_def sc;
     cf_error e2 = {0};
     cf_status st = cf_scene_load(o->scene, all, n, o->mesh_dir, &sc, &e2);
     free(all);
@@ -179,7 +180,7 @@ static cf_status start_case(const cf_study_options *o, job *j, int threads, cf_e
 {
     char th[16];
     snprintf(th, sizeof th, "%d", threads);
-    const char *argv[] = {o->exe, "run", j->lua, "-q", "-j", th, "-m", o->mesh_dir,
+    const char *argv[] = {o->exe, "run", j->lua, "-q", "-t", th, "-m", o->mesh_dir,
                           "-o", j->h5, NULL};
     unlink(j->meta);
     unlink(j->h5);
@@ -679,7 +680,7 @@ cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_err
     memset(res, 0, sizeof *res);
     res->best = -1;
     if (!o.mesh_dir)
-        o.mesh_dir = "build/meshes";
+        o.mesh_dir = cf_default_mesh_dir();
     if (o.jobs < 1)
         o.jobs = 1;
     if (!(o.tolerance > 0))

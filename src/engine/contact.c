@@ -2,7 +2,7 @@
 #include "contact.h"
 
 #include "linalg.h"
-#include "sim.h"
+#include "world_impl.h"
 
 #include <ccd/ccd.h>
 #include <math.h>
@@ -60,7 +60,7 @@ int cf_boxes_overlap(const double lo0[3], const double hi0[3], const double lo1[
 }
 
 /* Append body fragment g's hulls in world coordinates. */
-static int add_hulls(cf_sim *sim, int g, cf_hull_set *hs)
+static int add_hulls(cf_world *sim, int g, cf_hull_set *hs)
 {
     const cf_fragment *f = &sim->frag[g];
     const cf_hulls *h = &f->hulls;
@@ -112,7 +112,7 @@ static int add_hulls(cf_sim *sim, int g, cf_hull_set *hs)
     return 0;
 }
 
-int cf_body_boxes(cf_sim *sim, double **boxes)
+int cf_body_boxes(cf_world *sim, double **boxes)
 {
     double *b = realloc(*boxes, (size_t)(sim->n_frag > 0 ? sim->n_frag : 1) * 6 * sizeof(double));
     if (!b)
@@ -129,7 +129,7 @@ int cf_body_boxes(cf_sim *sim, double **boxes)
     return 0;
 }
 
-int cf_hull_set_gather(cf_sim *sim, int fi, double pad, const double *boxes, cf_hull_set *hs)
+int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, cf_hull_set *hs)
 {
     const cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;
@@ -250,7 +250,7 @@ typedef struct {
     int hit;
 } push_sum;
 
-double cf_node_impulses_flush(cf_sim *sim, cf_node_impulses *ni, const int *nodes)
+double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes)
 {
     int n = sim->n_frag;
     push_sum *sum = calloc((size_t)n, sizeof *sum);

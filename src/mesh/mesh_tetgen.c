@@ -395,15 +395,3 @@ cf_status cf_mesh_write_tetgen(const cf_mesh *m, const char *base, cf_error *err
     free(b);
     return st;
 }
-
-void cf_mesh_free(cf_mesh *m)
-{
-    if (!m)
-        return;
-    free(m->x);
-    free(m->tets);
-    for (int g = 0; g < m->n_groups && m->groups; g++)
-        free(m->groups[g].nodes);
-    free(m->groups);
-    memset(m, 0, sizeof *m);
-}

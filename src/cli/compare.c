@@ -1,6 +1,7 @@
 /* cohfrac — the two rigid backends side by side (see include/cohfrac/compare.h
  * for the metrics, the reference rules and the files). */
 #include "cohfrac/compare.h"
+#include "cohfrac/surface.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
 #include "linalg.h"
@@ -83,7 +84,7 @@ static double quat_angle(const double a[4], const double b[4])
 
 static cf_status snap_take(cf_sim *sim, snap *s, cf_error *err)
 {
-    int n = cf_sim_fragments(sim, NULL, 0);
+    int n = cf_world_fragments(cf_sim_world(sim), NULL, 0);
     if (n > s->cap) {
         int cap = n + n / 2 + 4;
         cf_fragment_state *f = realloc(s->f, (size_t)cap * sizeof *f);
@@ -91,7 +92,7 @@ static cf_status snap_take(cf_sim *sim, snap *s, cf_error *err)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory for %d fragment states", n);
         s->f = f, s->cap = cap;
     }
-    s->n = cf_sim_fragments(sim, s->f, s->cap);
+    s->n = cf_world_fragments(cf_sim_world(sim), s->f, s->cap);
     int max_id = -1;
     for (int i = 0; i < s->n; i++)
         if (s->f[i].id > max_id)
@@ -127,9 +128,9 @@ static int cmp_u64(const void *a, const void *b)
 static void match_fragments(const cf_sim *a, const cf_sim *b, const snap *sa, const snap *sb,
                             uint64_t *keys, int *partner, int *shared)
 {
-    int nt = cf_sim_tet_count(a), nk = 0;
+    int nt = cf_world_tet_count(cf_sim_world(a)), nk = 0;
     for (int t = 0; t < nt; t++) {
-        int fa = cf_sim_tet_fragment(a, t), fb = cf_sim_tet_fragment(b, t);
+        int fa = cf_world_tet_fragment(cf_sim_world(a), t), fb = cf_world_tet_fragment(cf_sim_world(b), t);
         if (fa >= 0 && fb >= 0)
             keys[nk++] = (uint64_t)fa << 32 | (uint64_t)(uint32_t)fb;
     }
@@ -198,7 +199,7 @@ static int reference_at(const reference *r, double t, double x[3])
 }
 
 /* Decide the reference from the scene and the state at t = 0 (Bullet run). */
-static void reference_setup(const cf_scene *sc, cf_sim *sim, const snap *first, reference *r)
+static void reference_setup(const cf_world_def *sc, cf_sim *sim, const snap *first, reference *r)
 {
     memset(r, 0, sizeof *r);
     r->kind = CF_CMP_REF_NONE;
@@ -265,7 +266,7 @@ static void reference_setup(const cf_scene *sc, cf_sim *sim, const snap *first, 
     const cf_obstacle *o = &sc->obstacles[0];
     memcpy(r->n, o->normal, sizeof r->n);
     double mn[3] = {-r->n[0], -r->n[1], -r->n[2]}, d[3];
-    double h = cf_sim_fragment_support(sim, f->id, mn);
+    double h = cf_world_fragment_support(cf_sim_world(sim), f->id, mn);
     v3_sub(r->x0, o->point, d);
     double s0 = v3_dot(d, r->n), vn0 = v3_dot(r->v0, r->n), gn = v3_dot(r->g, r->n);
     if (!(gn < 0) || !(s0 > h))
@@ -297,7 +298,7 @@ static double axis_angle(const reference *r, const cf_fragment_state *f)
 
 typedef struct state {
     cf_sim *sim[2];
-    const cf_scene *scene;
+    const cf_world_def *scene;
     snap s[2];
     uint64_t *keys;
     int *partner, *shared, match_cap;
@@ -337,7 +338,7 @@ static cf_status take_sample(state *st, cf_error *err)
 
     sample *o = &st->smp[st->n_smp];
     memset(o, 0, sizeof *o);
-    o->t = cf_sim_time(st->sim[0]);
+    o->t = cf_world_time(cf_sim_world(st->sim[0]));
     double wsum = 0, dsum = 0, asum = 0;
     for (int i = 0; i < sa->n; i++) {
         int j = st->partner[i];
@@ -429,7 +430,7 @@ static void row(FILE *f, const char *metric, const char *unit, const double fin[
             num(b, 32, mx[0]), num(c, 32, fin[1]), num(d, 32, mx[1]), closer);
 }
 
-static void write_headline(FILE *f, const cf_compare_options *opt, const cf_scene *sc,
+static void write_headline(FILE *f, const cf_compare_options *opt, const cf_world_def *sc,
                            const cf_compare_result *r, const reference *ref, cf_status run_st)
 {
     char a[32], b[32], c[32];
@@ -708,10 +709,10 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     static const char *const extra[2][3] = {
         {"solver.rigid_backend=\"bullet\"", "output.file=\"\"", NULL},
         {"solver.rigid_backend=\"pbd\"", "solver.pbd.k_damping=1", "output.file=\"\""}};
-    const char *mesh_dir = opt->mesh_dir ? opt->mesh_dir : "build/meshes";
+    const char *mesh_dir = opt->mesh_dir ? opt->mesh_dir : cf_default_mesh_dir();
     cf_compare_result local, *r = res ? res : &local;
     memset(r, 0, sizeof *r);
-    cf_scene sc[2];
+    cf_world_def sc[2];
     memset(sc, 0, sizeof sc);
     state st;
     memset(&st, 0, sizeof st);
@@ -732,11 +733,11 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     cf_run_options ro = {.progress = 0, .threads = opt->threads, .mesh_dir = mesh_dir};
     for (int b = 0; b < 2 && rc == CF_OK; b++)
         rc = cf_sim_create(&sc[b], &ro, &st.sim[b], err);
-    if (rc == CF_OK && cf_sim_tet_count(st.sim[0]) != cf_sim_tet_count(st.sim[1]))
+    if (rc == CF_OK && cf_world_tet_count(cf_sim_world(st.sim[0])) != cf_world_tet_count(cf_sim_world(st.sim[1])))
         rc = cf_error_set(err, CF_ERR_SCENE_VALUE, "the two runs of %s have different meshes",
                           opt->scene);
     if (rc == CF_OK) {
-        st.keys = malloc(((size_t)cf_sim_tet_count(st.sim[0]) + 1) * sizeof *st.keys);
+        st.keys = malloc(((size_t)cf_world_tet_count(cf_sim_world(st.sim[0])) + 1) * sizeof *st.keys);
         if (!st.keys)
             rc = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     }
@@ -761,7 +762,7 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     double dt = sc[0].solver.dt_rigid, every = sc[0].output.frame_interval;
     double next = every, next_report = 0.1 * st.T;
     cf_error run_err = {0};
-    int n_bodies = cf_sim_fragments(st.sim[0], NULL, 0);
+    int n_bodies = cf_world_fragments(cf_sim_world(st.sim[0]), NULL, 0);
     r->t_split[0] = r->t_split[1] = NAN;
     while (!cf_sim_done(st.sim[0]) || !cf_sim_done(st.sim[1])) {
         for (int b = 0; b < 2 && run_st == CF_OK; b++) {
@@ -772,8 +773,8 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
             double w = cf_wall_time() - t0;
             r->wall[b] += w;
             /* after the split: from the step whose fragments outnumber the bodies */
-            if (isnan(r->t_split[b]) && cf_sim_fragments(st.sim[b], NULL, 0) > n_bodies)
-                r->t_split[b] = cf_sim_time(st.sim[b]);
+            if (isnan(r->t_split[b]) && cf_world_fragments(cf_sim_world(st.sim[b]), NULL, 0) > n_bodies)
+                r->t_split[b] = cf_world_time(cf_sim_world(st.sim[b]));
             if (!isnan(r->t_split[b]))
                 r->wall_split[b] += w;
             if (run_st != CF_OK)
@@ -782,7 +783,7 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
         }
         if (run_st != CF_OK)
             break;
-        double t = cf_sim_time(st.sim[0]);
+        double t = cf_world_time(cf_sim_world(st.sim[0]));
         int done = cf_sim_done(st.sim[0]) && cf_sim_done(st.sim[1]);
         if (t >= next - 1e-9 * dt || done) {
             if ((rc = take_sample(&st, err)) != CF_OK)

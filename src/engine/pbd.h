@@ -3,7 +3,7 @@
 #ifndef COHFRAC_PBD_H
 #define COHFRAC_PBD_H
 
-#include "cohfrac/scene.h"
+#include "cohfrac/types.h"
 #include "cf_fcl.h"
 #include "solid.h"
 

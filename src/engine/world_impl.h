@@ -8,8 +8,7 @@
 #include "cohesive_ppr.h"
 #include "contact.h"
 #include "decompose.h"
-#include "cohfrac/h5_output.h"
-#include "cohfrac/sim.h"
+#include "cohfrac/world.h"
 #include "fragments.h"
 #include "insertion.h"
 #include "pbd.h"
@@ -63,7 +62,7 @@ typedef struct cf_fragment {
 #define CF_HULL_MIN_TETS 4
 
 /* Energy removed or put in by each mechanism since t = 0, J (DESIGN §3-§6;
- * the ledger balance is in cf_sim_ledger). */
+ * the ledger balance is in cf_world_ledger). */
 typedef struct cf_energy_flows {
     double boundary;   /* work of prescribed velocities */
     double obstacles;  /* work of moving obstacles (the energy contact with them put in) */
@@ -77,20 +76,18 @@ typedef struct cf_energy_flows {
 } cf_energy_flows;
 
 typedef struct cf_profile {
-    double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose, output; /* s of
-                                                                      wall time */
+    double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s of wall time */
 } cf_profile;
 
-struct cf_sim {
-    const cf_scene *scene;
-    cf_run_options opt;
+struct cf_world {
+    cf_world_def def;        /* the world's copy (obstacles and boundaries too) */
+    const cf_world_def *scene; /* &def */
     cf_solid solid;
     cf_ppr ppr;
     cf_obstacles obs;
     cf_fragment *frag;
     int n_frag, cap_frag;
     cfb_world *bullet;       /* NULL for the pbd rigid backend */
-    cf_h5 *h5;               /* NULL when no output is asked for */
     double t;                /* s */
     long step;               /* rigid steps done */
     long n_steps;            /* rigid steps in the scene's duration */
@@ -106,15 +103,16 @@ struct cf_sim {
     int n_handoffs;
     double max_momentum_error, total_handoff_loss;
     double wall_start;
-    double last_progress;
     int *obstacle_body;      /* [n_obstacles] Bullet body of each obstacle */
     unsigned char *obstacle_moving; /* [n_obstacles] kinematic (restored on a re-step) */
     double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
     unsigned long long bullet_base; /* Bullet allocator bytes when the run was created */
-    unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
     int *tet_of_user;        /* [n_tets] the solid's tet of each input tet (the solid is
                                 renumbered for locality at load: renumber.h) */
     cf_int_list cand;        /* facets that qualify at a check (scratch of the step) */
+    cf_initial_bounds bounds;/* taken at create */
+    cf_event *ev;            /* events since the caller last drained them */
+    int n_ev, cap_ev;
 };
 
 /* One step of the in-house solver on fragment f (source Table 6.2): with
@@ -123,25 +121,25 @@ struct cf_sim {
  * instead.  Then prediction, PBD bars + collision constraints, velocity
  * update, friction and restitution.  t: time at the start of the step (s).
  * Returns CF_OK or CF_ERR_NOMEM. */
-cf_status cf_solver_step(cf_sim *sim, int fi, double t, double dt, int fracture);
+cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture);
 
 /* Whether rigid fragment fi (nodes in the in-house solver) would hit an
  * obstacle during the next step of length dt faster than the impact
  * threshold (normal approach speed). */
-int cf_pbd_impact(const cf_sim *sim, int fi, double dt);
+int cf_pbd_impact(const cf_world *sim, int fi, double dt);
 
 /* Compute the rest-shape mass properties of fragment fi. */
-void cf_fragment_rest_props(cf_sim *sim, int fi);
+void cf_fragment_rest_props(cf_world *sim, int fi);
 
 /* Rigid -> fracture: nodes from the Bullet state `st` (x = R X + c,
  * v = v + w x r), body removed.  Records the hand-off. */
-cf_status cf_handoff_to_fracture(cf_sim *sim, int fi, const cfb_state *st, cf_error *err);
+cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err);
 
 /* Fracture -> rigid: split fragment fi into its connected components; each
  * becomes a rigid fragment (a Bullet body with momentum-preserving
  * velocities, or a pbd rigid fragment).  Records momentum error and
  * handoff_loss. */
-cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err);
+cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err);
 
 /* Fracture-only runs: split fracture-mode fragment fi into its connected
  * components, each a new fracture-mode fragment (its tets, nodes, bars and
@@ -149,23 +147,26 @@ cf_status cf_handoff_to_rigid(cf_sim *sim, int fi, cf_error *err);
  * moment carried over node by node, so the ledger does not jump).  Sets
  * *first to the first new fragment and returns the number made (0: fi is
  * one piece and stays), or -1 when out of memory. */
-int cf_fragment_split_fracture(cf_sim *sim, int fi, int *first);
+int cf_fragment_split_fracture(cf_world *sim, int fi, int *first);
 
 /* Add a Bullet body for rigid fragment fi with COM pos, rotation R (rest ->
  * current), velocity v and angular velocity w. */
-cf_status cf_fragment_add_body(cf_sim *sim, int fi, const double pos[3], const double R[9],
+cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const double R[9],
                                const double v[3], const double w[3], cf_error *err);
 
 /* Centre of mass, rotation, velocities of fragment fi, whatever its mode. */
-void cf_fragment_pose(cf_sim *sim, int fi, double com[3], double R[9], double v[3], double w[3]);
+void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double v[3], double w[3]);
 
 /* The ledger state of fragment fi from its nodes now: exact kinetic energy,
  * zero strain energy, sum m x. */
-void cf_fragment_ledger_reset(cf_sim *sim, int fi);
+void cf_fragment_ledger_reset(cf_world *sim, int fi);
 
 /* Bullet collision margin of fragment fi: 0.1% of its size, m (Bullet's
  * default 4 cm would hold small fragments off the ground). */
-double cf_fragment_margin(const cf_sim *sim, int fi);
+double cf_fragment_margin(const cf_world *sim, int fi);
+
+/* Push a hand-off event (handoff.c records them). */
+cf_status cf_world_push_handoff(cf_world *sim, const cf_handoff_record *r, cf_error *err);
 
 /* A rigid step is re-run at most this many times for fragments that go to
  * fracture mode during it. */
@@ -180,16 +181,16 @@ void cf_body_spin(const cf_fragment *f, const cfb_state *st, double Iw[3]);
 void cf_body_momenta(const cf_fragment *f, const cfb_state *st, double P[3], double L[3]);
 
 /* The same for fragment fi now: of its Bullet body, or of its nodes. */
-void cf_fragment_momenta(const cf_sim *sim, int fi, double P[3], double L[3]);
+void cf_fragment_momenta(const cf_world *sim, int fi, double P[3], double L[3]);
 
 /* Kinetic energy of rigid fragment fi's Bullet body, J. */
-double cf_body_kinetic_energy(const cf_sim *sim, int fi);
+double cf_body_kinetic_energy(const cf_world *sim, int fi);
 
 /* Append a new fragment; returns its index or -1 (out of memory). */
-int cf_fragment_new(cf_sim *sim, int parent, double birth_time);
+int cf_fragment_new(cf_world *sim, int parent, double birth_time);
 
 /* The initial body fragment fi descends from (its family: fragments of one
  * body do not collide with each other). */
-int cf_fragment_root(const cf_sim *sim, int fi);
+int cf_fragment_root(const cf_world *sim, int fi);
 
 #endif

@@ -1,0 +1,192 @@
+/* cohfrac — world definitions: materials, bodies, obstacles, boundary
+ * conditions, solver and output settings, as plain C structs with
+ * defaults (cf_default_*).  The engine (cohfrac/world.h) is created from a
+ * cf_world_def and copies what it needs; the Lua scene loader
+ * (cohfrac/scene.h) only fills these structs.  Units are SI throughout;
+ * the keys, defaults and ranges are those of the scene schema documented
+ * in cohfrac/scene.h.
+ */
+#ifndef COHFRAC_TYPES_H
+#define COHFRAC_TYPES_H
+
+#include "cohfrac/error.h"
+#include "cohfrac/tetmesh.h"
+
+/* Meshed primitives (scene bodies with `mesh = {type = ...}`), m. */
+typedef enum {
+    CF_PRIM_NONE = 0,
+    CF_PRIM_BOX,           /* structured, in-engine: size, cells, tets_per_cell */
+    CF_PRIM_SPHERE,        /* gmsh: radius, mesh_size */
+    CF_PRIM_HOLLOW_SPHERE, /* gmsh: radius (outer), thickness, mesh_size */
+    CF_PRIM_PLATE,         /* gmsh: size (x, y, thickness z), mesh_size */
+    CF_PRIM_NOTCHED_BEAM   /* gmsh: size (length x, width y, height z), notch, mesh_size */
+} cf_primitive_type;
+
+typedef struct cf_primitive {
+    cf_primitive_type type;
+    double size[3];     /* box, plate, notched beam: edge lengths along x, y, z, m */
+    int cells[3];       /* box: cells along x, y, z */
+    int tets_per_cell;  /* box: 5 or 6 */
+    double radius;      /* sphere, hollow sphere: outer radius, m */
+    double thickness;   /* hollow sphere: shell thickness, m */
+    double notch[3];    /* notched beam: depth (from the bottom face, z), width (x),
+                           offset of the notch centre from mid-span (x), m */
+    double mesh_size;   /* gmsh characteristic element length, m */
+} cf_primitive;
+
+typedef struct cf_material {
+    double E, nu, rho;             /* Pa, -, kg/m^3 */
+    double G_I, G_II;              /* fracture energies phi_n, phi_t, N/m */
+    double sigma_max, tau_max;     /* cohesive strengths, Pa */
+    double alpha, beta;            /* PPR shape parameters */
+    double friction, restitution;  /* contact with obstacles */
+    int weibull;                   /* strength distribution: 0 uniform, 1 Weibull */
+    double weibull_modulus;        /* m, > 0 */
+    int strength_seed;
+} cf_material;
+
+typedef struct cf_body_def {
+    const cf_mesh *tet_mesh;   /* the body's Tet4 mesh as made (before scale, orientation
+                                  and position); not owned, read only by cf_world_create.
+                                  NULL: mesh preparation makes it from `mesh` or
+                                  `primitive` (cf_world_meshes_load, cohfrac/mesh.h) */
+    char mesh[1024];           /* where a loader finds it: resolved path of a TetGen base
+                                  (no extension) or a .msh file; "" for a primitive */
+    cf_primitive primitive;    /* type CF_PRIM_NONE when `mesh` is a file */
+    double scale;
+    double position[3];        /* m, where the bounding-box centre goes */
+    double orientation[4];     /* w,x,y,z, normalised */
+    double velocity[3];        /* m/s */
+    double angular_velocity[3];/* rad/s */
+    double expansion_rate[3];  /* 1/s, per axis */
+    int has_expansion_center;  /* 0: the body's centre of mass */
+    double expansion_center[3];/* m */
+    int hollow_layers;         /* > 0: keep only the tets within this many tet
+                                  layers of the surface (a hollow shell); 0 solid */
+} cf_body_def;
+
+typedef enum { CF_REGION_BOX, CF_REGION_PLANE, CF_REGION_GROUP } cf_region_type;
+
+typedef struct cf_boundary {
+    cf_region_type type;
+    double min[3], max[3];       /* box, m */
+    double point[3], normal[3];  /* plane (normal normalised) */
+    double tolerance;            /* plane, m */
+    char group[64];              /* Gmsh physical group name */
+    int body;                    /* 0-based body index, -1 for every body */
+    int axes;                    /* prescribed components: bit 0 x, 1 y, 2 z */
+    double velocity[3];          /* m/s (zero when fixed) */
+} cf_boundary;
+
+typedef enum {
+    CF_OBSTACLE_PLANE,
+    CF_OBSTACLE_SPHERE,
+    CF_OBSTACLE_BOX,
+    CF_OBSTACLE_MESH
+} cf_obstacle_type;
+
+typedef struct cf_obstacle {
+    cf_obstacle_type type;
+    double point[3], normal[3];  /* plane (normal normalised) */
+    double center[3];            /* sphere, box: at t = 0 */
+    double radius;               /* sphere, m */
+    double half_extents[3];      /* box (axis-aligned), m */
+    double velocity[3];          /* sphere, box: constant, m/s */
+    const double *vertices;      /* mesh: [n_vertices][3] the surface in its file's frame,
+                                    m; not owned, read only by cf_world_create.  NULL:
+                                    mesh preparation reads `file` (cf_world_meshes_load) */
+    const int *triangles;        /* mesh: [n_triangles][3] 0-based vertex indices */
+    int n_vertices, n_triangles;
+    char file[1024];             /* mesh: resolved path of a closed or open
+                                    triangle surface (.obj/.off/.stl) */
+    double scale;                /* mesh: applied first */
+    double orientation[4];       /* mesh: w,x,y,z, normalised, then */
+    double position[3];          /* mesh: where the file's origin goes, m */
+    double friction, restitution;/* factors on the material's values (the
+                                    pair's coefficient is their product) */
+} cf_obstacle;
+
+typedef enum { CF_RUN_HYBRID, CF_RUN_FRACTURE } cf_run_mode;
+typedef enum { CF_RIGID_BULLET, CF_RIGID_PBD } cf_rigid_backend;
+typedef enum { CF_ELASTICITY_COROTATIONAL, CF_ELASTICITY_LINEAR } cf_elasticity;
+typedef enum { CF_CRITERION_TRACTION, CF_CRITERION_SOURCE, CF_CRITERION_NONE } cf_criterion;
+typedef enum { CF_CONSTRAINTS_PBD, CF_CONSTRAINTS_XPBD, CF_CONSTRAINTS_NONE } cf_constraints;
+
+typedef struct cf_solver_settings {
+    cf_run_mode mode;
+    cf_rigid_backend rigid_backend;
+    double dt_rigid;
+    int rigid_substeps;
+    double dt_fracture;
+    double cfl_fraction;          /* > 0: dt_fracture = cfl_fraction dt_cfl */
+    int check_interval;
+    int quiet_steps;
+    double max_fracture_time;
+    double impact_threshold;
+    int ccd;                      /* Bullet continuous collision detection */
+    double sleep_linear, sleep_angular; /* m/s, rad/s; 0, 0: no sleeping */
+    cf_elasticity elasticity;
+    cf_criterion criterion;
+    int has_crack_plane;
+    double crack_plane_point[3], crack_plane_normal[3]; /* normal normalised */
+    double crack_plane_tolerance;                    /* m */
+    cf_constraints constraints;
+    double k_stiffness;
+    int iterations;
+    double k_damping;
+    int iteration_independent;
+    double compliance_scale;
+    double contact_stiffness;     /* Pa/m, 0 = stability cap */
+    double max_inverted_fraction;
+    double max_energy_growth;
+    int threads;
+} cf_solver_settings;
+
+typedef struct cf_output_settings {
+    char file[1024];
+    double frame_interval;
+    int cracks;                  /* write /cracks at frames */
+} cf_output_settings;
+
+/* A world definition: everything cf_world_create needs.  Start from
+ * cf_default_world_def() and fill in; the Lua scene loader (cohfrac/scene.h)
+ * fills one the same way. */
+typedef struct cf_world_def {
+    char name[128];
+    double duration;
+    double gravity[3];
+    cf_material material;
+    int n_bodies;
+    cf_body_def *bodies;
+    int n_obstacles;
+    cf_obstacle *obstacles;
+    int n_boundaries;
+    cf_boundary *boundaries;
+    cf_solver_settings solver;
+    cf_output_settings output;
+    char *resolved; /* the resolved scene as Lua text (every key, defaults filled,
+                       mesh paths absolute); loading it again gives this scene */
+} cf_world_def;
+
+/* Defaults of every setting, as documented in the scene schema
+ * (cohfrac/scene.h); a scene key left out takes the same value. */
+cf_material cf_default_material(void);
+cf_solver_settings cf_default_solver(void);
+cf_output_settings cf_default_output(void);
+/* A body at the origin, unit scale, at rest, with no mesh yet. */
+cf_body_def cf_default_body(void);
+/* An obstacle of `type` with the schema's defaults (plane through the origin
+ * facing +z; sphere, box and mesh still need their geometry). */
+cf_obstacle cf_default_obstacle(cf_obstacle_type type);
+/* No bodies, no obstacles, the defaults above; name "scene", duration 1 s,
+ * gravity (0, 0, -9.81) m/s^2, no output file. */
+cf_world_def cf_default_world_def(void);
+
+/* Check a definition as cf_world_create does: every value in the range the
+ * schema documents, each body with a mesh, each mesh obstacle with a surface.
+ * Errors: CF_ERR_SCENE_VALUE naming the key path ("solver.dt_rigid",
+ * "bodies[2].scale") with the value and the allowed range, as the scene
+ * loader words them. */
+cf_status cf_world_def_check(const cf_world_def *def, cf_error *err);
+
+#endif

@@ -1,0 +1,292 @@
+/* cohfrac — the engine: a world of Tet4 bodies that fall, collide and
+ * break (docs/architecture.md).
+ *
+ * cf_world_create builds what a world definition (cohfrac/types.h) asks
+ * for and nothing else (no Bullet world for the `pbd` rigid backend);
+ * cf_world_step advances it by one rigid step.  The world does no file
+ * I/O and prints nothing: what happened in a step (hand-offs, new
+ * fragments, cohesive insertions) is pushed as events the caller drains
+ * (cf_world_events), and everything else is read through the queries below.
+ * The run loop that writes HDF5 and shows progress is cohfrac/sim.h. */
+#ifndef COHFRAC_WORLD_H
+#define COHFRAC_WORLD_H
+
+#include <stdint.h>
+
+#include "cohfrac/error.h"
+#include "cohfrac/types.h"
+
+typedef struct cf_world cf_world;
+
+/* The energy ledger (J) and momenta of the whole scene at the current
+ * state.  Balance: residual = kinetic + strain + cohesive_stored +
+ * cohesive_dissipated + contact + pbd + damping + handoff + integration
+ * - (initial + work_gravity + work_boundary + work_obstacles); zero for an
+ * exact integrator.  work_obstacles is the work of moving obstacles: the
+ * impulse they give a node times their velocity, and for Bullet bodies the
+ * energy gained in a rigid step in contact when the scene has moving ones.
+ * Kinetic energy of the in-house solver is the leapfrog estimate
+ * 1/2 sum m v(n-1/2).v(n+1/2) at the last force evaluation; Bullet bodies'
+ * is 1/2 M v^2 + 1/2 w.I w.  `contact`, `pbd`, `damping`, `handoff` are
+ * energies removed since t = 0 (see DESIGN §3-§6 and docs/physics.md);
+ * `integration` is what Bullet's integrator changed in bodies that touched
+ * nothing during a rigid step (its implicit gyroscopic term: a free
+ * spinning asymmetric body loses a little), never booked as contact. */
+typedef struct cf_ledger {
+    double kinetic, strain, cohesive_stored, cohesive_dissipated;
+    double work_gravity, work_boundary, work_obstacles;
+    double contact, pbd, damping, handoff, integration;
+    double initial;            /* kinetic + strain at t = 0 */
+    double residual;
+    double momentum[3];        /* kg m/s */
+    double angular_momentum[3];/* kg m^2/s, about the origin */
+    double mass_moment[3];     /* kg m, sum m x (gravity's work is g . its change) */
+} cf_ledger;
+
+/* Build the world `def` describes: every body's mesh placed (scale,
+ * orientation, position), renumbered for locality and joined into one solid;
+ * boundary conditions, obstacles, the initial fragments (one per connected
+ * piece of each body, a Bullet body each in hybrid runs with the Bullet
+ * backend).  What the world needs of `def` is copied: `def` and the meshes
+ * it points to may be freed after the call.  Threads: def->solver.threads
+ * (0: all cores; it sets OpenMP's default for the process).
+ * Errors: those of cf_world_def_check; CF_ERR_SCENE_VALUE for a boundary
+ * region that selects no node or a crack plane with no facet on it;
+ * CF_ERR_MESH_* for a mesh that fails its checks; CF_ERR_EXTERNAL (Bullet,
+ * FCL); CF_ERR_NOMEM.  On error *out is NULL. */
+cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err);
+
+/* One rigid step (dt_rigid, sub-cycled in fracture mode), with hand-offs
+ * and the divergence guard.  Errors: CF_ERR_DIVERGED (a non-finite or
+ * faster than 1e5 m/s node, more inverted tets than
+ * solver.guard.max_inverted_fraction, or kinetic + strain + cohesive energy
+ * above (1 + solver.guard.max_energy_growth) times the initial energy plus
+ * all work input; the message names dt/dt_cfl and what to change),
+ * CF_ERR_NOMEM.  cf_world_done tells when the duration is reached: the
+ * step count is ceil(duration / dt_rigid), so the last step ends at or just
+ * past it (cf_world_dt_outer). */
+cf_status cf_world_step(cf_world *w, cf_error *err);
+int cf_world_done(const cf_world *w);
+
+/* Rigid steps taken and the number the duration needs; the rigid step, s
+ * (fracture-only runs: a whole number of fracture steps). */
+long cf_world_step_count(const cf_world *w);
+long cf_world_steps_total(const cf_world *w);
+double cf_world_dt_outer(const cf_world *w);
+
+/* One fragment's record (an initial body or a product of a split). */
+typedef struct cf_frag_info {
+    int id;
+    int parent;              /* -1 for an initial body */
+    double birth_time;       /* s */
+    double mass;             /* kg */
+    int n_tets;
+    double inertia_principal[3]; /* kg m^2 */
+    int n_hulls;             /* convex hulls of its Bullet shape, 0 none */
+    double hull_volume_error;/* hull volume / tet volume - 1 */
+    double decomposition_time; /* s of wall time */
+} cf_frag_info;
+
+/* One hand-off between modes. */
+typedef struct cf_handoff_record {
+    double time;             /* s */
+    int fragment;            /* the fragment that changed mode (the parent for a split) */
+    int direction;           /* 0 rigid -> fracture, 1 fracture -> rigid */
+    double momentum_error;   /* |P_after - P_before| / |P_before| */
+    double momentum_change[3];         /* P_after - P_before, kg m/s */
+    double angular_momentum_change[3]; /* L_after - L_before about the origin, kg m^2/s */
+    double handoff_loss;     /* J: kinetic energy not carried by rigid motion */
+} cf_handoff_record;
+
+/* What happened during the steps since the caller last drained the events,
+ * in order. */
+typedef enum {
+    CF_EVENT_FRAGMENTS,  /* fragments first .. first + count - 1 were born
+                            (the initial bodies at create, pieces of a split) */
+    CF_EVENT_HANDOFF,    /* a fragment changed mode: `handoff` */
+    CF_EVENT_INSERTIONS  /* cohesive elements first .. first + count - 1 were inserted
+                            during the rigid step that ended at `time` */
+} cf_event_type;
+
+typedef struct cf_event {
+    cf_event_type type;
+    double time;             /* s */
+    int first, count;        /* fragments or cohesive elements */
+    int alive;               /* fragments alive after the event */
+    cf_handoff_record handoff;
+} cf_event;
+
+/* The events pushed since the last cf_world_clear_events: *n of them. */
+const cf_event *cf_world_events(const cf_world *w, int *n);
+void cf_world_clear_events(cf_world *w);
+
+/* Fragment `id`'s record (any id below cf_world_fragments_ever, dead or
+ * alive).  Returns 0, or -1 for an unknown id. */
+int cf_world_fragment_info(const cf_world *w, int id, cf_frag_info *out);
+int cf_world_fragments_ever(const cf_world *w);
+
+/* Simulated time, s. */
+double cf_world_time(const cf_world *sim);
+
+/* The fracture-mode step (solver.dt_fracture, or cfl_fraction x dt_cfl)
+ * and the mesh's explicit stability limit dt_cfl (DESIGN §3.2), s. */
+double cf_world_dt_fracture(const cf_world *sim);
+double cf_world_dt_cfl(const cf_world *sim);
+
+/* The energy ledger and momenta now. */
+void cf_world_ledger(const cf_world *sim, cf_ledger *out);
+
+/* One alive fragment's rigid state now (pose as DESIGN §2).  `kinetic` is
+ * the kinetic energy of its nodes (fracture mode, pbd rigid backend) or of
+ * its Bullet body; momenta are those of the same. */
+typedef struct cf_fragment_state {
+    int id;                     /* fragment index, as in /fragments */
+    int parent;                 /* -1 for an initial body */
+    double birth_time;          /* s */
+    int mode;                   /* 0 rigid, 1 fracture */
+    int n_tets;
+    double mass;                /* kg */
+    double com[3];              /* m */
+    double quat[4];             /* w,x,y,z: rest shape -> current */
+    double v[3];                /* m/s, centre of mass */
+    double w[3];                /* rad/s, world frame */
+    double kinetic;             /* J */
+    double momentum[3];         /* kg m/s */
+    double angular_momentum[3]; /* kg m^2/s, about the fragment's centre of mass */
+    double principal[3];        /* kg m^2 */
+    double axes[9];             /* principal axes in the rest frame, columns */
+} cf_fragment_state;
+
+/* The alive fragments now, in id order: writes up to `cap` to out (may be
+ * NULL with cap 0) and returns how many are alive. */
+int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap);
+
+/* Number of tets of the scene's solid, and the fragment (id) that tet t
+ * belongs to now: fragments of two runs of one scene are matched through
+ * their tets.  -1 for t out of range. */
+int cf_world_tet_count(const cf_world *sim);
+int cf_world_tet_fragment(const cf_world *sim, int t);
+
+/* Support distance of fragment `id` along unit direction d now: the largest
+ * (R (X - X_cm)).d over its nodes, m, with X the rest positions and R the
+ * fragment's rigid pose (deformation is not seen); 0 for a dead or unknown
+ * fragment. */
+double cf_world_fragment_support(cf_world *sim, int id, const double d[3]);
+
+/* FNV-1a hash of the state's bits: every node's position and velocity,
+ * each tet's fragment, each fragment's mode and its Bullet body's state.
+ * Two runs of one scene give the same hash at the same step, for any thread
+ * count (the element loops write per-element results and sum them in a
+ * fixed order). */
+uint64_t cf_world_state_hash(const cf_world *sim);
+
+/* Memory each subsystem of the run holds now, bytes; 0 for one the scene
+ * does not use (nothing of it is allocated). */
+typedef struct cf_memory {
+    unsigned long long solid;     /* Tet4 nodes and elements: positions, velocities,
+                                     lumped masses, rest shapes, stresses, node-to-tet map */
+    unsigned long long fracture;  /* facets, crack flags, crack-plane candidates: only
+                                     when solver.criterion is not "none" */
+    unsigned long long cohesive;  /* the cohesive elements' array (its capacity) */
+    unsigned long long fragments; /* fragment records, their tet and node lists, PBD bars,
+                                     convex hulls, contact scratch */
+    unsigned long long bullet;    /* held by Bullet's allocator beyond what it held when
+                                     this run was created (world, bodies, shapes); counted
+                                     for the process, so exact with one run at a time */
+    unsigned long long collision; /* FCL hierarchies of mesh obstacles and of
+                                     fragment surfaces (contact between bodies) */
+    unsigned long long output;    /* HDF5 metadata cache of the output file, the
+                                     largest seen at a frame (filled in by the run
+                                     loop, cohfrac/sim.h; 0 from cf_world_memory) */
+} cf_memory;
+
+void cf_world_memory(const cf_world *sim, cf_memory *m);
+
+/* The fracture-mode step so far, for benchmarks: steps taken, wall time
+ * per stage (s, as in the run summary), and the sizes of what the step
+ * works on now (fracture-mode fragments only). */
+typedef struct cf_step_stats {
+    long fracture_steps;
+    double stress, insertion, forces, pbd; /* s of wall time since creation */
+    int tets, nodes, bars, cohesive;       /* in fracture mode now */
+    int iterations;                        /* constraint iterations per step */
+    int check;                             /* 1: the insertion criterion is checked */
+    int xpbd;                              /* 1: XPBD bars (compliance, multipliers) */
+} cf_step_stats;
+
+void cf_world_step_stats(const cf_world *sim, cf_step_stats *out);
+
+/* The traffic model (docs/performance.md): the bytes one fracture-mode
+ * step must move between memory and the cores at the least, each array
+ * the step needs read or written once per pass that needs it, from the
+ * sizes in `st`:
+ *   per tet:  node indices 16 + inverse rest shape 72 + volume 8 + rotation
+ *             warm start read and written 64 + strain energy 8 = 168 B;
+ *             plus, when the criterion is checked, the stress written
+ *             72 B and read back 72 B by the criterion
+ *   per node: position and velocity read and written 96 + lumped mass 8 =
+ *             104 B, and the prediction read and written in every
+ *             constraint iteration, 48 B each
+ *   per bar:  node pair 8 + rest length 8 read in every constraint
+ *             iteration; XPBD also compliance 8 and the multiplier read
+ *             and written 16
+ *   per cohesive element: its state read and written, 2 sizeof(cf_cohesive)
+ * Returns bytes per step. */
+double cf_step_traffic(const cf_step_stats *st);
+
+/* One cohesive element (crack facet) now. */
+typedef struct cf_crack_row {
+    double time;             /* s */
+    int element;             /* cohesive element index (order of insertion) */
+    double centroid[3];      /* m, mid-surface centre */
+    double normal[3];        /* unit, mid-surface normal from side A to side B */
+    double area;             /* m^2, mid-surface */
+    double opening;          /* m, normal opening, mean of its three node pairs */
+    double sliding;          /* m, tangential opening, the same mean */
+    int failed;              /* 1: every node pair has failed (a free crack face) */
+} cf_crack_row;
+
+/* Number of cohesive elements, and element e's state (0 <= e < count). */
+int cf_world_cohesive_count(const cf_world *w);
+void cf_world_crack(const cf_world *w, int e, cf_crack_row *out);
+
+/* Crack area now, m^2 (cf_solid_crack_area). */
+double cf_world_crack_area(const cf_world *w);
+
+/* The initial state's bounds, for readers that check a run's outcome
+ * (tools/check_physics.py): the box around the nodes (m), total mass (kg),
+ * kinetic + strain energy (J), fastest node (m/s), fastest kinematic
+ * obstacle or prescribed velocity (m/s). */
+typedef struct cf_initial_bounds {
+    double lower[3], upper[3];
+    double mass, energy, max_speed, max_obstacle_speed;
+} cf_initial_bounds;
+
+void cf_world_initial_bounds(const cf_world *w, cf_initial_bounds *out);
+
+/* Figures for a run summary: sizes, steps per mode, fragments, hand-offs,
+ * the convex decomposition of the rigid fragments alive now, and the wall
+ * time each stage of the step took since create (s). */
+typedef struct cf_world_stats {
+    int tets, nodes_input, nodes;       /* nodes after duplication */
+    double dt_fracture, dt_cfl, dt_outer;/* s */
+    long steps_rigid, steps_fracture;
+    int threads;
+    int alive, in_fracture, ever;       /* fragments */
+    int cohesive;
+    int handoffs;
+    double max_momentum_error, handoff_loss; /* relative; J */
+    int rigid_with_hulls, hulls;        /* Bullet bodies alive and their hulls */
+    double hull_error_median, hull_error_worst; /* hull volume / tet volume - 1 */
+    double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s */
+} cf_world_stats;
+
+void cf_world_stats_get(const cf_world *w, cf_world_stats *out);
+
+/* The world's copy of its definition (settings, obstacles, boundary
+ * conditions; no bodies: they are used up at create). */
+const cf_world_def *cf_world_definition(const cf_world *w);
+
+void cf_world_destroy(cf_world *w);
+
+#endif

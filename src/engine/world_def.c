@@ -1,0 +1,283 @@
+/* World definitions: the defaults of every setting (the scene schema's,
+ * cohfrac/scene.h) and the check cf_world_create runs on what a program or
+ * the scene loader filled in. */
+#include "cohfrac/types.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cf_mesh_free(cf_mesh *m)
+{
+    if (!m)
+        return;
+    free(m->x);
+    free(m->tets);
+    for (int g = 0; g < m->n_groups && m->groups; g++)
+        free(m->groups[g].nodes);
+    free(m->groups);
+    memset(m, 0, sizeof *m);
+}
+
+cf_material cf_default_material(void)
+{
+    cf_material m;
+    memset(&m, 0, sizeof m);
+    m.E = 1e6, m.nu = 0.3, m.rho = 2400.0;
+    m.G_I = m.G_II = 22.0;
+    m.sigma_max = m.tau_max = 1e4;
+    m.alpha = m.beta = 2.0;
+    m.friction = 0.5, m.restitution = 0.0;
+    m.weibull = 0, m.weibull_modulus = 10.0, m.strength_seed = 1;
+    return m;
+}
+
+cf_solver_settings cf_default_solver(void)
+{
+    cf_solver_settings s;
+    memset(&s, 0, sizeof s);
+    s.mode = CF_RUN_HYBRID;
+    s.rigid_backend = CF_RIGID_BULLET;
+    s.dt_rigid = 1e-3, s.rigid_substeps = 5;
+    s.dt_fracture = 5e-6, s.cfl_fraction = 0.0;
+    s.check_interval = 1, s.quiet_steps = 400;
+    s.max_fracture_time = 0.05, s.impact_threshold = 0.2;
+    s.ccd = 1;
+    s.elasticity = CF_ELASTICITY_COROTATIONAL;
+    s.criterion = CF_CRITERION_TRACTION;
+    s.crack_plane_normal[2] = 1.0, s.crack_plane_tolerance = 1e-6;
+    s.constraints = CF_CONSTRAINTS_PBD;
+    s.k_stiffness = 0.9, s.iterations = 3, s.k_damping = 1.0;
+    s.compliance_scale = 1.0;
+    s.max_inverted_fraction = 0.01, s.max_energy_growth = 0.5;
+    return s;
+}
+
+cf_output_settings cf_default_output(void)
+{
+    cf_output_settings o;
+    memset(&o, 0, sizeof o);
+    o.frame_interval = 0.01;
+    return o;
+}
+
+cf_body_def cf_default_body(void)
+{
+    cf_body_def b;
+    memset(&b, 0, sizeof b);
+    b.scale = 1.0;
+    b.orientation[0] = 1.0;
+    return b;
+}
+
+cf_obstacle cf_default_obstacle(cf_obstacle_type type)
+{
+    cf_obstacle o;
+    memset(&o, 0, sizeof o);
+    o.type = type;
+    o.normal[2] = 1.0;
+    o.scale = 1.0;
+    o.orientation[0] = 1.0;
+    o.friction = o.restitution = 1.0;
+    return o;
+}
+
+cf_world_def cf_default_world_def(void)
+{
+    cf_world_def d;
+    memset(&d, 0, sizeof d);
+    snprintf(d.name, sizeof d.name, "scene");
+    d.duration = 1.0;
+    d.gravity[2] = -9.81;
+    d.material = cf_default_material();
+    d.solver = cf_default_solver();
+    d.output = cf_default_output();
+    return d;
+}
+
+/* An allowed interval, worded as the scene loader words it. */
+typedef struct interval {
+    double lo, hi;
+    int lo_closed, hi_closed;
+} interval;
+
+static const interval POSITIVE = {0.0, INFINITY, 0, 0};
+static const interval NON_NEGATIVE = {0.0, INFINITY, 1, 0};
+static const interval AT_LEAST_ONE = {1.0, INFINITY, 1, 0};
+static const interval UNIT = {0.0, 1.0, 1, 1};
+static const interval POISSON = {-1.0, 0.5, 0, 0};
+static const interval PPR_SHAPE = {1.0, INFINITY, 0, 0};
+
+static cf_status in_interval(const char *key, double v, const interval *r, cf_error *err)
+{
+    int ok = (r->lo_closed ? v >= r->lo : v > r->lo) && (r->hi_closed ? v <= r->hi : v < r->hi);
+    if (ok)
+        return CF_OK;
+    char rule[96];
+    if (isinf(r->hi))
+        snprintf(rule, sizeof rule, "%s %g", r->lo_closed ? ">=" : ">", r->lo);
+    else
+        snprintf(rule, sizeof rule, "in %c%g, %g%c", r->lo_closed ? '[' : '(', r->lo, r->hi,
+                 r->hi_closed ? ']' : ')');
+    return cf_error_set(err, CF_ERR_SCENE_VALUE, "'%s' must be %s, got %.17g", key, rule, v);
+}
+
+#define CHECK(key, value, range)                                                             \
+    do {                                                                                     \
+        cf_status st_ = in_interval(key, (double)(value), &(range), err);                    \
+        if (st_ != CF_OK)                                                                    \
+            return st_;                                                                      \
+    } while (0)
+
+static cf_status check_unit(const char *key, const double *v, int n, cf_error *err)
+{
+    double q = 0;
+    for (int i = 0; i < n; i++)
+        q += v[i] * v[i];
+    if (fabs(q - 1.0) > 1e-9)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'%s' must be a unit %s (length 1), got length %.17g", key,
+                            n == 4 ? "quaternion" : "vector", sqrt(q));
+    return CF_OK;
+}
+
+static cf_status check_mesh(int b, const cf_mesh *m, cf_error *err)
+{
+    if (!m)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'bodies[%d].tet_mesh' is not set: give the body a Tet4 mesh, or "
+                            "let mesh preparation make it (cf_world_meshes_load)",
+                            b + 1);
+    if (m->n_nodes < 4 || m->n_tets < 1 || !m->x || !m->tets)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'bodies[%d].tet_mesh' is empty (%d nodes, %d tets)", b + 1, m->n_nodes,
+                            m->n_tets);
+    for (int i = 0; i < 4 * m->n_tets; i++)
+        if (m->tets[i] < 0 || m->tets[i] >= m->n_nodes)
+            return cf_error_set(err, CF_ERR_MESH_INDEX,
+                                "bodies[%d].tet_mesh: tet %d uses node %d, outside [0, %d)", b + 1,
+                                i / 4, m->tets[i], m->n_nodes);
+    return CF_OK;
+}
+
+static cf_status check_obstacle(int j, const cf_obstacle *o, cf_error *err)
+{
+    char key[96];
+#define OKEY(name) (snprintf(key, sizeof key, "obstacles[%d].%s", j + 1, name), key)
+    cf_status st = CF_OK;
+    switch (o->type) {
+    case CF_OBSTACLE_PLANE:
+        st = check_unit(OKEY("normal"), o->normal, 3, err);
+        break;
+    case CF_OBSTACLE_SPHERE:
+        CHECK(OKEY("radius"), o->radius, POSITIVE);
+        break;
+    case CF_OBSTACLE_BOX:
+        for (int k = 0; k < 3; k++)
+            CHECK(OKEY("half_extents"), o->half_extents[k], POSITIVE);
+        break;
+    case CF_OBSTACLE_MESH:
+        CHECK(OKEY("scale"), o->scale, POSITIVE);
+        st = check_unit(OKEY("orientation"), o->orientation, 4, err);
+        if (st == CF_OK && (!o->vertices || !o->triangles || o->n_triangles < 1))
+            st = cf_error_set(err, CF_ERR_SCENE_VALUE,
+                              "'obstacles[%d]' (mesh %s) has no triangle: give vertices and "
+                              "triangles, or let mesh preparation read `file` "
+                              "(cf_world_meshes_load)",
+                              j + 1, o->file[0] ? o->file : "without a file");
+        for (int i = 0; st == CF_OK && i < 3 * o->n_triangles; i++)
+            if (o->triangles[i] < 0 || o->triangles[i] >= o->n_vertices)
+                st = cf_error_set(err, CF_ERR_SCENE_VALUE,
+                                  "obstacles[%d]: triangle %d uses vertex %d, outside [0, %d)",
+                                  j + 1, i / 3, o->triangles[i], o->n_vertices);
+        break;
+    default:
+        return cf_error_set(err, CF_ERR_SCENE_VALUE, "'obstacles[%d].type' is not a known type",
+                            j + 1);
+    }
+    if (st != CF_OK)
+        return st;
+    CHECK(OKEY("friction"), o->friction, NON_NEGATIVE);
+    CHECK(OKEY("restitution"), o->restitution, NON_NEGATIVE);
+#undef OKEY
+    return CF_OK;
+}
+
+cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
+{
+    const cf_material *m = &d->material;
+    const cf_solver_settings *s = &d->solver;
+    CHECK("duration", d->duration, POSITIVE);
+    CHECK("material.E", m->E, POSITIVE);
+    CHECK("material.nu", m->nu, POISSON);
+    CHECK("material.rho", m->rho, POSITIVE);
+    CHECK("material.G_I", m->G_I, POSITIVE);
+    CHECK("material.G_II", m->G_II, POSITIVE);
+    CHECK("material.sigma_max", m->sigma_max, POSITIVE);
+    CHECK("material.tau_max", m->tau_max, POSITIVE);
+    CHECK("material.alpha", m->alpha, PPR_SHAPE);
+    CHECK("material.beta", m->beta, PPR_SHAPE);
+    CHECK("material.friction", m->friction, NON_NEGATIVE);
+    CHECK("material.restitution", m->restitution, UNIT);
+    CHECK("material.strength.modulus", m->weibull_modulus, POSITIVE);
+    CHECK("solver.dt_rigid", s->dt_rigid, POSITIVE);
+    CHECK("solver.rigid_substeps", s->rigid_substeps, AT_LEAST_ONE);
+    CHECK("solver.dt_fracture", s->dt_fracture, POSITIVE);
+    if (s->dt_fracture > s->dt_rigid)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'solver.dt_fracture' must not exceed solver.dt_rigid (%g), got %g",
+                            s->dt_rigid, s->dt_fracture);
+    CHECK("solver.cfl_fraction", s->cfl_fraction, NON_NEGATIVE);
+    CHECK("solver.check_interval", s->check_interval, AT_LEAST_ONE);
+    CHECK("solver.quiet_steps", s->quiet_steps, AT_LEAST_ONE);
+    CHECK("solver.max_fracture_time", s->max_fracture_time, POSITIVE);
+    CHECK("solver.impact_threshold", s->impact_threshold, NON_NEGATIVE);
+    CHECK("solver.sleeping.linear", s->sleep_linear, NON_NEGATIVE);
+    CHECK("solver.sleeping.angular", s->sleep_angular, NON_NEGATIVE);
+    CHECK("solver.pbd.k_stiffness", s->k_stiffness, UNIT);
+    CHECK("solver.pbd.iterations", s->iterations, AT_LEAST_ONE);
+    CHECK("solver.pbd.k_damping", s->k_damping, UNIT);
+    CHECK("solver.xpbd.compliance_scale", s->compliance_scale, POSITIVE);
+    CHECK("solver.contact_stiffness", s->contact_stiffness, NON_NEGATIVE);
+    CHECK("solver.guard.max_inverted_fraction", s->max_inverted_fraction, UNIT);
+    CHECK("solver.guard.max_energy_growth", s->max_energy_growth, POSITIVE);
+    CHECK("solver.threads", s->threads, NON_NEGATIVE);
+    CHECK("output.frame_interval", d->output.frame_interval, POSITIVE);
+    if (s->has_crack_plane) {
+        cf_status st = check_unit("solver.crack_plane.normal", s->crack_plane_normal, 3, err);
+        if (st != CF_OK)
+            return st;
+        CHECK("solver.crack_plane.tolerance", s->crack_plane_tolerance, POSITIVE);
+    }
+    if (d->n_bodies < 1 || !d->bodies)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'bodies' is empty; a scene needs at least one body");
+    for (int b = 0; b < d->n_bodies; b++) {
+        char key[64];
+        snprintf(key, sizeof key, "bodies[%d].scale", b + 1);
+        CHECK(key, d->bodies[b].scale, POSITIVE);
+        snprintf(key, sizeof key, "bodies[%d].orientation", b + 1);
+        cf_status st = check_unit(key, d->bodies[b].orientation, 4, err);
+        if (st == CF_OK)
+            st = check_mesh(b, d->bodies[b].tet_mesh, err);
+        if (st != CF_OK)
+            return st;
+    }
+    for (int j = 0; j < d->n_obstacles; j++) {
+        cf_status st = check_obstacle(j, &d->obstacles[j], err);
+        if (st != CF_OK)
+            return st;
+    }
+    if (d->n_boundaries > 0 && s->mode != CF_RUN_FRACTURE)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'boundary' has %d entries but solver.mode is not \"fracture\": "
+                            "boundary conditions need solver.mode = \"fracture\"",
+                            d->n_boundaries);
+    for (int c = 0; c < d->n_boundaries; c++)
+        if (d->boundaries[c].body >= d->n_bodies)
+            return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                                "'boundary[%d].body' must be in [1, %d], got %d", c + 1,
+                                d->n_bodies, d->boundaries[c].body + 1);
+    return CF_OK;
+}

@@ -1,0 +1,418 @@
+/* The run loop: a world stepped to its duration, its events turned into
+ * HDF5 rows and progress lines, a frame every output.frame_interval. */
+#include "cohfrac/sim.h"
+
+#include "clock.h"
+#include "cohfrac/h5_output.h"
+#include "cohfrac/surface.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+struct cf_sim {
+    cf_world *world;
+    cf_world_meshes meshes;
+    cf_run_options opt;
+    char name[128];
+    double duration;            /* s */
+    cf_output_settings output;
+    cf_h5 *h5;                  /* NULL when no output is asked for */
+    double next_frame;          /* s */
+    double wall_start;          /* s, wall clock at create */
+    double loop_start;          /* s, wall clock at the first step */
+    double last_progress;       /* s, wall clock of the last progress display */
+    int bar_shown;              /* a progress bar is on the terminal's last line */
+    double output_time;         /* s of wall time writing the file */
+    unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
+};
+
+cf_world *cf_sim_world(const cf_sim *sim) { return sim->world; }
+
+int cf_sim_done(const cf_sim *sim) { return cf_world_done(sim->world); }
+
+static int tty(void) { return isatty(STDERR_FILENO); }
+
+/* A line above the progress bar (the bar is redrawn at the next update). */
+static void event_line(cf_sim *sim, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void event_line(cf_sim *sim, const char *fmt, ...)
+{
+    if (!sim->opt.progress)
+        return;
+    if (sim->bar_shown)
+        fputs("\r\033[K", stderr);
+    sim->bar_shown = 0;
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    sim->last_progress = 0; /* redraw the bar at once */
+}
+
+/* Fragment records, hand-off rows and event lines for what the world did. */
+static cf_status drain_events(cf_sim *sim, cf_error *err)
+{
+    int n;
+    const cf_event *ev = cf_world_events(sim->world, &n);
+    cf_status st = CF_OK;
+    for (int i = 0; i < n && st == CF_OK; i++) {
+        const cf_event *e = &ev[i];
+        if (e->type == CF_EVENT_FRAGMENTS && sim->h5) {
+            cf_frag_info *info = calloc((size_t)e->count, sizeof *info);
+            if (!info)
+                return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+            for (int k = 0; k < e->count; k++)
+                cf_world_fragment_info(sim->world, e->first + k, &info[k]);
+            st = cf_h5_add_fragments(sim->h5, info, e->count, err);
+            free(info);
+        } else if (e->type == CF_EVENT_HANDOFF) {
+            const cf_handoff_record *r = &e->handoff;
+            event_line(sim,
+                       "hand-off t=%.4f s: fragment %d %s, linear momentum error %.2e, "
+                       "handoff_loss %.4g J, %d fragments alive",
+                       r->time, r->fragment, r->direction ? "fracture -> rigid" : "rigid -> fracture",
+                       r->momentum_error, r->handoff_loss, e->alive);
+            if (sim->h5)
+                st = cf_h5_add_handoff(sim->h5, r, err);
+        }
+    }
+    cf_world_clear_events(sim->world);
+    return st;
+}
+
+/* What a reader needs to bound the run's outcome (tools/check_physics.py). */
+static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
+{
+    cf_initial_bounds b;
+    cf_world_initial_bounds(sim->world, &b);
+    const struct {
+        const char *name;
+        const double *v;
+        int n;
+        const char *unit;
+    } p[] = {{"initial_lower", b.lower, 3, "m"},
+             {"initial_upper", b.upper, 3, "m"},
+             {"total_mass", &b.mass, 1, "kg"},
+             {"initial_energy", &b.energy, 1, "J"},
+             {"max_initial_speed", &b.max_speed, 1, "m/s"},
+             {"max_obstacle_speed", &b.max_obstacle_speed, 1, "m/s"}};
+    cf_status st = CF_OK;
+    for (size_t i = 0; i < sizeof p / sizeof p[0] && st == CF_OK; i++)
+        st = cf_h5_write_parameter(sim->h5, p[i].name, p[i].v, p[i].n, p[i].unit, err);
+    return st;
+}
+
+cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
+                        cf_error *err)
+{
+    *out = NULL;
+    cf_sim *sim = calloc(1, sizeof *sim);
+    if (!sim)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    sim->opt = *opt;
+    sim->wall_start = cf_wall_time();
+    snprintf(sim->name, sizeof sim->name, "%s", def->name);
+    sim->duration = def->duration;
+    sim->output = def->output;
+    /* The world reads a copy whose meshes point at what mesh preparation made. */
+    cf_world_def w = *def;
+    size_t nb = (size_t)def->n_bodies, no = (size_t)def->n_obstacles;
+    w.bodies = malloc((nb + 1) * sizeof *w.bodies);
+    w.obstacles = malloc((no + 1) * sizeof *w.obstacles);
+    cf_status st = w.bodies && w.obstacles ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    if (st == CF_OK) {
+        memcpy(w.bodies, def->bodies, nb * sizeof *w.bodies);
+        memcpy(w.obstacles, def->obstacles, no * sizeof *w.obstacles);
+        if (opt->threads > 0)
+            w.solver.threads = opt->threads;
+        st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
+    }
+    if (st == CF_OK)
+        st = cf_world_create(&w, &sim->world, err);
+    free(w.bodies), free(w.obstacles);
+    if (st == CF_OK && def->output.file[0]) {
+        st = cf_h5_open(def->output.file, def->name, def->resolved, &sim->h5, err);
+        if (st == CF_OK)
+            st = write_initial_bounds(sim, err);
+    }
+    if (st == CF_OK)
+        st = drain_events(sim, err);
+    if (st != CF_OK) {
+        cf_sim_destroy(sim);
+        return st;
+    }
+    *out = sim;
+    return CF_OK;
+}
+
+void cf_sim_destroy(cf_sim *sim)
+{
+    if (!sim)
+        return;
+    if (sim->h5)
+        cf_h5_close(sim->h5, NULL);
+    cf_world_destroy(sim->world);
+    cf_world_meshes_free(&sim->meshes);
+    free(sim);
+}
+
+static cf_status write_cracks(cf_sim *sim, cf_error *err)
+{
+    int n = cf_world_cohesive_count(sim->world);
+    cf_crack_row *rows = malloc((size_t)(n > 0 ? n : 1) * sizeof *rows);
+    if (!rows)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory writing %d crack rows", n);
+    for (int e = 0; e < n; e++)
+        cf_world_crack(sim->world, e, &rows[e]);
+    cf_status st = cf_h5_add_cracks(sim->h5, rows, n, err);
+    free(rows);
+    return st;
+}
+
+static cf_status write_frame(cf_sim *sim, cf_error *err)
+{
+    if (!sim->h5)
+        return CF_OK;
+    double t0 = cf_wall_time();
+    cf_world *w = sim->world;
+    int cap = cf_world_fragments_ever(w);
+    cf_fragment_state *fs = malloc((size_t)(cap > 0 ? cap : 1) * sizeof *fs);
+    cf_frag_frame *fr = malloc((size_t)(cap > 0 ? cap : 1) * sizeof *fr);
+    if (!fs || !fr) {
+        free(fs), free(fr);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    int n = cf_world_fragments(w, fs, cap), n_fracture = 0;
+    for (int i = 0; i < n; i++) {
+        cf_frag_frame *o = &fr[i];
+        o->id = fs[i].id;
+        o->mode = fs[i].mode;
+        memcpy(o->com, fs[i].com, sizeof o->com);
+        memcpy(o->quat, fs[i].quat, sizeof o->quat);
+        memcpy(o->v, fs[i].v, sizeof o->v);
+        memcpy(o->w, fs[i].w, sizeof o->w);
+        n_fracture += fs[i].mode == 1;
+    }
+    double t = cf_world_time(w);
+    long step = cf_world_step_count(w);
+    cf_status st = cf_h5_write_frame(sim->h5, step, t, fr, n, err);
+    free(fs), free(fr);
+    unsigned long long mem = cf_h5_memory(sim->h5);
+    sim->output_peak = mem > sim->output_peak ? mem : sim->output_peak;
+    cf_world_stats ws;
+    cf_world_stats_get(w, &ws);
+    cf_ledger l;
+    cf_world_ledger(w, &l);
+    const struct {
+        const char *name;
+        double value;
+    } obs[] = {
+        {"energy_kinetic", l.kinetic},
+        {"energy_strain", l.strain},
+        {"energy_cohesive_stored", l.cohesive_stored},
+        {"energy_cohesive_dissipated", l.cohesive_dissipated},
+        {"work_gravity", l.work_gravity},
+        {"work_boundary", l.work_boundary},
+        {"work_obstacles", l.work_obstacles},
+        {"energy_contact_removed", l.contact},
+        {"energy_rigid_integration_removed", l.integration},
+        {"energy_pbd_removed", l.pbd},
+        {"energy_damping_removed", l.damping},
+        {"energy_handoff_loss", l.handoff},
+        {"energy_residual", l.residual},
+        {"momentum_x", l.momentum[0]},
+        {"momentum_y", l.momentum[1]},
+        {"momentum_z", l.momentum[2]},
+        {"angular_momentum_x", l.angular_momentum[0]},
+        {"angular_momentum_y", l.angular_momentum[1]},
+        {"angular_momentum_z", l.angular_momentum[2]},
+        {"fragment_count", n},
+        {"cohesive_elements", ws.cohesive},
+        {"crack_area", cf_world_crack_area(w)},
+        {"fragments_in_fracture_mode", n_fracture},
+        {"handoff_momentum_error_max", ws.max_momentum_error},
+    };
+    for (size_t i = 0; i < sizeof obs / sizeof obs[0] && st == CF_OK; i++)
+        st = cf_h5_write_observable(sim->h5, obs[i].name, step, t, obs[i].value, err);
+    if (st == CF_OK && sim->output.cracks)
+        st = write_cracks(sim, err);
+    sim->output_time += cf_wall_time() - t0;
+    return st;
+}
+
+/* Progress: simulated time, mode, fragments and an ETA from the measured
+ * wall time per rigid step so far. */
+static void progress(cf_sim *sim, int final)
+{
+    if (!sim->opt.progress)
+        return;
+    double now = cf_wall_time();
+    int term = tty();
+    if (!final && now - sim->last_progress < (term ? 0.2 : 10.0))
+        return;
+    sim->last_progress = now;
+    cf_world *w = sim->world;
+    long done = cf_world_step_count(w), total = cf_world_steps_total(w);
+    double frac = total > 0 ? fmin(1.0, (double)done / (double)total) : 1.0;
+    double eta = done > 0 ? (now - sim->loop_start) / (double)done * (double)(total - done) : 0;
+    cf_world_stats ws;
+    cf_world_stats_get(w, &ws);
+    double t = fmin(cf_world_time(w), sim->duration);
+    const char *mode = ws.in_fracture ? "fracture" : "rigid";
+    if (term) {
+        char bar[31];
+        int fill = (int)(30 * frac);
+        for (int i = 0; i < 30; i++)
+            bar[i] = i < fill ? '#' : '.';
+        bar[30] = 0;
+        fprintf(stderr, "\r\033[K[%s] t=%.4f/%.4g s  %-8s  fragments %d  cohesive %d  ETA %.0f s",
+                bar, t, sim->duration, mode, ws.alive, ws.cohesive, fmax(0.0, eta));
+        sim->bar_shown = !final;
+        if (final)
+            fputc('\n', stderr);
+    } else {
+        fprintf(stderr, "t=%.4f/%.4g s (%3.0f%%)  %s  fragments %d  cohesive %d  ETA %.0f s\n",
+                t, sim->duration, 100 * frac, mode, ws.alive, ws.cohesive, fmax(0.0, eta));
+    }
+}
+
+cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
+{
+    if (sim->loop_start == 0)
+        sim->loop_start = cf_wall_time();
+    cf_world *w = sim->world;
+    cf_status st = cf_world_step(w, err);
+    cf_status st2 = drain_events(sim, st == CF_OK ? err : NULL);
+    if (st == CF_OK)
+        st = st2;
+    double t = cf_world_time(w), dt = cf_world_dt_outer(w);
+    if (st == CF_OK && (t >= sim->next_frame - 1e-9 * dt || cf_world_done(w))) {
+        st = write_frame(sim, err);
+        while (sim->next_frame <= t + 1e-9 * dt)
+            sim->next_frame += sim->output.frame_interval;
+    }
+    progress(sim, 0);
+    return st;
+}
+
+cf_status cf_sim_run(cf_sim *sim, cf_error *err)
+{
+    cf_world_stats ws;
+    cf_world_stats_get(sim->world, &ws);
+    if (sim->opt.progress)
+        fprintf(stderr, "cohfrac: %d nodes, %d tets, %d fragment(s); dt_cfl = %.4g s, "
+                        "dt_fracture/dt_cfl = %.4g, dt_rigid/dt_cfl = %.4g\n",
+                ws.nodes, ws.tets, ws.alive, ws.dt_cfl, ws.dt_fracture / ws.dt_cfl,
+                ws.dt_outer / ws.dt_cfl);
+    cf_status st = write_frame(sim, err);
+    sim->next_frame = sim->output.frame_interval;
+    while (st == CF_OK && !cf_sim_done(sim))
+        st = cf_sim_advance(sim, err);
+    progress(sim, 1);
+    cf_error cerr;
+    if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK && st == CF_OK) {
+        *err = cerr;
+        st = cerr.code;
+    }
+    sim->h5 = NULL;
+    return st;
+}
+
+void cf_sim_memory(const cf_sim *sim, cf_memory *m)
+{
+    cf_world_memory(sim->world, m);
+    m->output = sim->output_peak;
+}
+
+static void print_memory(const cf_sim *sim, FILE *out)
+{
+    cf_memory m;
+    cf_sim_memory(sim, &m);
+    const struct {
+        const char *name;
+        unsigned long long bytes;
+    } part[] = {{"solid", m.solid},       {"fracture state", m.fracture},
+                {"cohesive", m.cohesive}, {"fragments", m.fragments},
+                {"Bullet world", m.bullet}, {"FCL meshes", m.collision},
+                {"HDF5 output", m.output}};
+    fprintf(out, "memory (MiB)      ");
+    for (size_t i = 0; i < sizeof part / sizeof part[0]; i++) {
+        fprintf(out, "%s%s ", i ? " | " : "", part[i].name);
+        if (part[i].bytes)
+            fprintf(out, "%.3g", part[i].bytes / 1048576.0);
+        else
+            fputs("none", out);
+    }
+    fputc('\n', out);
+}
+
+void cf_sim_print_summary(const cf_sim *sim, FILE *out)
+{
+    const cf_world *w = sim->world;
+    const cf_world_def *d = cf_world_definition(w);
+    cf_world_stats p;
+    cf_world_stats_get(w, &p);
+    double wall = cf_wall_time() - sim->wall_start;
+    fprintf(out, "\n== cohfrac summary: %s ==\n", sim->name);
+    static const char *constraints[] = {"pbd", "xpbd", "none"};
+    fprintf(out, "simulated time     %.4g s in %ld rigid steps (dt_rigid %.3g s, backend %s)\n",
+            cf_world_time(w), cf_world_step_count(w), p.dt_outer,
+            d->solver.mode == CF_RUN_FRACTURE ? "none: fracture mode only"
+            : d->solver.rigid_backend == CF_RIGID_BULLET ? "bullet" : "pbd");
+    fprintf(out, "constraints        %s\n", constraints[d->solver.constraints]);
+    fprintf(out, "mesh               %d tets, %d nodes (%d after duplication)\n", p.tets,
+            p.nodes_input, p.nodes);
+    fprintf(out, "time step          dt_fracture %.3g s = %.4g dt_cfl (dt_cfl %.4g s)\n",
+            p.dt_fracture, p.dt_fracture / p.dt_cfl, p.dt_cfl);
+    fprintf(out, "steps per mode     rigid %ld, fracture %ld (threads %d)\n", p.steps_rigid,
+            p.steps_fracture, p.threads);
+    fprintf(out, "fragments          %d alive (%d in fracture mode), %d ever\n", p.alive,
+            p.in_fracture, p.ever);
+    fprintf(out, "cohesive elements  %d\n", p.cohesive);
+    fprintf(out, "hand-offs          %d, max linear momentum error %.3g (relative), "
+                 "handoff_loss %.4g J\n",
+            p.handoffs, p.max_momentum_error, p.handoff_loss);
+    if (p.rigid_with_hulls > 0)
+        fprintf(out, "convex hulls       %d over %d rigid fragments; hull volume / tet volume - 1: "
+                     "median %.3g, worst %.3g; decomposition %.2f s (%.1f%% of wall time)\n",
+                p.hulls, p.rigid_with_hulls, p.hull_error_median, p.hull_error_worst, p.decompose,
+                100 * p.decompose / fmax(wall, 1e-300));
+    print_memory(sim, out);
+    double staged = p.rigid + p.stress + p.insertion + p.forces + p.pbd + p.bodies + p.handoff +
+                    sim->output_time;
+    cf_ledger l;
+    cf_world_ledger(w, &l);
+    double scale = fmax(fabs(l.initial) + fabs(l.work_gravity) + fabs(l.work_boundary) +
+                            fabs(l.work_obstacles),
+                        1e-300);
+    fprintf(out, "energy ledger (J)  kinetic %.6g | strain %.6g | cohesive stored %.6g | "
+                 "cohesive dissipated %.6g\n",
+            l.kinetic, l.strain, l.cohesive_stored, l.cohesive_dissipated);
+    fprintf(out, "                   initial %.6g | work: gravity %.6g, boundary %.6g, "
+                 "moving obstacles %.6g\n",
+            l.initial, l.work_gravity, l.work_boundary, l.work_obstacles);
+    fprintf(out, "                   removed: contact %.6g, PBD %.6g, damping %.6g, hand-off %.6g, "
+                 "rigid integration %.6g\n",
+            l.contact, l.pbd, l.damping, l.handoff, l.integration);
+    fprintf(out, "                   residual %.4g J = %.3g of initial + work\n", l.residual,
+            l.residual / scale);
+    fprintf(out, "momentum           P = (%.6g, %.6g, %.6g) kg m/s, L = (%.6g, %.6g, %.6g) kg m^2/s\n",
+            l.momentum[0], l.momentum[1], l.momentum[2], l.angular_momentum[0],
+            l.angular_momentum[1], l.angular_momentum[2]);
+    fprintf(out, "state hash         %016llx (FNV-1a of the final state)\n",
+            (unsigned long long)cf_world_state_hash(w));
+    fprintf(out, "wall time          %.2f s\n", wall);
+    fprintf(out, "  rigid step %.2f s | stress %.2f s | insertion %.2f s | forces %.2f s | "
+                 "PBD %.2f s | contact between bodies %.2f s | hand-off %.2f s | output %.2f s | "
+                 "other %.2f s\n",
+            p.rigid, p.stress, p.insertion, p.forces, p.pbd, p.bodies, p.handoff,
+            sim->output_time, wall - staged);
+    if (p.steps_fracture > 0)
+        fprintf(out, "per fracture step  %.3f ms\n",
+                1e3 * (p.stress + p.insertion + p.forces + p.pbd) / (double)p.steps_fracture);
+    if (sim->output.file[0])
+        fprintf(out, "output             %s\n", sim->output.file);
+}
