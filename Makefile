@@ -6,7 +6,7 @@ BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
 MESHES    := $(BUILD)/meshes
 JOBS      ?= 2
 
-.PHONY: all deps build meshes run test bench bench-scaling clean
+.PHONY: all deps build meshes run test bench bench-scaling install clean
 
 all: build
 
@@ -22,7 +22,7 @@ meshes: build
 	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_small --target-tets 15000
 
 run: meshes
-	$(BUILD)/cohfrac run scenes/bunny_drop.lua --mesh-dir $(MESHES)
+	$(BUILD)/cohfrac run scenes/bunny_drop.lua --mesh-dir $(MESHES) -o out/bunny_drop.h5
 	/usr/bin/python3 tools/check_run.py out/bunny_drop.h5
 	/usr/bin/python3 tools/check_physics.py out/bunny_drop.h5
 
@@ -36,6 +36,11 @@ bench-scaling: meshes
 	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_50k --target-tets 50000
 	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_800k --target-tets 800000
 	$(BUILD)/cohfrac bench --scaling -m $(MESHES)
+
+# The library, headers, program, pkg-config file and CMake package under PREFIX.
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure

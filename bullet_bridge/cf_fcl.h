@@ -1,6 +1,6 @@
 /* cohfrac — C face of FCL (the Flexible Collision Library) for point queries
  * against triangle meshes: mesh obstacles seen by fracture-mode nodes
- * (DESIGN §5), and the deforming surfaces of fracture-mode fragments of
+ * (docs/physics.md §9), and the deforming surfaces of fracture-mode fragments of
  * other bodies (contact_bodies.c).  The implementation is C++; no C++ type
  * or exception crosses this header.  Units SI (m).  Queries are thread-safe on a
  * built mesh (they do not modify it); cff_mesh_update is not. */

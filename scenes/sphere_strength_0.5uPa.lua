@@ -2,7 +2,7 @@
 -- breaks.  E = 100 Pa fixed; sigma_max = 0.5 uPa here, 5 mPa in
 -- sphere_strength_5mPa.lua (the pair differs in one value:
 -- --set material.sigma_max=...).  The Fig 6.11 caption prints 500 mPa for
--- this case, the text 0.5 uPa: we follow the text and DESIGN §8.  The source
+-- this case, the text 0.5 uPa: we follow the text and docs/scenes.md.  The source
 -- prints only E and sigma_max; the rest is the Fig 6.12 sphere's: nu 0.1,
 -- rho 2400 kg/m^3, G_I 22 N/m, alpha 2, dt 2 ms / 5 us, PBD k = 0.9,
 -- k_damping = 1, 3 iterations, insertion rule "source".  Geometry is ours:

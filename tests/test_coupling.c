@@ -1,4 +1,4 @@
-/* The hybrid's coupling (DESIGN §1, §5): momentum across fracture-mode
+/* The hybrid's coupling (docs/architecture.md, docs/physics.md §9): momentum across fracture-mode
  * contact with a Bullet body, re-entry of a fragment into fracture mode, and
  * bit-identical runs for any thread count. */
 #include <setjmp.h>

@@ -1,4 +1,4 @@
-/* Convex decomposition of fragments into tet-cluster hulls (DESIGN §5). */
+/* Convex decomposition of fragments into tet-cluster hulls (docs/physics.md §9). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

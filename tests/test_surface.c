@@ -545,7 +545,7 @@ static void test_decimate(void **state)
     cf_surface_free(&t);
 }
 
-/* The real input (DESIGN §9): the bunny of glmark2-data has exactly the
+/* The real input (docs/scenes.md): the bunny of glmark2-data has exactly the
  * two intersecting pairs tetgen -d reports (its facets 22950/69662 and
  * 69660/69662, 1-based), both made by one valence-3 vertex. */
 static void test_real_bunny_defect(void **state)

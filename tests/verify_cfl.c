@@ -1,4 +1,4 @@
-/* The CFL estimate is tight (DESIGN §3.2): the explicit solver with no PBD
+/* The CFL estimate is tight (docs/physics.md §3): the explicit solver with no PBD
  * (scenes/verification/wave_bar.lua) runs stable at dt = 0.9 dt_cfl, and at
  * dt = 3 dt_cfl the divergence guard stops it with CF_ERR_DIVERGED. */
 #include <setjmp.h>

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Plots of `cohfrac compare`: compare_plot.py COMPARE.csv OUT.png [TITLE]
 
-2x2 panels from the time series written by src/compare.c:
+2x2 panels from the time series written by src/cli/compare.c:
   COM distance (bullet vs pbd, each backend vs the analytic reference),
   orientation difference (and, for a symmetric top, the precession angle),
   kinetic-energy drift per backend, linear and angular momentum drifts.

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Heatmaps of `cohfrac stability`: stability_plot.py STABILITY.csv OUT.png
 
-One row of panels per slice of the map written by src/stability.c
+One row of panels per slice of the map written by src/cli/stability.c
 ("E x dt", "mass x dt", "speed x dt", "mesh x dt"), one panel per constraint mode; each
 cell is green when the case is stable and red when not, labelled with the
 criterion that failed first (n = nan, e = energy, i = inverted,

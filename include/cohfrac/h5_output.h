@@ -1,4 +1,4 @@
-/* cohfrac — HDF5 output (H5MD-style layout, DESIGN §7), readable by h5py and
+/* cohfrac — HDF5 output (H5MD-style layout, docs/output.md), readable by h5py and
  * ParaView (through the XDMF sidecar written next to the file).
  *
  * Layout (all SI; every dataset chunked and extendable, flushed each frame so

@@ -3,7 +3,7 @@
  * itself (cf_mesh) is the engine's, in cohfrac/tetmesh.h.
  *
  * A cf_mesh is a linear tetrahedral mesh in SI units (metres).  Tets are
- * positively oriented: det[x1-x0, x2-x0, x3-x0] > 0 (DESIGN §2).
+ * positively oriented: det[x1-x0, x2-x0, x3-x0] > 0 (docs/physics.md §1).
  */
 #ifndef COHFRAC_MESH_H
 #define COHFRAC_MESH_H

@@ -99,7 +99,7 @@
  *       must be > 0
  *     dt_fracture [5e-6] s, check_interval [1] steps, quiet_steps [400]
  *     cfl_fraction [0]: when > 0, dt_fracture = cfl_fraction x dt_cfl of the
- *       mesh (DESIGN §3.2) instead of the dt_fracture value
+ *       mesh (docs/physics.md §3) instead of the dt_fracture value
  *     max_fracture_time [0.05] s (a fragment returns to rigid mode after this
  *       long in fracture mode even if still cracking)
  *     impact_threshold [0.2] m/s: the normal contact impulse a rigid fragment
@@ -107,7 +107,7 @@
  *       velocity change contact gives it); when it reaches this value the
  *       fragment goes to fracture mode; default 0.2 m/s
  *     elasticity ["corotational"] | "linear"
- *     criterion ["traction"] | "source": cohesive insertion rule, DESIGN §3.3
+ *     criterion ["traction"] | "source": cohesive insertion rule, docs/physics.md §5
  *       (facet traction sigma_n >= sigma_max or tau >= tau_max; or the
  *       source's nodal-averaged max principal stress >= 0.9 sigma_max at all
  *       three facet nodes) | "none" (no insertion: elastic only)
@@ -131,7 +131,8 @@
  *       all work input by this fraction of their sum
  *     threads [0] (0: all cores)
  *   }
- *   output = { file ["out/<name>.h5"] ("" for none), frame_interval [0.01] s,
+ *   output = { file ["out/<name>.h5"] ("" for none; a relative path starts at
+ *              the scene file's directory, as mesh paths do), frame_interval [0.01] s,
  *              cracks [true with solver.mode = "fracture", else false]: write
  *              every cohesive element's centroid, normal, area, opening and
  *              state at each frame to /cracks }

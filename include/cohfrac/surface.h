@@ -41,7 +41,7 @@ cf_status cf_surface_write_off(const cf_surface *s, const char *path, cf_error *
  * as axis-aligned faces) and a uniform grid, O(n) for even meshes. */
 int cf_surface_self_intersections(const cf_surface *s, int *pairs, int max_pairs);
 
-/* Repair the defect class of DESIGN §9: a valence-3 vertex whose three
+/* Repair the defect class of docs/scenes.md: a valence-3 vertex whose three
  * triangles overlap their neighbours.  Such a vertex is removed and its three
  * triangles replaced by the one triangle of its three neighbours.  Only
  * vertices touching an intersecting pair are considered; a vertex is kept

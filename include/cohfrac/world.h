@@ -28,7 +28,7 @@ typedef struct cf_world cf_world;
  * Kinetic energy of the in-house solver is the leapfrog estimate
  * 1/2 sum m v(n-1/2).v(n+1/2) at the last force evaluation; Bullet bodies'
  * is 1/2 M v^2 + 1/2 w.I w.  `contact`, `pbd`, `damping`, `handoff` are
- * energies removed since t = 0 (see DESIGN §3-§6 and docs/physics.md);
+ * energies removed since t = 0 (see docs/physics.md §4-§9);
  * `integration` is what Bullet's integrator changed in bodies that touched
  * nothing during a rigid step (its implicit gyroscopic term: a free
  * spinning asymmetric body loses a little), never booked as contact. */
@@ -129,14 +129,14 @@ int cf_world_fragments_ever(const cf_world *w);
 double cf_world_time(const cf_world *sim);
 
 /* The fracture-mode step (solver.dt_fracture, or cfl_fraction x dt_cfl)
- * and the mesh's explicit stability limit dt_cfl (DESIGN §3.2), s. */
+ * and the mesh's explicit stability limit dt_cfl (docs/physics.md §3), s. */
 double cf_world_dt_fracture(const cf_world *sim);
 double cf_world_dt_cfl(const cf_world *sim);
 
 /* The energy ledger and momenta now. */
 void cf_world_ledger(const cf_world *sim, cf_ledger *out);
 
-/* One alive fragment's rigid state now (pose as DESIGN §2).  `kinetic` is
+/* One alive fragment's rigid state now (pose as docs/physics.md §1).  `kinetic` is
  * the kinetic energy of its nodes (fracture mode, pbd rigid backend) or of
  * its Bullet body; momenta are those of the same. */
 typedef struct cf_fragment_state {
@@ -166,6 +166,12 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap);
  * their tets.  -1 for t out of range. */
 int cf_world_tet_count(const cf_world *sim);
 int cf_world_tet_fragment(const cf_world *sim, int t);
+
+/* The four corners of tet t (input numbering) now, x[4][3] in m: the
+ * nodes of a fracture-mode or pbd-rigid fragment as they are, those of a
+ * Bullet body its rest shape moved by the body's pose.  Returns 0, or -1
+ * for t out of range. */
+int cf_world_tet_positions(const cf_world *sim, int t, double x[12]);
 
 /* Support distance of fragment `id` along unit direction d now: the largest
  * (R (X - X_cm)).d over its nodes, m, with X the rest positions and R the

@@ -6,7 +6,7 @@
 -- stiffness shows.  E = 100 Pa, nu = 0.1, rho = 2400 (the Fig 6.12 sphere's
 -- material; the source prints none here): dt is ~0.01 dt_cfl, so the bars,
 -- not the tets, hold the shape.  PBD 3 iterations.  The source prints the
--- Fig 6.7 step as "10e-4 s"; the series here runs at 5e-4 s (DESIGN §8).
+-- Fig 6.7 step as "10e-4 s"; the series here runs at 5e-4 s (docs/scenes.md).
 -- Series (same file but one value): k1_dt5e-4, k0.1_dt5e-4, k0.01_dt5e-4 (this);
 -- the dt pair (Fig 6.8): k1_dt1e-4 vs k1_dt5e-4.  Any one from another:
 --   --set solver.pbd.k_stiffness=0.1 --set solver.dt_fracture=1e-4

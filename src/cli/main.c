@@ -241,8 +241,12 @@ static int cmd_run(int argc, char **argv)
     char *out_set = NULL;
     int rc = parse_scene_args(argc, argv, "run", &a);
     if (rc == 0 && a.output) { /* -o FILE is --set output.file="FILE" in its place */
-        out_set = malloc(strlen(a.output) + 32);
-        sprintf(out_set, "output.file=[==[%s]==]", a.output);
+        /* A command-line path is relative to the working directory. */
+        char cwd[4096] = "";
+        if (a.output[0] && a.output[0] != '/' && !getcwd(cwd, sizeof cwd))
+            cwd[0] = '\0';
+        out_set = malloc(strlen(cwd) + strlen(a.output) + 32);
+        sprintf(out_set, "output.file=[==[%s%s%s]==]", cwd, cwd[0] ? "/" : "", a.output);
         memmove(&a.sets[a.output_at + 1], &a.sets[a.output_at],
                 (size_t)(a.n_sets - a.output_at) * sizeof *a.sets);
         a.sets[a.output_at] = out_set;

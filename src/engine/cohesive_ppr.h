@@ -1,4 +1,4 @@
-/* Extrinsic PPR cohesive law (DESIGN §3.5): Park, Paulino, Celes, Espinha
+/* Extrinsic PPR cohesive law (docs/physics.md §6): Park, Paulino, Celes, Espinha
  * 2012, IJNME 92:1-35 — the extrinsic (lambda -> 0) limit of the
  * Park-Paulino-Roesler potential, JMPS 57:891-908 (2009).
  *
@@ -43,7 +43,7 @@ void cf_ppr_traction(const cf_ppr *p, double dn, double dt, double *dn_max, doub
  * a penalty T_n = K_p Delta_n with K_p = kp Pa/m, capped per node pair so
  * that the pair is stable at step dt: K_p A/3 <= 1/(4 dt^2 (1/m_a + 1/m_b)),
  * a sixteenth of the two-mass limit, as a node pair may sit in ~8 elements
- * (DESIGN §3.5); kp = 0 means the cap; kp < 0: no penalty, for runs whose
+ * (docs/physics.md §6); kp = 0 means the cap; kp < 0: no penalty, for runs whose
  * PBD crack-contact constraint (cf_cohesive_project_contact) keeps the faces
  * apart.  The penalty's stiffness follows the cap, which changes with the
  * facet's area: on a pair that already overlaps it releases energy that no

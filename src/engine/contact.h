@@ -1,4 +1,4 @@
-/* Contact of fracture-mode nodes with rigid fragments (DESIGN §5): each node
+/* Contact of fracture-mode nodes with rigid fragments (docs/physics.md §9): each node
  * is a point pushed out of the convex hulls of the Bullet bodies near its
  * fragment (penetration by Minkowski portal refinement in libccd), and the impulse
  * that push gives the node goes back to the body, so linear momentum is

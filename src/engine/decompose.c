@@ -1,5 +1,5 @@
 /* Convex decomposition by recursive bisection of the fragment with planes
- * (DESIGN §5).  Each piece is the part of the fragment inside a convex cell
+ * (docs/physics.md §9).  Each piece is the part of the fragment inside a convex cell
  * (an intersection of half-spaces); tets that straddle a cutting plane are
  * clipped by it, so neighbouring hulls meet on the plane without gap or
  * overlap and the summed hull volume is that of their union.  Hulls and

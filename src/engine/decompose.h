@@ -1,5 +1,5 @@
 /* Convex decomposition of a fragment for its Bullet collision shape
- * (DESIGN §5): convex hulls of the fragment's parts inside convex cells,
+ * (docs/physics.md §9): convex hulls of the fragment's parts inside convex cells,
  * made by recursive bisection with planes until the hulls fit the tets.
  *
  * Error measure (reported per fragment): hull_volume / tet_volume - 1, the

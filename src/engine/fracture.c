@@ -1,4 +1,4 @@
-/* The in-house solver step (source Table 6.2, DESIGN §3), per fragment. */
+/* The in-house solver step (source Table 6.2, docs/physics.md §4), per fragment. */
 #include "world_impl.h"
 
 #include "linalg.h"

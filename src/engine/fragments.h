@@ -1,5 +1,5 @@
 /* Fragments: connected pieces of the solid, their mass properties and their
- * rigid state (DESIGN §2, §5). */
+ * rigid state (docs/physics.md §1, §9). */
 #ifndef COHFRAC_FRAGMENTS_H
 #define COHFRAC_FRAGMENTS_H
 
@@ -17,7 +17,7 @@ int cf_label_components(const cf_solid *s, const int *tets, int nt, int *comp);
 int cf_label_pieces(const cf_solid *s, const int *tets, int nt, const int *coh, int ncoh,
                     int *comp);
 
-/* Mass properties of `tets` from the tet second moment (DESIGN §5):
+/* Mass properties of `tets` from the tet second moment (docs/physics.md §9):
  * per tet, int x x^T dm = (m/20)(sum_i x_i x_i^T + s s^T), s = sum_i x_i,
  * positions relative to the COM; I = tr(C) Id - C.
  * `pos` is s->X (rest) or s->x (current).  mass kg, com m, inertia kg m^2. */
@@ -45,7 +45,7 @@ void cf_nodes_state(const cf_solid *s, const int *nodes, int nn, double q[4], cf
 /* The same without the rotation (R left as zero): cheap momenta only. */
 void cf_nodes_momenta(const cf_solid *s, const int *nodes, int nn, cf_node_state *st);
 
-/* Global damping (DESIGN §6, source Table 6.1, Müller et al. 2007):
+/* Global damping (docs/physics.md §8, source Table 6.1, Müller et al. 2007):
  * v_i += k (v_cm + w x r_i - v_i), w = I^-1 L.  k = 1 keeps only the rigid
  * motion; linear and angular momentum are preserved. */
 void cf_global_damping(cf_solid *s, const int *nodes, int nn, double k);

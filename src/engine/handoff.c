@@ -1,5 +1,5 @@
 /* Hand-off between rigid mode (Bullet, or the pbd rigid backend) and
- * fracture mode (DESIGN §5). */
+ * fracture mode (docs/physics.md §9). */
 #include "world_impl.h"
 
 #include "linalg.h"
@@ -39,7 +39,7 @@ int cf_fragment_root(const cf_world *sim, int fi)
 /* Mass and centre of mass from the tets (identical to the lumped ones); the
  * inertia of the lumped masses, the solver's own discretisation, so that a
  * hand-off preserves linear and angular momentum and never adds kinetic
- * energy (the tet second moment of DESIGN §5 would give a single tet 1/5 of
+ * energy (the tet second moment of docs/physics.md §9 would give a single tet 1/5 of
  * its lumped inertia, and the rigid spin 5 times the energy). */
 void cf_fragment_rest_props(cf_world *sim, int fi)
 {
@@ -53,7 +53,7 @@ void cf_fragment_rest_props(cf_world *sim, int fi)
     sym3_eigen(I, f->principal, f->Q);
 }
 
-/* Convex decomposition of fragment fi (DESIGN §5), kept in the principal
+/* Convex decomposition of fragment fi (docs/physics.md §9), kept in the principal
  * frame for Bullet and for fracture-mode contact. */
 static int decompose_fragment(cf_world *sim, cf_fragment *f)
 {

@@ -1,4 +1,4 @@
-/* Extrinsic cohesive insertion and node duplication (DESIGN §3.3, §3.4). */
+/* Extrinsic cohesive insertion and node duplication (docs/physics.md §5). */
 #ifndef COHFRAC_INSERTION_H
 #define COHFRAC_INSERTION_H
 

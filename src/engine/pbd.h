@@ -1,10 +1,9 @@
-/* Position based dynamics (DESIGN §4, source §6.2; Müller et al. 2007) and
+/* Position based dynamics (docs/physics.md §7, source §6.2; Müller et al. 2007) and
  * the obstacles of the collision constraints. */
 #ifndef COHFRAC_PBD_H
 #define COHFRAC_PBD_H
 
 #include "cohfrac/types.h"
-#include "cf_fcl.h"
 #include "solid.h"
 
 /* One bar per unique edge of the current tets, rest length from s->X.
@@ -53,36 +52,5 @@ double cf_pbd_effective_stiffness(double k, int iterations, int iteration_indepe
  * cf_bars_reset_lambda at the start of every step. */
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale);
 void cf_bars_reset_lambda(cf_bars *b);
-
-/* Obstacles at time t (moving ones at constant velocity).  Mesh obstacles
- * are queried through FCL: mesh[j] is the built mesh of obstacle j (NULL for
- * the analytic ones), and a node counts as inside a mesh only within
- * range[j] m behind its surface (deeper nodes have gone through). */
-typedef struct cf_obstacles {
-    int n;
-    const cf_obstacle *o;
-    cff_mesh **mesh;
-    double *range;
-} cf_obstacles;
-
-/* Keep a node's prediction p (at time t) out of every obstacle, moving it
- * along the obstacle's normal: to the surface, or, when the node was already
- * inside at x (at time t0, the step's start), no deeper than it was then.
- * An overlap present at the start of the step is thus never pushed out on p
- * alone, which would turn depth/dt into velocity (energy no load put in);
- * only the obstacle's own motion over the step moves p.  Returns the index
- * of the last obstacle that was hit, or -1; `normal` receives its outward
- * normal. */
-int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], double t,
-                         double p[3], double normal[3]);
-
-/* Velocity of obstacle o (m/s): planes are static, spheres and boxes move
- * at their constant velocity. */
-void cf_obstacle_velocity(const cf_obstacle *o, double u[3]);
-
-/* Signed distance of point p from obstacle j at time t (negative inside) and
- * the outward normal there. */
-double cf_obstacle_distance(const cf_obstacles *obs, int j, double t, const double p[3],
-                            double normal[3]);
 
 #endif

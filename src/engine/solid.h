@@ -1,7 +1,7 @@
 /* The solid: every node, tet, facet and cohesive element of the scene's
  * bodies in one set of arrays (structure of arrays, SI units).
  *
- * Nodes grow by node duplication (DESIGN §3.4); tets never change count but
+ * Nodes grow by node duplication (docs/physics.md §5); tets never change count but
  * their node indices move to duplicated copies.  `tet0` keeps the original
  * vertex of every slot, so topology questions are asked on the reference
  * mesh.  Face k of a tet is the face opposite its node k, with the vertex
@@ -82,7 +82,7 @@ typedef struct cf_solid {
     int n_coh, cap_coh;
     cf_cohesive *coh;
 
-    double dt_cfl;            /* s, DESIGN §3.2 */
+    double dt_cfl;            /* s, docs/physics.md §3 */
 } cf_solid;
 
 /* Build the solid from meshes already placed in the world frame.

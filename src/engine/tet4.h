@@ -1,4 +1,4 @@
-/* Tet4 elasticity (DESIGN §3.1): constant-gradient linear tetrahedra,
+/* Tet4 elasticity (docs/physics.md §2): constant-gradient linear tetrahedra,
  * corotational (default) or small-strain ("linear", the source's) stress.
  *
  * Shape-function gradients: rows of Dm^-1 are grad N1..N3 (1/m),

@@ -1,5 +1,5 @@
 /* The driver: builds what a scene asks for and runs the rigid-step loop
- * (DESIGN §1, §5).  Each rigid step: Bullet (or the pbd rigid backend)
+ * (docs/architecture.md, docs/physics.md §9).  Each rigid step: Bullet (or the pbd rigid backend)
  * moves the rigid fragments; a fragment hit harder than the impact threshold
  * is rolled back to the start of the step and re-done in fracture mode,
  * sub-cycled at dt_fracture; a fracture-mode fragment quiet for quiet_steps
@@ -287,80 +287,22 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
     return CF_OK;
 }
 
-/* A mesh obstacle's surface placed in the world: x' = position + scale R x,
- * [n_vertices][3] (NULL when out of memory). */
-static double *place_obstacle_mesh(const cf_obstacle *o)
-{
-    double R[9], *v = malloc(((size_t)o->n_vertices * 3 + 1) * sizeof(double));
-    if (!v)
-        return NULL;
-    quat_to_mat(o->orientation, R);
-    for (int i = 0; i < o->n_vertices; i++) {
-        double y[3];
-        m3_mulv(R, &o->vertices[3 * i], y);
-        for (int k = 0; k < 3; k++)
-            v[3 * i + k] = o->position[k] + o->scale * y[k];
-    }
-    return v;
-}
-
-/* Mesh obstacles for the in-house solver (FCL), and every obstacle for
- * Bullet when there is a Bullet world.  Nodes count as inside a mesh down
- * to 5% of its size behind the surface. */
+/* Every obstacle for the in-house solver and, when there is a Bullet
+ * world, as Bullet bodies; which of them move (kinematic). */
 static cf_status add_obstacles(cf_world *sim, const cf_world_def *def, cf_error *err)
 {
-    const cf_world_def *sc = sim->scene;
-    int n = sc->n_obstacles;
-    sim->obs.n = n;
-    sim->obs.o = sc->obstacles;
-    if (n == 0)
-        return CF_OK;
-    sim->obs.mesh = calloc((size_t)n, sizeof *sim->obs.mesh);
-    sim->obs.range = calloc((size_t)n, sizeof *sim->obs.range);
-    sim->obstacle_body = malloc((size_t)n * sizeof(int));
-    sim->obstacle_moving = calloc((size_t)n, 1);
-    if (!sim->obs.mesh || !sim->obs.range || !sim->obstacle_body || !sim->obstacle_moving)
+    int n = def->n_obstacles;
+    sim->obs.o = sim->scene->obstacles;
+    sim->obstacle_body = malloc(((size_t)n + 1) * sizeof(int));
+    sim->obstacle_moving = calloc((size_t)n + 1, 1);
+    if (!sim->obstacle_body || !sim->obstacle_moving)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for obstacles");
     for (int j = 0; j < n; j++) {
-        const cf_obstacle *o = &sc->obstacles[j];
-        int id = -1;
-        sim->obstacle_body[j] = -1;
-        sim->obstacle_moving[j] = o->type != CF_OBSTACLE_PLANE && o->type != CF_OBSTACLE_MESH &&
-                                  v3_dot(o->velocity, o->velocity) > 0;
-        if (o->type == CF_OBSTACLE_MESH) {
-            o = &def->obstacles[j]; /* the caller's: the world keeps no surface */
-            double *v = place_obstacle_mesh(o), lo[3], hi[3], diag[3];
-            if (!v)
-                return cf_error_set(err, CF_ERR_NOMEM, "out of memory for obstacle %d", j + 1);
-            points_bbox(v, o->n_vertices, lo, hi);
-            v3_sub(hi, lo, diag);
-            sim->obs.range[j] = 0.05 * v3_norm(diag);
-            sim->obs.mesh[j] = cff_mesh_create(v, o->n_vertices, o->triangles, o->n_triangles);
-            if (sim->obs.mesh[j] && sim->bullet)
-                id = cfb_add_trimesh(sim->bullet, v, o->n_vertices, o->triangles,
-                                     o->n_triangles, o->friction, o->restitution);
-            free(v);
-            if (!sim->obs.mesh[j])
-                return cf_error_set(err, CF_ERR_EXTERNAL, "FCL refused obstacle %d (%s): %s",
-                                    j + 1, o->file, cff_last_error());
-        } else if (!sim->bullet) {
-            continue;
-        } else if (o->type == CF_OBSTACLE_PLANE) {
-            id = cfb_add_plane(sim->bullet, o->point, o->normal, o->friction, o->restitution);
-        } else if (o->type == CF_OBSTACLE_SPHERE) {
-            id = cfb_add_sphere(sim->bullet, o->center, o->radius, o->velocity, o->friction,
-                                o->restitution);
-        } else {
-            id = cfb_add_box(sim->bullet, o->center, o->half_extents, o->velocity, o->friction,
-                             o->restitution);
-        }
-        /* Bullet multiplies the two bodies' coefficients: material x obstacle factor. */
-        if (sim->bullet && id < 0)
-            return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused obstacle %d: %s", j + 1,
-                                cfb_last_error());
-        sim->obstacle_body[j] = id;
+        double u[3];
+        cf_obstacle_velocity(&def->obstacles[j], u);
+        sim->obstacle_moving[j] = v3_dot(u, u) > 0;
     }
-    return CF_OK;
+    return cf_obstacles_create(&sim->obs, def, sim->bullet, sim->obstacle_body, err);
 }
 
 /* Append an event (the array grows; out of memory drops it and says so). */
@@ -595,9 +537,8 @@ void cf_world_destroy(cf_world *sim)
         cf_frag_surface_free(&f->surface);
     }
     free(sim->frag);
-    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
-        cff_mesh_destroy(sim->obs.mesh[j]);
-    free(sim->obs.mesh), free(sim->obs.range), free(sim->obstacle_body), free(sim->obstacle_moving);
+    cf_obstacles_free(&sim->obs);
+    free(sim->obstacle_body), free(sim->obstacle_moving);
     free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
     free(sim->def.obstacles), free(sim->def.boundaries);
     if (sim->bullet)
@@ -726,6 +667,31 @@ double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
 }
 
 int cf_world_tet_count(const cf_world *sim) { return sim->solid.n_tets; }
+
+int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
+{
+    if (t < 0 || t >= sim->solid.n_tets)
+        return -1;
+    const cf_solid *s = &sim->solid;
+    int st = sim->tet_of_user[t], fi = s->tet_frag[st];
+    const cf_fragment *f = &sim->frag[fi];
+    double com[3], R[9], v[3], w[3];
+    if (f->body >= 0) /* rigid in Bullet: the nodes are not moved, the pose is */
+        cf_fragment_pose((cf_world *)sim, fi, com, R, v, w);
+    for (int j = 0; j < 4; j++) {
+        int a = s->tet[4 * st + j];
+        if (f->body < 0) {
+            memcpy(&x[3 * j], &s->x[3 * a], 3 * sizeof(double));
+            continue;
+        }
+        double r[3], y[3];
+        v3_sub(&s->X[3 * a], f->com_rest, r);
+        m3_mulv(R, r, y);
+        for (int k = 0; k < 3; k++)
+            x[3 * j + k] = com[k] + y[k];
+    }
+    return 0;
+}
 
 int cf_world_tet_fragment(const cf_world *sim, int t)
 {
@@ -902,13 +868,19 @@ static double contact_pad(const cf_world *sim, int fi, double dt)
 /* Sub-cycle every fracture-mode fragment through the rigid step, all of
  * them in step so that fragments of different bodies meet in contact after
  * each sub-step. */
-static cf_status fracture_steps(cf_world *sim, double dt, cf_error *err)
+/* Fracture sub-steps in a rigid step of dt: n_sub of h <= dt_fracture. */
+static long sub_steps(const cf_world *sim, double dt, double *h)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
-    long n_sub = lround(ceil(dt / sim->dt_fracture - 1e-9)); /* h <= dt_fracture */
+    long n_sub = lround(ceil(dt / sim->dt_fracture - 1e-9));
     if (n_sub < 1)
         n_sub = 1;
-    double h = dt / (double)n_sub;
+    *h = dt / (double)n_sub;
+    return n_sub;
+}
+
+static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, cf_error *err)
+{
+    const cf_solver_settings *set = &sim->scene->solver;
     int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
     int bodies = cf_body_contact_needed(sim);
     for (int fi = 0; fi < n; fi++) {
@@ -1051,13 +1023,28 @@ double cf_world_dt_cfl(const cf_world *sim) { return sim->solid.dt_cfl; }
 cf_status cf_world_step(cf_world *sim, cf_error *err)
 {
     const cf_world_def *sc = sim->scene;
-    double dt = sim->dt_outer;
+    double dt = sim->dt_outer, h, t0 = sim->t;
+    long n_sub = sub_steps(sim, dt, &h);
+    /* The last step is cut short so that the run ends at the duration: in
+     * rigid mode exactly; a fracture-only run in whole fracture steps of the
+     * same h (the leapfrog energy estimate needs a constant step), so it
+     * ends less than one fracture step past it. */
+    double rest = sc->duration - (double)sim->step * sim->dt_outer;
+    int cut = sim->step == sim->n_steps - 1 && rest < (1 - 1e-9) * dt;
+    if (cut && sc->solver.mode == CF_RUN_FRACTURE) {
+        n_sub = lround(fmax(1.0, ceil(rest / h - 1e-9)));
+        dt = (double)n_sub * h;
+    } else if (cut) {
+        dt = rest;
+        n_sub = sub_steps(sim, dt, &h);
+    }
     int n_coh = sim->solid.n_coh;
     cf_status st = rigid_step(sim, dt, err);
     if (st == CF_OK)
-        st = fracture_steps(sim, dt, err);
+        st = fracture_steps(sim, dt, n_sub, h, err);
     sim->step++;
-    sim->t = (double)sim->step * dt;
+    sim->t = !cut ? (double)sim->step * sim->dt_outer
+                  : sc->solver.mode == CF_RUN_FRACTURE ? t0 + dt : sc->duration;
     if (st == CF_OK && sim->solid.n_coh > n_coh) {
         cf_event e = {.type = CF_EVENT_INSERTIONS, .time = sim->t, .first = n_coh,
                       .count = sim->solid.n_coh - n_coh, .alive = alive_fragments(sim, NULL)};

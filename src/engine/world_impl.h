@@ -11,6 +11,7 @@
 #include "cohfrac/world.h"
 #include "fragments.h"
 #include "insertion.h"
+#include "obstacle.h"
 #include "pbd.h"
 #include "solid.h"
 
@@ -54,14 +55,14 @@ typedef struct cf_fragment {
                                 other bodies' fragments */
 } cf_fragment;
 
-/* Convex decomposition settings (DESIGN §5): split until the hulls exceed
+/* Convex decomposition settings (docs/physics.md §9): split until the hulls exceed
  * the tet volume by at most this fraction, into at most this many hulls of
  * at least this many tets each. */
 #define CF_HULL_MAX_ERROR 0.05
 #define CF_HULL_MAX_COUNT 64
 #define CF_HULL_MIN_TETS 4
 
-/* Energy removed or put in by each mechanism since t = 0, J (DESIGN §3-§6;
+/* Energy removed or put in by each mechanism since t = 0, J (docs/physics.md §4-§6;
  * the ledger balance is in cf_world_ledger). */
 typedef struct cf_energy_flows {
     double boundary;   /* work of prescribed velocities */

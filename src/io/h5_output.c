@@ -1,4 +1,4 @@
-/* cohfrac — HDF5 output in an H5MD-style layout (DESIGN §7), plus an XDMF 3
+/* cohfrac — HDF5 output in an H5MD-style layout (docs/output.md), plus an XDMF 3
  * sidecar so ParaView can play the fragment centres back over time.
  *
  * The layout is documented in include/cohfrac/h5_output.h.  Choices made

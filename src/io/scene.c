@@ -804,7 +804,7 @@ static cf_status read_material(loader *ld, int t, cf_material *m)
     TRY(get_num(ld, t, "G_I", &G_I, &POSITIVE, &m->G_I));
     TRY(get_num(ld, t, "sigma_max", &sigma, &POSITIVE, &m->sigma_max));
     TRY(get_num(ld, t, "alpha", &alpha, &PPR_SHAPE, &m->alpha));
-    /* Mode II defaults to mode I (DESIGN.md §3.5). */
+    /* Mode II defaults to mode I (docs/physics.md §6). */
     TRY(get_num(ld, t, "G_II", &m->G_I, &POSITIVE, &m->G_II));
     TRY(get_num(ld, t, "tau_max", &m->sigma_max, &POSITIVE, &m->tau_max));
     TRY(get_num(ld, t, "beta", &m->alpha, &PPR_SHAPE, &m->beta));
@@ -1219,6 +1219,21 @@ static cf_status read_output(loader *ld, int t, const char *name, int fracture_o
     } else {
         lua_pop(L, 1);
         TRY(get_str(ld, t, "file", def, o->file, sizeof o->file));
+        /* A relative output path starts at the scene file's directory (as
+         * mesh paths do), so a run writes the same file from anywhere. */
+        if (o->file[0] != '/' && strcmp(ld->dir, ".") != 0) {
+            char *real = realpath(ld->dir, NULL), rel[sizeof o->file];
+            int w = -1;
+            if (real) {
+                memcpy(rel, o->file, sizeof rel);
+                w = snprintf(o->file, sizeof o->file, "%s/%s", real, rel);
+                free(real);
+            }
+            if (w < 0 || (size_t)w >= sizeof o->file)
+                return fail(ld, CF_ERR_SCENE_VALUE,
+                            "'%s': cannot make %s absolute against the scene's directory %s",
+                            kp(ld, "file"), o->file, ld->dir);
+        }
     }
     TRY(get_num(ld, t, "frame_interval", &frame_interval, &POSITIVE, &o->frame_interval));
     TRY(get_bool(ld, t, "cracks", fracture_only, &o->cracks));

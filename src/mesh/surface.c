@@ -1,6 +1,6 @@
 /* cohfrac — closed triangle surfaces: OBJ/OFF/STL input, OFF output,
  * enclosed volume, closedness, self-intersection search, the valence-3
- * repair of DESIGN §9 and quadric-error decimation. */
+ * repair of docs/scenes.md and quadric-error decimation. */
 #include "file_text.h"
 #include "cohfrac/surface.h"
 
