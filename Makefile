@@ -25,6 +25,8 @@ run: meshes
 	$(BUILD)/cohfrac run scenes/bunny_drop.lua --mesh-dir $(MESHES) -o out/bunny_drop.h5
 	/usr/bin/python3 tools/check_run.py out/bunny_drop.h5
 	/usr/bin/python3 tools/check_physics.py out/bunny_drop.h5
+	/usr/bin/python3 tools/check_geometry.py out/bunny_drop.h5
+	$(BUILD)/cohfrac render out/bunny_drop.h5
 
 # The fracture-mode step on the 203k-tet bunny against the memory floor, 1
 # against 2 threads and against btSoftBody (docs/performance.md).

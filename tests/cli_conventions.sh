@@ -14,7 +14,7 @@ check() { # check WHAT CONDITION...
     if "$@"; then echo "ok: $what"; else echo "FAIL: $what"; fails=$((fails + 1)); fi
 }
 
-for sub in run compare mesh study stability bench; do
+for sub in run compare mesh study stability bench render export; do
     out=$("$exe" "$sub" --help 2>&1); rc=$?
     check "cohfrac $sub --help exits 0" [ $rc -eq 0 ]
     check "cohfrac $sub --help shows its own usage" \

@@ -220,10 +220,10 @@ static void write_scenario(const char *path)
                 frames[n++] = frag_state(ALIVE[t][k], t, MODE[t]);
         assert_int_equal(cf_h5_write_frame(h, STEPS[t], TIMES[t], frames, n, &err), CF_OK);
         assert_int_equal(
-            cf_h5_write_observable(h, "kinetic_energy", STEPS[t], TIMES[t], 10.0 - t, &err), CF_OK);
+            cf_h5_write_observable(h, "kinetic_energy", NULL, STEPS[t], TIMES[t], 10.0 - t, &err), CF_OK);
         if (t % 2 == 0)
             assert_int_equal(
-                cf_h5_write_observable(h, "n_cohesive", STEPS[t], TIMES[t], 5.0 * t, &err), CF_OK);
+                cf_h5_write_observable(h, "n_cohesive", NULL, STEPS[t], TIMES[t], 5.0 * t, &err), CF_OK);
         if (t == 1 || t == 3) {
             const cf_handoff_record r = {.time = TIMES[t], .fragment = 0, .direction = t == 1 ? 0 : 1,
                                          .momentum_error = 1e-12 * t, .handoff_loss = 0.5 * t};
@@ -467,7 +467,7 @@ static void test_growth(void **state)
         for (int o = 0; o < NOBS; ++o) {
             char name[32];
             snprintf(name, sizeof name, "obs_%02d", o);
-            assert_int_equal(cf_h5_write_observable(h, name, t, 0.001 * t, 100.0 * o + t, &err),
+            assert_int_equal(cf_h5_write_observable(h, name, NULL, t, 0.001 * t, 100.0 * o + t, &err),
                              CF_OK);
         }
     }
@@ -614,12 +614,12 @@ static void test_killed_writer(void **state)
         for (int t = 0; t < 3; ++t) {
             cf_frag_frame fr[2] = {frag_state(0, t, 0), frag_state(1, t, 0)};
             /* observables before their frame: the frame's flush covers them */
-            if (cf_h5_write_observable(h, "energy", t, 0.1 * t, 1.0 * t, &err) != CF_OK ||
+            if (cf_h5_write_observable(h, "energy", NULL, t, 0.1 * t, 1.0 * t, &err) != CF_OK ||
                 cf_h5_write_frame(h, t, 0.1 * t, fr, 2, &err) != CF_OK)
                 _exit(3);
         }
         /* an observable sample after the last flush may or may not be there */
-        cf_h5_write_observable(h, "energy", 3, 0.3, 3.0, &err);
+        cf_h5_write_observable(h, "energy", NULL, 3, 0.3, 3.0, &err);
         kill(getpid(), SIGKILL);
         _exit(4);
     }
@@ -737,12 +737,12 @@ static void test_bad_arguments(void **state)
     neg.id = -2;
     assert_int_equal(cf_h5_write_frame(h, 0, 0.0, &neg, 1, &err), CF_ERR_OUTPUT);
     assert_int_equal(cf_h5_write_frame(h, 0, 0.0, NULL, 1, &err), CF_ERR_OUTPUT);
-    assert_int_equal(cf_h5_write_observable(h, "a/b", 0, 0.0, 1.0, &err), CF_ERR_OUTPUT);
-    assert_int_equal(cf_h5_write_observable(h, "", 0, 0.0, 1.0, &err), CF_ERR_OUTPUT);
+    assert_int_equal(cf_h5_write_observable(h, "a/b", NULL, 0, 0.0, 1.0, &err), CF_ERR_OUTPUT);
+    assert_int_equal(cf_h5_write_observable(h, "", NULL, 0, 0.0, 1.0, &err), CF_ERR_OUTPUT);
     assert_int_equal(cf_h5_add_handoff(h, NULL, &err), CF_ERR_OUTPUT);
     assert_int_equal(cf_h5_write_frame(NULL, 0, 0.0, NULL, 0, &err), CF_ERR_OUTPUT);
     assert_int_equal(cf_h5_add_fragments(NULL, NULL, 0, &err), CF_ERR_OUTPUT);
-    assert_int_equal(cf_h5_write_observable(NULL, "e", 0, 0.0, 0.0, &err), CF_ERR_OUTPUT);
+    assert_int_equal(cf_h5_write_observable(NULL, "e", NULL, 0, 0.0, 0.0, &err), CF_ERR_OUTPUT);
     assert_int_equal(cf_h5_add_handoff(NULL, NULL, &err), CF_ERR_OUTPUT);
 
     /* a frame with no fragment alive is still a frame */

@@ -7,11 +7,13 @@
  *   cohfrac/scene.h    Lua scene files into a world definition
  *   cohfrac/sim.h      the run loop: HDF5 output, progress, summary
  *   cohfrac/h5_output.h  the HDF5 writer
+ *   cohfrac/export.h   glTF export of a run
  * See docs/architecture.md and examples/drop.c. */
 #ifndef COHFRAC_COHFRAC_H
 #define COHFRAC_COHFRAC_H
 
 #include "cohfrac/error.h"
+#include "cohfrac/export.h"
 #include "cohfrac/h5_output.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/scene.h"

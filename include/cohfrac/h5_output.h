@@ -26,7 +26,8 @@
  *               n_hulls[N] (convex hulls of its Bullet shape, 0 when it was
  *               born with none), hull_volume_error[N] (hull volume / tet
  *               volume - 1, NaN without hulls), decomposition_time[N] s}
- *   /observables/<name>/{step[T] int64, time[T] s, value[T] float64}
+ *   /observables/<name>/{step[T] int64, time[T] s, value[T] float64 with its
+ *                          `unit` attribute (none for counts)}
  *   /handoffs/{time, fragment, direction (0 rigid->fracture, 1 fracture->rigid),
  *              momentum_error (relative), momentum_change[3] kg m/s and
  *              angular_momentum_change[3] kg m^2/s (after - before, about the
@@ -34,6 +35,19 @@
  *   /cracks/{element, centroid[3] m, normal[3], area m^2, opening m,
  *            sliding m, failed, time s}  with output.cracks: one row per
  *            cohesive element per frame (rows of a frame share its time)
+ *   /mesh/rest/nodes[n][3] m, /mesh/rest/tets[nt][4] int32: the rest mesh as
+ *                          placed at t = 0 (before node duplication), input tet order
+ *   /mesh/tet_fragment/{step[K], time[K] s, value[K][nt] int32}: the fragment of
+ *                          every tet, at each frame after fragments were born
+ *   /surfaces/{triangles[M][3] int32 (on /mesh/rest/nodes, outward), crack[M]
+ *              (1: a crack face, inside the rest mesh; 0: the body's surface)}
+ *                          every fragment's boundary, written at its birth; a
+ *                          fragment's rows are surface_first .. + surface_count
+ *                          of its /fragments record, which also holds com_rest[3]
+ *                          (m): the pose maps a rest node X to com + R (X - com_rest)
+ *   /parameters/obstacle_{type (0 plane, 1 sphere, 2 box, 3 mesh), radius,
+ *                          point, normal, center, half_extents, velocity}: the
+ *                          obstacles at t = 0 (vectors flattened, [3 n])
  *   /h5md                  H5MD 1.1 metadata: attr version [1,1], author/ and
  *                          creator/ (attrs name, version), modules/units
  *   /particles/fragments/box  attrs dimension=3, boundary=["none"]*3 (H5MD)
@@ -102,10 +116,11 @@ cf_status cf_h5_write_frame(cf_h5 *h, long step, double time, const cf_frag_fram
 /* Append fragment records (ids must be new and consecutive from 0). */
 cf_status cf_h5_add_fragments(cf_h5 *h, const cf_frag_info *info, int n, cf_error *err);
 
-/* Append a scalar observable sample, creating /observables/<name> on first use.
+/* Append a scalar observable sample, creating /observables/<name> on first use
+ * with `unit` as its value's unit attribute (NULL: dimensionless).
  * Cheap (open datasets are kept); reaches the disk with the next flush. */
-cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double time,
-                                 double value, cf_error *err);
+cf_status cf_h5_write_observable(cf_h5 *h, const char *name, const char *unit, long step,
+                                 double time, double value, cf_error *err);
 
 /* Write /parameters/<name>: `n` float64 values (a scalar when n = 1) with
  * a `unit` attribute (none when unit is NULL), once per name.  What a reader
@@ -117,6 +132,22 @@ cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int
 /* Append `n` rows to /cracks (created on the first call, even with n = 0).
  * Flushes. */
 cf_status cf_h5_add_cracks(cf_h5 *h, const cf_crack_row *rows, int n, cf_error *err);
+
+/* Geometry (docs/output.md).  The rest mesh once: /mesh/rest/nodes[n][3]
+ * (m) and /mesh/rest/tets[nt][4] (0-based node indices, input tet order). */
+cf_status cf_h5_write_rest_mesh(cf_h5 *h, const double *X, int n, const int *tets, int nt,
+                                cf_error *err);
+
+/* Append m boundary triangles ([m][3] indices into /mesh/rest/nodes) and
+ * their crack flags to /surfaces; *first gets the row of the first (a
+ * fragment's surface_first).  Reaches the disk with the next flush. */
+cf_status cf_h5_add_surfaces(cf_h5 *h, const int *tris, const int *crack, int m, int *first,
+                             cf_error *err);
+
+/* Append the fragment of every tet (input order, [nt]) at a topology
+ * change to /mesh/tet_fragment/{step, time, value[K][nt]}. */
+cf_status cf_h5_write_tet_fragments(cf_h5 *h, long step, double time, const int *map, int nt,
+                                    cf_error *err);
 
 /* Append one hand-off record. */
 cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err);

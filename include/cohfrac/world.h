@@ -85,6 +85,10 @@ typedef struct cf_frag_info {
     int n_hulls;             /* convex hulls of its Bullet shape, 0 none */
     double hull_volume_error;/* hull volume / tet volume - 1 */
     double decomposition_time; /* s of wall time */
+    double com_rest[3];      /* m: centre of mass in the rest mesh; the pose maps
+                                X to com + R (X - com_rest) */
+    int surface_first, surface_count; /* its boundary triangles in the output's
+                                /surfaces (filled in by the run loop; 0, 0 when none) */
 } cf_frag_info;
 
 /* One hand-off between modes. */
@@ -166,6 +170,15 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap);
  * their tets.  -1 for t out of range. */
 int cf_world_tet_count(const cf_world *sim);
 int cf_world_tet_fragment(const cf_world *sim, int t);
+
+/* The rest mesh as placed at create, before any node duplication: its
+ * node count, the positions X[n][3] (m) in the world's node numbering, and
+ * tet t's four nodes in that numbering (t in input order; returns 0, or -1
+ * out of range).  A fragment's rest shape is its tets on these nodes; its
+ * pose (cf_fragment_state com, quat) moves X - com_rest (cf_frag_info). */
+int cf_world_rest_node_count(const cf_world *sim);
+void cf_world_rest_nodes(const cf_world *sim, double *X);
+int cf_world_rest_tet(const cf_world *sim, int t, int nodes[4]);
 
 /* The four corners of tet t (input numbering) now, x[4][3] in m: the
  * nodes of a fracture-mode or pbd-rigid fragment as they are, those of a

@@ -7,12 +7,16 @@
 #include "cohfrac/bench.h"
 #include "cohfrac/compare.h"
 #include "cohfrac/error.h"
+#include "cohfrac/export.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
 #include "cohfrac/stability.h"
 #include "cohfrac/study.h"
 #include "cohfrac/surface.h"
 
+#include "report.h"
+
+#include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -79,6 +83,19 @@ static const struct {
      "      --quick                         the corners only (under a minute)\n"
      "      -o, --output DIR                report directory (default build/stability)\n"
      "      -q, --quiet                     no line per case\n"},
+    {"render",
+     "  cohfrac render OUT.h5 [options]     PNG frames and an MP4 of a run (every fragment's\n"
+     "                                      surface, obstacles, coloured by fragment)\n"
+     "      -o, --output DIR                frames and movie here (default: frames in\n"
+     "                                      OUT_frames/, the movie beside OUT as OUT.mp4)\n"
+     "          --fps N                     frames per second of the movie (default 24)\n"
+     "          --size WxH                  pixels (default 960x720)\n"},
+    {"export",
+     "  cohfrac export OUT.h5 --format gltf -o FILE.glb\n"
+     "                                      the fragments for Blender, three.js, game engines:\n"
+     "                                      a mesh per fragment, one animation of their poses\n"
+     "      -f, --format gltf               the format (glTF 2.0 binary)\n"
+     "      -o, --output FILE               the file to write (default: OUT minus .h5, .glb)\n"},
     {"bench",
      "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 3.1 m/s)\n"
      "                                      against the memory floor, 1 against N threads\n"
@@ -470,6 +487,86 @@ static int cmd_bench(int argc, char **argv)
     return cf_bench_run(&o, &r, &err) == CF_OK ? 0 : fail(&err);
 }
 
+/* tools/render.py on an output file (matplotlib frames, ffmpeg movie). */
+static int cmd_render(int argc, char **argv)
+{
+    static const struct option lo[] = {{"output", required_argument, 0, 'o'},
+                                       {"fps", required_argument, 0, 'f'},
+                                       {"size", required_argument, 0, 'S'},
+                                       {0, 0, 0, 0}};
+    const char *out = NULL, *fps = NULL, *size = NULL;
+    int c, w, h;
+    while ((c = getopt_long(argc, argv, "o:", lo, NULL)) != -1) {
+        switch (c) {
+        case 'o': out = optarg; break;
+        case 'f':
+            if (count_arg("--fps", optarg, 1) < 0)
+                return cf_status_exit_code(CF_ERR_USAGE);
+            fps = optarg;
+            break;
+        case 'S':
+            if (sscanf(optarg, "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192)
+                return usage_error("--size is WxH in pixels, 16 to 8192 each (e.g. 960x720)");
+            size = optarg;
+            break;
+        default: return usage_error("bad option for 'render'");
+        }
+    }
+    if (optind != argc - 1)
+        return usage_error("'render' needs one output file (.h5)");
+    if (access(argv[optind], R_OK) != 0) {
+        fprintf(stderr, "cohfrac: error [file]: cannot read %s: %s\n", argv[optind],
+                strerror(errno));
+        return cf_status_exit_code(CF_ERR_FILE_OPEN);
+    }
+    const char *args[10] = {argv[optind]};
+    int n = 1;
+    if (out)
+        args[n++] = "-o", args[n++] = out;
+    if (fps)
+        args[n++] = "--fps", args[n++] = fps;
+    if (size)
+        args[n++] = "--size", args[n++] = size;
+    args[n] = NULL;
+    return cf_report_plot("render.py", NULL, args, "no frames or movie") ? 0
+                                                                          : cf_status_exit_code(CF_ERR_EXTERNAL);
+}
+
+/* The fragments of an output file as glTF (cf_export_gltf). */
+static int cmd_export(int argc, char **argv)
+{
+    static const struct option lo[] = {{"format", required_argument, 0, 'f'},
+                                       {"output", required_argument, 0, 'o'},
+                                       {0, 0, 0, 0}};
+    const char *out = NULL;
+    int c;
+    while ((c = getopt_long(argc, argv, "f:o:", lo, NULL)) != -1) {
+        switch (c) {
+        case 'f':
+            if (strcmp(optarg, "gltf") != 0 && strcmp(optarg, "glb") != 0)
+                return usage_error("--format: only gltf (glTF 2.0 binary, .glb) is written");
+            break;
+        case 'o': out = optarg; break;
+        default: return usage_error("bad option for 'export'");
+        }
+    }
+    if (optind != argc - 1)
+        return usage_error("'export' needs one output file (.h5)");
+    const char *in = argv[optind];
+    char def[4096];
+    if (!out) {
+        const char *dot = strrchr(in, '.');
+        int len = dot && !strchr(dot, '/') ? (int)(dot - in) : (int)strlen(in);
+        snprintf(def, sizeof def, "%.*s.glb", len, in);
+        out = def;
+    }
+    cf_error err = {0};
+    if (cf_export_gltf(in, out, &err) != CF_OK)
+        return fail(&err);
+    printf("wrote %s\n", out);
+    return 0;
+}
+
 /* --help / -h or --version among a subcommand's arguments (before "--"). */
 static int asks(int argc, char **argv, const char *a, const char *b)
 {
@@ -485,7 +582,8 @@ int main(int argc, char **argv)
         const char *name;
         int (*run)(int, char **);
     } table[] = {{"run", cmd_run},         {"compare", cmd_compare},     {"mesh", cmd_mesh},
-                 {"study", cmd_study},     {"stability", cmd_stability}, {"bench", cmd_bench}};
+                 {"study", cmd_study},     {"stability", cmd_stability}, {"bench", cmd_bench},
+                 {"render", cmd_render},   {"export", cmd_export}};
     if (argc < 2)
         return usage_error("no command given");
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {

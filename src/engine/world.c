@@ -373,6 +373,7 @@ int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
     o->n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
     o->hull_volume_error = cf_hulls_error(&f->hulls);
     o->decomposition_time = f->decompose_time;
+    memcpy(o->com_rest, f->com_rest, sizeof o->com_rest);
     return 0;
 }
 
@@ -667,6 +668,21 @@ double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
 }
 
 int cf_world_tet_count(const cf_world *sim) { return sim->solid.n_tets; }
+
+int cf_world_rest_node_count(const cf_world *sim) { return sim->solid.n_verts0; }
+
+void cf_world_rest_nodes(const cf_world *sim, double *X)
+{
+    memcpy(X, sim->solid.X, (size_t)sim->solid.n_verts0 * 3 * sizeof(double));
+}
+
+int cf_world_rest_tet(const cf_world *sim, int t, int nodes[4])
+{
+    if (t < 0 || t >= sim->solid.n_tets)
+        return -1;
+    memcpy(nodes, &sim->solid.tet0[4 * sim->tet_of_user[t]], 4 * sizeof(int));
+    return 0;
+}
 
 int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
 {

@@ -65,7 +65,7 @@ static const column_def FIELDS[FLD_COUNT] = {
 };
 
 enum { FR_PARENT, FR_BIRTH, FR_MASS, FR_NTETS, FR_INERTIA, FR_NHULLS, FR_HULLERR, FR_DECOMP,
-       FR_COUNT };
+       FR_COMREST, FR_SURF_FIRST, FR_SURF_COUNT, FR_COUNT };
 static const column_def FRAGMENT_COLUMNS[FR_COUNT] = {
     {"parent", 1, 1, NULL},
     {"birth_time", 1, 0, "s"},
@@ -75,6 +75,18 @@ static const column_def FRAGMENT_COLUMNS[FR_COUNT] = {
     {"n_hulls", 1, 1, NULL},
     {"hull_volume_error", 1, 0, NULL},
     {"decomposition_time", 1, 0, "s"},
+    {"com_rest", 3, 0, "m"},
+    {"surface_first", 1, 1, NULL},
+    {"surface_count", 1, 1, NULL},
+};
+
+/* Fragment surfaces: boundary triangles on /mesh/rest/nodes (outward
+ * for the rest shape), 1 where the face is a crack face (inside the rest
+ * mesh), 0 where it is the body's own surface. */
+enum { SF_TRIANGLES, SF_CRACK, SF_COUNT };
+static const column_def SURFACE_COLUMNS[SF_COUNT] = {
+    {"triangles", 3, 1, NULL},
+    {"crack", 1, 1, NULL},
 };
 
 /* "time" is last: it is appended last, so its length counts complete rows. */
@@ -128,6 +140,10 @@ struct cf_h5 {
     hid_t handoff[HO_COUNT];
     hid_t crack[CR_COUNT];   /* /cracks, created by the first cf_h5_add_cracks */
     hsize_t ncracks;
+    hid_t surface[SF_COUNT]; /* /surfaces */
+    hsize_t nsurface;
+    hid_t map_step, map_time, map_value; /* /mesh/tet_fragment, created on first use */
+    hsize_t nmaps;
     hid_t obs_group;
 
     hsize_t nframes, ncols, nfragments, nhandoffs;
@@ -457,6 +473,9 @@ static void init_handles(cf_h5 *h)
         h->handoff[i] = H5I_INVALID_HID;
     for (int i = 0; i < CR_COUNT; ++i)
         h->crack[i] = H5I_INVALID_HID;
+    for (int i = 0; i < SF_COUNT; ++i)
+        h->surface[i] = H5I_INVALID_HID;
+    h->map_step = h->map_time = h->map_value = H5I_INVALID_HID;
 }
 
 /* Close every HDF5 object and the file; returns -1 if any close failed. */
@@ -476,6 +495,11 @@ static int close_handles(cf_h5 *h)
         close_dataset(&h->handoff[i], &failed);
     for (int i = 0; i < CR_COUNT; ++i)
         close_dataset(&h->crack[i], &failed);
+    for (int i = 0; i < SF_COUNT; ++i)
+        close_dataset(&h->surface[i], &failed);
+    close_dataset(&h->map_step, &failed);
+    close_dataset(&h->map_time, &failed);
+    close_dataset(&h->map_value, &failed);
     close_dataset(&h->step, &failed);
     close_dataset(&h->time, &failed);
     if (h->obs_group >= 0 && H5Gclose(h->obs_group) < 0)
@@ -661,6 +685,8 @@ static cf_status build_layout(cf_h5 *h, const char *scene_name, const char *scen
         st = write_row_group(h, "fragments", FRAGMENT_COLUMNS, FR_COUNT, h->fragment, err);
     if (st == CF_OK)
         st = write_row_group(h, "handoffs", HANDOFF_COLUMNS, HO_COUNT, h->handoff, err);
+    if (st == CF_OK)
+        st = write_row_group(h, "surfaces", SURFACE_COLUMNS, SF_COUNT, h->surface, err);
     if (st != CF_OK)
         return st;
     h->obs_group = make_group(h->file, "observables");
@@ -851,12 +877,12 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
     if (n == 0)
         return CF_OK;
     size_t un = (size_t)n;
-    if (grow_scratch(h, 4 * un, 7 * un) < 0)
+    if (grow_scratch(h, 6 * un, 10 * un) < 0)
         return no_memory(err, h->path);
     /* Rows are stored by id; the batch may list the new ids in any order. */
     long long base = (long long)h->nfragments;
     int *src = h->ibuf, *parent = h->ibuf + un, *ntets = h->ibuf + 2 * un;
-    int *nhulls = h->ibuf + 3 * un;
+    int *nhulls = h->ibuf + 3 * un, *sfirst = h->ibuf + 4 * un, *scount = h->ibuf + 5 * un;
     for (size_t i = 0; i < un; ++i)
         src[i] = -1;
     for (int i = 0; i < n; ++i) {
@@ -874,7 +900,7 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
         src[id - base] = i;
     }
     double *birth = h->dbuf, *mass = h->dbuf + un, *inertia = h->dbuf + 2 * un;
-    double *hull_error = h->dbuf + 5 * un, *decomp = h->dbuf + 6 * un;
+    double *hull_error = h->dbuf + 5 * un, *decomp = h->dbuf + 6 * un, *com = h->dbuf + 7 * un;
     for (size_t r = 0; r < un; ++r) {
         const cf_frag_info *fi = &info[src[r]];
         nhulls[r] = fi->n_hulls;
@@ -884,10 +910,15 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
         ntets[r] = fi->n_tets;
         birth[r] = fi->birth_time;
         mass[r] = fi->mass;
-        for (int k = 0; k < 3; ++k)
+        for (int k = 0; k < 3; ++k) {
             inertia[3 * r + (size_t)k] = fi->inertia_principal[k];
+            com[3 * r + (size_t)k] = fi->com_rest[k];
+        }
+        sfirst[r] = fi->surface_first;
+        scount[r] = fi->surface_count;
     }
-    const void *bufs[FR_COUNT] = {parent, birth, mass, ntets, inertia, nhulls, hull_error, decomp};
+    const void *bufs[FR_COUNT] = {parent, birth,      mass, ntets,  inertia, nhulls,
+                                  hull_error, decomp, com,  sfirst, scount};
     for (int c = 0; c < FR_COUNT; ++c)
         if (append_rows(h->fragment[c], h->nfragments, un, mem_type(&FRAGMENT_COLUMNS[c]),
                         bufs[c]) < 0)
@@ -923,7 +954,8 @@ static observable *find_observable(cf_h5 *h, const char *name)
     return NULL;
 }
 
-static cf_status create_observable(cf_h5 *h, const char *name, observable **out, cf_error *err)
+static cf_status create_observable(cf_h5 *h, const char *name, const char *unit,
+                                   observable **out, cf_error *err)
 {
     void *p = h->obs;
     if (grow(&p, &h->obs_cap, h->nobs + 1, sizeof(observable)) < 0)
@@ -942,7 +974,8 @@ static cf_status create_observable(cf_h5 *h, const char *name, observable **out,
         o->value = create_rows(g, "value", H5T_IEEE_F64LE, 1);
         H5Gclose(g);
     }
-    if (g < 0 || o->step < 0 || o->time < 0 || o->value < 0 || write_unit(o->time, "s") < 0) {
+    if (g < 0 || o->step < 0 || o->time < 0 || o->value < 0 || write_unit(o->time, "s") < 0 ||
+        write_unit(o->value, unit) < 0) {
         int ignored = 0;
         close_dataset(&o->step, &ignored);
         close_dataset(&o->time, &ignored);
@@ -955,8 +988,8 @@ static cf_status create_observable(cf_h5 *h, const char *name, observable **out,
     return CF_OK;
 }
 
-static cf_status write_observable_impl(cf_h5 *h, const char *name, long step, double time,
-                                       double value, cf_error *err)
+static cf_status write_observable_impl(cf_h5 *h, const char *name, const char *unit, long step,
+                                       double time, double value, cf_error *err)
 {
     if (!h)
         return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_observable: no output file is open");
@@ -968,7 +1001,7 @@ static cf_status write_observable_impl(cf_h5 *h, const char *name, long step, do
                             h->path, name ? name : "(null)");
     observable *o = find_observable(h, name);
     if (!o) {
-        cf_status st = create_observable(h, name, &o, err);
+        cf_status st = create_observable(h, name, unit, &o, err);
         if (st != CF_OK)
             return st;
     }
@@ -983,12 +1016,12 @@ static cf_status write_observable_impl(cf_h5 *h, const char *name, long step, do
     return CF_OK;
 }
 
-cf_status cf_h5_write_observable(cf_h5 *h, const char *name, long step, double time,
-                                 double value, cf_error *err)
+cf_status cf_h5_write_observable(cf_h5 *h, const char *name, const char *unit, long step,
+                                 double time, double value, cf_error *err)
 {
     quiet_state q;
     quiet_begin(&q);
-    cf_status st = write_observable_impl(h, name, step, time, value, err);
+    cf_status st = write_observable_impl(h, name, unit, step, time, value, err);
     quiet_end(&q);
     return st;
 }
@@ -1120,6 +1153,110 @@ cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
     quiet_state q;
     quiet_begin(&q);
     cf_status st = add_handoff_impl(h, r, err);
+    quiet_end(&q);
+    return st;
+}
+
+/* ---- geometry ---------------------------------------------------------- */
+
+static cf_status add_surfaces_impl(cf_h5 *h, const int *tris, const int *crack, int m, int *first,
+                                   cf_error *err)
+{
+    if (!h || m < 0 || (m > 0 && (!tris || !crack)))
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_add_surfaces: bad arguments");
+    *first = (int)h->nsurface;
+    if (m == 0)
+        return CF_OK;
+    if (append_rows(h->surface[SF_TRIANGLES], h->nsurface, (hsize_t)m, H5T_NATIVE_INT, tris) < 0 ||
+        append_rows(h->surface[SF_CRACK], h->nsurface, (hsize_t)m, H5T_NATIVE_INT, crack) < 0)
+        return h5_fail(err, h->path, "appending to /surfaces");
+    h->nsurface += (hsize_t)m;
+    return CF_OK;
+}
+
+cf_status cf_h5_add_surfaces(cf_h5 *h, const int *tris, const int *crack, int m, int *first,
+                             cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = add_surfaces_impl(h, tris, crack, m, first, err);
+    quiet_end(&q);
+    return st;
+}
+
+static cf_status write_rest_mesh_impl(cf_h5 *h, const double *X, int n, const int *tets, int nt,
+                                      cf_error *err)
+{
+    if (!h || n < 0 || nt < 0)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_rest_mesh: bad arguments");
+    hid_t mesh = make_group(h->file, "mesh");
+    hid_t rest = mesh >= 0 ? make_group(mesh, "rest") : H5I_INVALID_HID;
+    hid_t dn = rest >= 0 ? create_rows(rest, "nodes", H5T_IEEE_F64LE, 3) : H5I_INVALID_HID;
+    hid_t dt = rest >= 0 ? create_rows(rest, "tets", H5T_STD_I32LE, 4) : H5I_INVALID_HID;
+    int ok = dn >= 0 && dt >= 0 && write_unit(dn, "m") == 0 &&
+             append_rows(dn, 0, (hsize_t)n, H5T_NATIVE_DOUBLE, X) == 0 &&
+             append_rows(dt, 0, (hsize_t)nt, H5T_NATIVE_INT, tets) == 0;
+    int ignored = 0;
+    close_dataset(&dn, &ignored);
+    close_dataset(&dt, &ignored);
+    if (rest >= 0)
+        H5Gclose(rest);
+    if (mesh >= 0)
+        H5Gclose(mesh);
+    if (!ok || H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+        return h5_fail(err, h->path, "writing /mesh/rest");
+    return CF_OK;
+}
+
+cf_status cf_h5_write_rest_mesh(cf_h5 *h, const double *X, int n, const int *tets, int nt,
+                                cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = write_rest_mesh_impl(h, X, n, tets, nt, err);
+    quiet_end(&q);
+    return st;
+}
+
+static cf_status write_tet_fragments_impl(cf_h5 *h, long step, double time, const int *map,
+                                          int nt, cf_error *err)
+{
+    if (!h || nt < 1 || !map)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_tet_fragments: bad arguments");
+    if (h->map_value < 0) {
+        hid_t g = H5Gopen2(h->file, "mesh", H5P_DEFAULT);
+        hid_t m = g >= 0 ? make_group(g, "tet_fragment") : H5I_INVALID_HID;
+        hsize_t dims[2] = {0, (hsize_t)nt}, maxdims[2] = {H5S_UNLIMITED, (hsize_t)nt};
+        hsize_t chunk[2] = {1, (hsize_t)nt};
+        int fill = -1;
+        if (m >= 0) {
+            h->map_step = create_rows(m, "step", H5T_STD_I64LE, 1);
+            h->map_time = create_rows(m, "time", H5T_IEEE_F64LE, 1);
+            h->map_value = create_extendable(m, "value", H5T_STD_I32LE, 2, dims, maxdims, chunk,
+                                             H5T_NATIVE_INT, &fill);
+            write_unit(h->map_time, "s");
+            H5Gclose(m);
+        }
+        if (g >= 0)
+            H5Gclose(g);
+        if (h->map_step < 0 || h->map_time < 0 || h->map_value < 0)
+            return h5_fail(err, h->path, "creating /mesh/tet_fragment");
+    }
+    int64_t step64 = step;
+    if (append_rows(h->map_value, h->nmaps, 1, H5T_NATIVE_INT, map) < 0 ||
+        append_rows(h->map_time, h->nmaps, 1, H5T_NATIVE_DOUBLE, &time) < 0 ||
+        append_rows(h->map_step, h->nmaps, 1, H5T_NATIVE_INT64, &step64) < 0)
+        return h5_fail(err, h->path, "appending to /mesh/tet_fragment");
+    h->nmaps++;
+    return CF_OK;
+}
+
+cf_status cf_h5_write_tet_fragments(cf_h5 *h, long step, double time, const int *map, int nt,
+                                    cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = write_tet_fragments_impl(h, step, time, map, nt, err);
     quiet_end(&q);
     return st;
 }

@@ -28,4 +28,10 @@ static inline void quiet_end(const quiet_state *q)
     H5Eset_auto2(H5E_DEFAULT, q->fn, q->data);
 }
 
+/* The whole dataset `name` of an open file as `type` (elements of `size`
+ * bytes; malloc'd, NULL when absent or unreadable); its rank and dimensions
+ * into rank/dims (up to 3).  In trajectory.c. */
+void *cf_h5_read_all(hid_t file, const char *name, hid_t type, size_t size, int *rank,
+                     hsize_t dims[3]);
+
 #endif

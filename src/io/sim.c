@@ -12,6 +12,32 @@
 #include <string.h>
 #include <unistd.h>
 
+/* A triangle's three node indices, ascending (a face seen from either side). */
+typedef struct face_key {
+    int v[3];
+} face_key;
+
+static int face_cmp(const void *a, const void *b)
+{
+    const int *x = ((const face_key *)a)->v, *y = ((const face_key *)b)->v;
+    for (int k = 0; k < 3; k++)
+        if (x[k] != y[k])
+            return (x[k] > y[k]) - (x[k] < y[k]);
+    return 0;
+}
+
+static face_key key_of(const int *tri)
+{
+    face_key k = {{tri[0], tri[1], tri[2]}};
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2 - i; j++)
+            if (k.v[j] > k.v[j + 1]) {
+                int t = k.v[j];
+                k.v[j] = k.v[j + 1], k.v[j + 1] = t;
+            }
+    return k;
+}
+
 struct cf_sim {
     cf_world *world;
     cf_world_meshes meshes;
@@ -27,6 +53,16 @@ struct cf_sim {
     int bar_shown;              /* a progress bar is on the terminal's last line */
     double output_time;         /* s of wall time writing the file */
     unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
+    /* Geometry output (docs/output.md): the rest tets (input order), the
+     * rest mesh's own boundary faces (sorted keys: a fragment face not
+     * among them is a crack face), the tet -> fragment map, and whether it
+     * changed since the last frame. */
+    int n_tets;
+    int *rest_tets;             /* [n_tets][4] */
+    face_key *outer;            /* [n_outer] sorted */
+    int n_outer;
+    int *tet_frag;              /* [n_tets] */
+    int topology_changed;
 };
 
 cf_world *cf_sim_world(const cf_sim *sim) { return sim->world; }
@@ -52,6 +88,84 @@ static void event_line(cf_sim *sim, const char *fmt, ...)
     sim->last_progress = 0; /* redraw the bar at once */
 }
 
+/* The boundary triangles of fragments first .. first + n - 1 (their rest
+ * shapes, outward), crack faces marked, appended to /surfaces; each
+ * fragment's rows into its record. */
+static cf_status write_surfaces(cf_sim *sim, cf_frag_info *info, int first, int n, cf_error *err)
+{
+    int nt = sim->n_tets;
+    for (int t = 0; t < nt; t++)
+        sim->tet_frag[t] = cf_world_tet_fragment(sim->world, t);
+    sim->topology_changed = 1;
+    /* Bucket the new fragments' tets: start[k] .. start[k + 1] in list. */
+    int *start = calloc((size_t)n + 1, sizeof(int)), *list = malloc(((size_t)nt + 1) * sizeof(int));
+    int *faces = malloc(((size_t)nt * 12 + 1) * sizeof(int)), *crack = malloc(((size_t)nt * 4 + 1) * sizeof(int));
+    cf_status st = start && list && faces && crack ? CF_OK
+                                                    : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int t = 0; st == CF_OK && t < nt; t++) {
+        int k = sim->tet_frag[t] - first;
+        if (k >= 0 && k < n)
+            start[k + 1]++;
+    }
+    for (int k = 0; st == CF_OK && k < n; k++)
+        start[k + 1] += start[k];
+    int *fill = st == CF_OK ? calloc((size_t)n + 1, sizeof(int)) : NULL;
+    if (st == CF_OK && !fill)
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int t = 0; st == CF_OK && t < nt; t++) {
+        int k = sim->tet_frag[t] - first;
+        if (k >= 0 && k < n)
+            list[start[k] + fill[k]++] = t;
+    }
+    for (int k = 0; st == CF_OK && k < n; k++) {
+        int m = cf_boundary_faces(sim->rest_tets, &list[start[k]], start[k + 1] - start[k], faces);
+        if (m < 0) {
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+            break;
+        }
+        for (int i = 0; i < m; i++) {
+            face_key key = key_of(&faces[3 * i]);
+            crack[i] = !bsearch(&key, sim->outer, (size_t)sim->n_outer, sizeof key, face_cmp);
+        }
+        st = cf_h5_add_surfaces(sim->h5, faces, crack, m, &info[k].surface_first, err);
+        info[k].surface_count = m;
+    }
+    free(start), free(list), free(faces), free(crack), free(fill);
+    return st;
+}
+
+/* The rest mesh into the file, and what the surfaces need of it. */
+static cf_status write_rest_mesh(cf_sim *sim, cf_error *err)
+{
+    cf_world *w = sim->world;
+    int nn = cf_world_rest_node_count(w), nt = cf_world_tet_count(w);
+    sim->n_tets = nt;
+    sim->rest_tets = malloc(((size_t)nt * 4 + 1) * sizeof(int));
+    sim->tet_frag = malloc(((size_t)nt + 1) * sizeof(int));
+    sim->outer = malloc(((size_t)nt * 4 + 1) * sizeof(face_key));
+    double *X = malloc(((size_t)nn * 3 + 1) * sizeof(double));
+    int *faces = malloc(((size_t)nt * 12 + 1) * sizeof(int));
+    cf_status st = sim->rest_tets && sim->tet_frag && sim->outer && X && faces
+                       ? CF_OK
+                       : cf_error_set(err, CF_ERR_NOMEM, "out of memory for the rest mesh");
+    if (st == CF_OK) {
+        cf_world_rest_nodes(w, X);
+        for (int t = 0; t < nt; t++)
+            cf_world_rest_tet(w, t, &sim->rest_tets[4 * t]);
+        int m = cf_boundary_faces(sim->rest_tets, NULL, nt, faces);
+        if (m < 0)
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory for the rest mesh");
+        for (int i = 0; i < m; i++)
+            sim->outer[i] = key_of(&faces[3 * i]);
+        sim->n_outer = m > 0 ? m : 0;
+        qsort(sim->outer, (size_t)sim->n_outer, sizeof *sim->outer, face_cmp);
+    }
+    if (st == CF_OK)
+        st = cf_h5_write_rest_mesh(sim->h5, X, nn, sim->rest_tets, nt, err);
+    free(X), free(faces);
+    return st;
+}
+
 /* Fragment records, hand-off rows and event lines for what the world did. */
 static cf_status drain_events(cf_sim *sim, cf_error *err)
 {
@@ -66,7 +180,9 @@ static cf_status drain_events(cf_sim *sim, cf_error *err)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
             for (int k = 0; k < e->count; k++)
                 cf_world_fragment_info(sim->world, e->first + k, &info[k]);
-            st = cf_h5_add_fragments(sim->h5, info, e->count, err);
+            st = write_surfaces(sim, info, e->first, e->count, err);
+            if (st == CF_OK)
+                st = cf_h5_add_fragments(sim->h5, info, e->count, err);
             free(info);
         } else if (e->type == CF_EVENT_HANDOFF) {
             const cf_handoff_record *r = &e->handoff;
@@ -80,6 +196,40 @@ static cf_status drain_events(cf_sim *sim, cf_error *err)
         }
     }
     cf_world_clear_events(sim->world);
+    return st;
+}
+
+/* The obstacles, for readers that draw them (tools/render.py):
+ * /parameters/obstacle_{type (0 plane, 1 sphere, 2 box, 3 mesh), point,
+ * normal, center (at t = 0), radius, half_extents, velocity}. */
+static cf_status write_obstacles(cf_sim *sim, cf_error *err)
+{
+    const cf_world_def *d = cf_world_definition(sim->world);
+    int n = d->n_obstacles;
+    if (n == 0)
+        return CF_OK;
+    double *buf = malloc((size_t)n * 3 * 7 * sizeof(double));
+    if (!buf)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    double *type = buf, *radius = buf + n, *vec = buf + 2 * n;
+    static const char *const names[] = {"point", "normal", "center", "half_extents", "velocity"};
+    for (int j = 0; j < n; j++) {
+        const cf_obstacle *o = &d->obstacles[j];
+        const double *v[] = {o->point, o->normal, o->center, o->half_extents, o->velocity};
+        type[j] = o->type, radius[j] = o->radius;
+        for (int q = 0; q < 5; q++)
+            memcpy(&vec[3 * (q * n + j)], v[q], 3 * sizeof(double));
+    }
+    cf_status st = cf_h5_write_parameter(sim->h5, "obstacle_type", type, n, NULL, err);
+    if (st == CF_OK)
+        st = cf_h5_write_parameter(sim->h5, "obstacle_radius", radius, n, "m", err);
+    for (int q = 0; q < 5 && st == CF_OK; q++) {
+        char name[64];
+        snprintf(name, sizeof name, "obstacle_%s", names[q]);
+        st = cf_h5_write_parameter(sim->h5, name, &vec[3 * q * n], 3 * n,
+                                   q == 1 ? NULL : q == 4 ? "m/s" : "m", err);
+    }
+    free(buf);
     return st;
 }
 
@@ -102,7 +252,7 @@ static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
     cf_status st = CF_OK;
     for (size_t i = 0; i < sizeof p / sizeof p[0] && st == CF_OK; i++)
         st = cf_h5_write_parameter(sim->h5, p[i].name, p[i].v, p[i].n, p[i].unit, err);
-    return st;
+    return st == CF_OK ? write_obstacles(sim, err) : st;
 }
 
 cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
@@ -137,6 +287,8 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
         st = cf_h5_open(def->output.file, def->name, def->resolved, &sim->h5, err);
         if (st == CF_OK)
             st = write_initial_bounds(sim, err);
+        if (st == CF_OK)
+            st = write_rest_mesh(sim, err);
     }
     if (st == CF_OK)
         st = drain_events(sim, err);
@@ -156,6 +308,7 @@ void cf_sim_destroy(cf_sim *sim)
         cf_h5_close(sim->h5, NULL);
     cf_world_destroy(sim->world);
     cf_world_meshes_free(&sim->meshes);
+    free(sim->rest_tets), free(sim->outer), free(sim->tet_frag);
     free(sim);
 }
 
@@ -207,36 +360,41 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     cf_ledger l;
     cf_world_ledger(w, &l);
     const struct {
-        const char *name;
+        const char *name, *unit;
         double value;
     } obs[] = {
-        {"energy_kinetic", l.kinetic},
-        {"energy_strain", l.strain},
-        {"energy_cohesive_stored", l.cohesive_stored},
-        {"energy_cohesive_dissipated", l.cohesive_dissipated},
-        {"work_gravity", l.work_gravity},
-        {"work_boundary", l.work_boundary},
-        {"work_obstacles", l.work_obstacles},
-        {"energy_contact_removed", l.contact},
-        {"energy_rigid_integration_removed", l.integration},
-        {"energy_pbd_removed", l.pbd},
-        {"energy_damping_removed", l.damping},
-        {"energy_handoff_loss", l.handoff},
-        {"energy_residual", l.residual},
-        {"momentum_x", l.momentum[0]},
-        {"momentum_y", l.momentum[1]},
-        {"momentum_z", l.momentum[2]},
-        {"angular_momentum_x", l.angular_momentum[0]},
-        {"angular_momentum_y", l.angular_momentum[1]},
-        {"angular_momentum_z", l.angular_momentum[2]},
-        {"fragment_count", n},
-        {"cohesive_elements", ws.cohesive},
-        {"crack_area", cf_world_crack_area(w)},
-        {"fragments_in_fracture_mode", n_fracture},
-        {"handoff_momentum_error_max", ws.max_momentum_error},
+        {"energy_kinetic", "J", l.kinetic},
+        {"energy_strain", "J", l.strain},
+        {"energy_cohesive_stored", "J", l.cohesive_stored},
+        {"energy_cohesive_dissipated", "J", l.cohesive_dissipated},
+        {"work_gravity", "J", l.work_gravity},
+        {"work_boundary", "J", l.work_boundary},
+        {"work_obstacles", "J", l.work_obstacles},
+        {"energy_contact_removed", "J", l.contact},
+        {"energy_rigid_integration_removed", "J", l.integration},
+        {"energy_pbd_removed", "J", l.pbd},
+        {"energy_damping_removed", "J", l.damping},
+        {"energy_handoff_loss", "J", l.handoff},
+        {"energy_residual", "J", l.residual},
+        {"momentum_x", "kg m s-1", l.momentum[0]},
+        {"momentum_y", "kg m s-1", l.momentum[1]},
+        {"momentum_z", "kg m s-1", l.momentum[2]},
+        {"angular_momentum_x", "kg m2 s-1", l.angular_momentum[0]},
+        {"angular_momentum_y", "kg m2 s-1", l.angular_momentum[1]},
+        {"angular_momentum_z", "kg m2 s-1", l.angular_momentum[2]},
+        {"fragment_count", NULL, n},
+        {"cohesive_elements", NULL, ws.cohesive},
+        {"crack_area", "m2", cf_world_crack_area(w)},
+        {"fragments_in_fracture_mode", NULL, n_fracture},
+        {"handoff_momentum_error_max", NULL, ws.max_momentum_error},
     };
+    if (st == CF_OK && sim->topology_changed) {
+        st = cf_h5_write_tet_fragments(sim->h5, step, t, sim->tet_frag, sim->n_tets, err);
+        sim->topology_changed = 0;
+    }
     for (size_t i = 0; i < sizeof obs / sizeof obs[0] && st == CF_OK; i++)
-        st = cf_h5_write_observable(sim->h5, obs[i].name, step, t, obs[i].value, err);
+        st = cf_h5_write_observable(sim->h5, obs[i].name, obs[i].unit, step, t, obs[i].value,
+                                    err);
     if (st == CF_OK && sim->output.cracks)
         st = write_cracks(sim, err);
     sim->output_time += cf_wall_time() - t0;

@@ -13,9 +13,7 @@ static const char *const obs_names[] = {
 #undef CF_X_OBS_NAME
 };
 
-/* The whole dataset `name` as `type` (NULL when absent or unreadable);
- * its rank and dimensions into rank/dims (up to 3). */
-static void *read_all(hid_t file, const char *name, hid_t type, size_t size, int *rank,
+void *cf_h5_read_all(hid_t file, const char *name, hid_t type, size_t size, int *rank,
                       hsize_t dims[3])
 {
     if (H5Lexists(file, name, H5P_DEFAULT) <= 0)
@@ -51,9 +49,9 @@ static void read_observable(hid_t file, const char *name, double *first, double 
     hsize_t ds[3], dv[3];
     *first = *last = NAN;
     snprintf(path, sizeof path, "/observables/%s/step", name);
-    long long *step = read_all(file, path, H5T_NATIVE_LLONG, sizeof(long long), &r1, ds);
+    long long *step = cf_h5_read_all(file, path, H5T_NATIVE_LLONG, sizeof(long long), &r1, ds);
     snprintf(path, sizeof path, "/observables/%s/value", name);
-    double *v = read_all(file, path, H5T_NATIVE_DOUBLE, sizeof(double), &r2, dv);
+    double *v = cf_h5_read_all(file, path, H5T_NATIVE_DOUBLE, sizeof(double), &r2, dv);
     if (step && v && r1 == 1 && r2 == 1) {
         hsize_t n = ds[0] < dv[0] ? ds[0] : dv[0];
         if (n > 0)
@@ -76,14 +74,14 @@ cf_status cf_trajectory_read(const char *path, cf_trajectory *t, cf_error *err)
     }
     int rs, rt, rp, rpar, rm;
     hsize_t ds[3], dt[3], dp[3], dpar[3], dm[3];
-    long long *step = read_all(file, "/particles/fragments/position/step", H5T_NATIVE_LLONG,
+    long long *step = cf_h5_read_all(file, "/particles/fragments/position/step", H5T_NATIVE_LLONG,
                                sizeof(long long), &rs, ds);
-    t->time = read_all(file, "/particles/fragments/position/time", H5T_NATIVE_DOUBLE,
+    t->time = cf_h5_read_all(file, "/particles/fragments/position/time", H5T_NATIVE_DOUBLE,
                        sizeof(double), &rt, dt);
-    t->pos = read_all(file, "/particles/fragments/position/value", H5T_NATIVE_DOUBLE,
+    t->pos = cf_h5_read_all(file, "/particles/fragments/position/value", H5T_NATIVE_DOUBLE,
                       sizeof(double), &rp, dp);
-    t->parent = read_all(file, "/fragments/parent", H5T_NATIVE_INT, sizeof(int), &rpar, dpar);
-    t->mass = read_all(file, "/fragments/mass", H5T_NATIVE_DOUBLE, sizeof(double), &rm, dm);
+    t->parent = cf_h5_read_all(file, "/fragments/parent", H5T_NATIVE_INT, sizeof(int), &rpar, dpar);
+    t->mass = cf_h5_read_all(file, "/fragments/mass", H5T_NATIVE_DOUBLE, sizeof(double), &rm, dm);
     if (!step || !t->time || !t->pos || !t->parent || !t->mass)
         st = cf_error_set(err, CF_ERR_MESH_FORMAT,
                           "%s: /particles/fragments/position or /fragments/{parent,mass} "

@@ -1,0 +1,169 @@
+/* A run's fragments as glTF 2.0 (see cohfrac/export.h): read the output
+ * file's geometry and poses, write through the tinygltf bridge. */
+#include "cohfrac/export.h"
+
+#include "cf_gltf.h"
+#include "h5_quiet.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Everything the export reads, whole. */
+typedef struct run_data {
+    hsize_t T, N, nn, M;             /* frames, fragment columns, rest nodes, triangles */
+    int nf;                          /* fragment records */
+    double *time, *pos, *quat, *X, *com_rest;
+    int *id, *tri, *first, *count;
+} run_data;
+
+static void run_free(run_data *r)
+{
+    free(r->time), free(r->pos), free(r->quat), free(r->X), free(r->com_rest);
+    free(r->id), free(r->tri), free(r->first), free(r->count);
+}
+
+static cf_status run_read(const char *path, run_data *r, cf_error *err)
+{
+    memset(r, 0, sizeof *r);
+    if (H5Fis_hdf5(path) <= 0)
+        return cf_error_set(err, CF_ERR_FILE_OPEN, "%s: not found or not an HDF5 file", path);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0)
+        return cf_error_set(err, CF_ERR_FILE_OPEN, "%s: cannot open it", path);
+    int rk;
+    hsize_t d[3], dt[3], dp[3], dq[3], dx[3], dtr[3], dfs[3], dc[3];
+    r->time = cf_h5_read_all(f, "/particles/fragments/position/time", H5T_NATIVE_DOUBLE, 8, &rk, dt);
+    r->id = cf_h5_read_all(f, "/particles/fragments/id/value", H5T_NATIVE_INT, 4, &rk, d);
+    r->pos = cf_h5_read_all(f, "/particles/fragments/position/value", H5T_NATIVE_DOUBLE, 8, &rk, dp);
+    r->quat = cf_h5_read_all(f, "/particles/fragments/orientation/value", H5T_NATIVE_DOUBLE, 8, &rk, dq);
+    r->X = cf_h5_read_all(f, "/mesh/rest/nodes", H5T_NATIVE_DOUBLE, 8, &rk, dx);
+    r->tri = cf_h5_read_all(f, "/surfaces/triangles", H5T_NATIVE_INT, 4, &rk, dtr);
+    r->first = cf_h5_read_all(f, "/fragments/surface_first", H5T_NATIVE_INT, 4, &rk, dfs);
+    r->count = cf_h5_read_all(f, "/fragments/surface_count", H5T_NATIVE_INT, 4, &rk, dfs);
+    r->com_rest = cf_h5_read_all(f, "/fragments/com_rest", H5T_NATIVE_DOUBLE, 8, &rk, dc);
+    H5Fclose(f);
+    if (!r->X || !r->first || !r->count || !r->com_rest || !r->tri)
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s holds no fragment geometry (/mesh/rest, /surfaces): written by "
+                            "an older cohfrac; run the scene again",
+                            path);
+    if (!r->time || !r->id || !r->pos || !r->quat)
+        return cf_error_set(err, CF_ERR_MESH_PARSE, "%s holds no frames (/particles/fragments)",
+                            path);
+    /* Complete frames only (a killed run may leave one partial row). */
+    r->T = dt[0] < d[0] ? dt[0] : d[0];
+    r->N = d[1], r->nn = dx[0], r->M = dtr[0], r->nf = (int)dfs[0];
+    return CF_OK;
+}
+
+/* cohfrac (x, y, z), +z up -> glTF (x, z, -y), +y up. */
+static void to_gltf(const double v[3], float out[3])
+{
+    out[0] = (float)v[0], out[1] = (float)v[2], out[2] = (float)-v[1];
+}
+
+/* One fragment's node: its surface in its body frame, its keys. */
+static int make_node(const run_data *r, int i, cfg_node *n, char *name, size_t name_len)
+{
+    memset(n, 0, sizeof *n);
+    snprintf(name, name_len, "fragment_%d", i);
+    n->name = name;
+    int a = r->first[i], m = r->count[i];
+    if (m <= 0 || a < 0 || (hsize_t)(a + m) > r->M)
+        return 0;
+    /* Compact the vertices the surface uses. */
+    int *map = malloc(r->nn * sizeof(int));
+    float *pos = malloc((size_t)3 * 3 * m * sizeof(float));
+    unsigned *idx = malloc((size_t)3 * m * sizeof(unsigned));
+    float *times = malloc(r->T * sizeof(float)), *tr = malloc(r->T * 3 * sizeof(float));
+    float *rot = malloc(r->T * 4 * sizeof(float)), *scale = malloc(r->T * sizeof(float));
+    if (!map || !pos || !idx || !times || !tr || !rot || !scale) {
+        free(map), free(pos), free(idx), free(times), free(tr), free(rot), free(scale);
+        return -1;
+    }
+    for (hsize_t v = 0; v < r->nn; v++)
+        map[v] = -1;
+    int nv = 0;
+    for (int k = 0; k < 3 * m; k++) {
+        int v = r->tri[3 * a + k];
+        if (map[v] < 0) {
+            double rel[3];
+            for (int c = 0; c < 3; c++)
+                rel[c] = r->X[3 * v + c] - r->com_rest[3 * i + c];
+            to_gltf(rel, &pos[3 * nv]);
+            map[v] = nv++;
+        }
+        idx[k] = (unsigned)map[v];
+    }
+    free(map);
+    /* Keys at every frame; before the first and after the last alive frame
+     * the nearest alive pose is held, hidden by scale 0. */
+    long first = -1, last = -1;
+    for (hsize_t t = 0; t < r->T; t++)
+        if ((hsize_t)i < r->N && r->id[t * r->N + i] >= 0)
+            last = (long)t, first = first < 0 ? (long)t : first;
+    for (hsize_t t = 0; t < r->T; t++) {
+        long s = first < 0 ? 0 : (long)t < first ? first : (long)t > last ? last : (long)t;
+        const double *p = &r->pos[((hsize_t)s * r->N + i) * 3];
+        const double *q = &r->quat[((hsize_t)s * r->N + i) * 4]; /* w, x, y, z */
+        int alive = first >= 0 && (long)t >= first && (long)t <= last;
+        times[t] = (float)r->time[t];
+        to_gltf(p, &tr[3 * t]);
+        double qv[3] = {q[1], q[2], q[3]};
+        float qg[3];
+        to_gltf(qv, qg);
+        rot[4 * t] = qg[0], rot[4 * t + 1] = qg[1], rot[4 * t + 2] = qg[2];
+        rot[4 * t + 3] = (float)q[0];
+        if (!isfinite(rot[4 * t] + rot[4 * t + 3]) || first < 0)
+            rot[4 * t] = rot[4 * t + 1] = rot[4 * t + 2] = 0, rot[4 * t + 3] = 1;
+        if (!isfinite(tr[3 * t] + tr[3 * t + 1] + tr[3 * t + 2]))
+            tr[3 * t] = tr[3 * t + 1] = tr[3 * t + 2] = 0;
+        scale[t] = alive ? 1.0f : 0.0f;
+    }
+    /* A colour per fragment, spread around the hue circle. */
+    double h = fmod(0.618033988749895 * i, 1.0);
+    for (int c = 0; c < 3; c++)
+        n->color[c] = (float)(0.45 + 0.4 * cos(6.283185307179586 * (h + c / 3.0)));
+    n->color[3] = 1.0f;
+    n->n_vertices = nv, n->positions = pos;
+    n->n_triangles = m, n->indices = idx;
+    n->n_keys = (int)r->T, n->times = times, n->translation = tr, n->rotation = rot;
+    n->scale = scale;
+    return 1;
+}
+
+static void node_free(cfg_node *n)
+{
+    free((void *)n->positions), free((void *)n->indices), free((void *)n->times);
+    free((void *)n->translation), free((void *)n->rotation), free((void *)n->scale);
+}
+
+cf_status cf_export_gltf(const char *h5_path, const char *glb_path, cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    run_data r;
+    cf_status st = run_read(h5_path, &r, err);
+    quiet_end(&q);
+    cfg_node *nodes = st == CF_OK ? calloc((size_t)r.nf + 1, sizeof *nodes) : NULL;
+    char (*names)[32] = st == CF_OK ? calloc((size_t)r.nf + 1, sizeof *names) : NULL;
+    if (st == CF_OK && (!nodes || !names))
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    int n = 0;
+    for (int i = 0; st == CF_OK && i < r.nf; i++) {
+        int k = make_node(&r, i, &nodes[n], names[i], sizeof names[i]);
+        if (k < 0)
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory for fragment %d", i);
+        n += k > 0;
+    }
+    char why[256] = "";
+    if (st == CF_OK && cfg_write_glb(glb_path, nodes, n, "fragments", why, sizeof why) != 0)
+        st = cf_error_set(err, CF_ERR_OUTPUT, "%s", why);
+    for (int i = 0; nodes && i < n; i++)
+        node_free(&nodes[i]);
+    free(nodes), free(names);
+    run_free(&r);
+    return st;
+}

@@ -1,0 +1,113 @@
+#!/usr/bin/python3
+"""Check a glTF export (cohfrac export) against the run it came from.
+
+    tools/check_gltf.py OUT.h5 OUT.glb
+
+Reads the .glb's JSON and binary chunks (glTF 2.0 container: a 12-byte
+header, then length-type-data chunks) with the standard library and numpy,
+and checks: one node per fragment that has a surface, each with a mesh;
+one animation with translation, rotation and scale channels per node;
+the largest fragment's last key equals its HDF5 pose at the last frame
+(glTF +y up: cohfrac (x, y, z) is (x, z, -y)); its mesh has the surface's
+triangle count; and a fragment is hidden (scale 0) exactly where it is not
+alive.  Exit status 0 when all hold, 1 otherwise.
+"""
+import json
+import os
+import struct
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import numpy as np
+
+import cohfrac_h5
+
+COMPONENTS = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}
+DTYPES = {5126: np.float32, 5125: np.uint32}
+
+
+def read_glb(path):
+    data = open(path, "rb").read()
+    magic, version, length = struct.unpack_from("<4sII", data, 0)
+    if magic != b"glTF" or version != 2 or length != len(data):
+        raise ValueError(f"{path}: not a glTF 2.0 binary ({magic}, version {version})")
+    off, doc, binary = 12, None, b""
+    while off < length:
+        n, kind = struct.unpack_from("<I4s", data, off)
+        chunk = data[off + 8:off + 8 + n]
+        if kind == b"JSON":
+            doc = json.loads(chunk)
+        elif kind == b"BIN\x00":
+            binary = chunk
+        off += 8 + n
+    return doc, binary
+
+
+def accessor(doc, binary, i):
+    a = doc["accessors"][i]
+    v = doc["bufferViews"][a["bufferView"]]
+    k = COMPONENTS[a["type"]]
+    start = v.get("byteOffset", 0) + a.get("byteOffset", 0)
+    arr = np.frombuffer(binary, DTYPES[a["componentType"]], a["count"] * k, start)
+    return arr.reshape(a["count"], k) if k > 1 else arr
+
+
+def main(h5, glb):
+    run = cohfrac_h5.load(h5)
+    doc, binary = read_glb(glb)
+    fails = []
+    with_surface = [i for i in range(run.n_fragments) if len(run.fragment(i).triangles)]
+    nodes = doc["nodes"]
+    if len(nodes) != len(with_surface):
+        fails.append(f"{len(nodes)} nodes for {len(with_surface)} fragments with a surface")
+    anims = doc.get("animations", [])
+    if len(anims) != 1:
+        fails.append(f"{len(anims)} animations, expected 1")
+    byname = {n["name"]: k for k, n in enumerate(nodes)}
+    chans = {}
+    for c in anims[0]["channels"] if anims else []:
+        chans[(c["target"]["node"], c["target"]["path"])] = anims[0]["samplers"][c["sampler"]]
+    masses = run.fragments["mass"]
+    alive_end = run.alive(-1)
+    big = max(alive_end, key=lambda i: masses[i])
+    k = byname.get(f"fragment_{big}")
+    checked = 0
+    for i in with_surface:
+        node = byname.get(f"fragment_{i}")
+        if node is None or "mesh" not in nodes[node]:
+            fails.append(f"fragment {i}: no node with a mesh")
+            continue
+        if any((node, p) not in chans for p in ("translation", "rotation", "scale")):
+            fails.append(f"fragment {i}: missing an animation channel")
+            continue
+        scale = accessor(doc, binary, chans[(node, "scale")]["output"])[:, 0]
+        alive = run.ids[:, i] >= 0 if i < run.ids.shape[1] else np.zeros(len(run.times), bool)
+        if not np.array_equal(scale > 0, alive):
+            fails.append(f"fragment {i}: shown at {int((scale > 0).sum())} keys, alive at "
+                         f"{int(alive.sum())} frames")
+        checked += 1
+    if k is not None:
+        tr = accessor(doc, binary, chans[(k, "translation")]["output"])[-1]
+        com = run.position[-1, big]
+        want = np.array([com[0], com[2], -com[1]])
+        err = np.abs(tr - want).max()
+        if err > 1e-5 * max(1.0, np.abs(want).max()):
+            fails.append(f"fragment {big}: last key {tr} against the HDF5's {want}")
+        prim = doc["meshes"][nodes[k]["mesh"]]["primitives"][0]
+        ntri = doc["accessors"][prim["indices"]]["count"] // 3
+        if ntri != len(run.fragment(big).triangles):
+            fails.append(f"fragment {big}: {ntri} triangles in the mesh, "
+                         f"{len(run.fragment(big).triangles)} in the file")
+        print(f"{glb}: {len(nodes)} nodes, {len(anims)} animation, {checked} fragments' "
+              f"channels checked; largest fragment {big} ({masses[big]:.4g} kg) ends at "
+              f"({com[0]:.4f}, {com[1]:.4f}, {com[2]:.4f}) m, glTF key off by {err:.2g} m")
+    for m in fails:
+        print("FAIL:", m)
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        print(__doc__, file=sys.stderr)
+        sys.exit(1)
+    sys.exit(main(sys.argv[1], sys.argv[2]))

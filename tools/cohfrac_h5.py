@@ -1,0 +1,168 @@
+#!/usr/bin/python3
+"""Read a cohfrac output file (docs/output.md) with h5py and numpy only.
+
+    import sys; sys.path.insert(0, "tools")
+    import cohfrac_h5
+    run = cohfrac_h5.load("out/bunny_drop.h5")
+    run.times                      # [T] s, one per frame
+    run.fragments                  # records: parent, birth_time, mass, n_tets, com_rest, ...
+    frag = run.fragment(0)         # one fragment: surface triangles, crack flags, rest nodes
+    for pid, verts, tris, crack in run.surfaces_at(-1):   # every alive fragment, posed
+        ...                        # verts [n][3] m in the world, tris [m][3] into verts
+    run.pose(fragment_id, frame)   # (com [3] m, rotation [3][3]) or None when not alive
+    run.children(fragment_id)      # the family tree
+    run.observables["energy_kinetic"]  # Series(time [K] s, value [K], unit "J")
+
+Shapes and units follow the file: positions in m, times in s, quaternions
+(w, x, y, z) rotating the rest shape about its rest centre of mass
+(com_rest) onto the current one: x = com + R (X - com_rest).
+"""
+import collections
+
+import h5py
+import numpy as np
+
+Series = collections.namedtuple("Series", "time value unit")
+Fragment = collections.namedtuple(
+    "Fragment", "id parent birth_time mass n_tets com_rest triangles crack")
+
+
+def quat_to_matrix(q):
+    """Rotation matrix [3][3] of a unit quaternion (w, x, y, z)."""
+    w, x, y, z = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+class Run:
+    """A whole output file in memory (geometry, poses, records, observables)."""
+
+    def __init__(self, path):
+        with h5py.File(path, "r") as f:
+            self.path = path
+            self.name = f.attrs.get("scene_name", "")
+            if isinstance(self.name, bytes):
+                self.name = self.name.decode()
+            self.scene = f["parameters/scene"][()]
+            if isinstance(self.scene, bytes):
+                self.scene = self.scene.decode()
+            parts = f["particles/fragments"]
+            t = len(parts["position/step"])           # complete frames only
+            self.steps = parts["position/step"][:t]
+            self.times = parts["position/time"][:t]
+            self.ids = parts["id/value"][:t]
+            self.position = parts["position/value"][:t]
+            self.orientation = parts["orientation/value"][:t]
+            self.velocity = parts["velocity/value"][:t]
+            self.mode = parts["mode/value"][:t]
+            fr = f["fragments"]
+            self.fragments = {k: fr[k][:] for k in fr.keys()}
+            self.rest_nodes = f["mesh/rest/nodes"][:] if "mesh/rest/nodes" in f else None
+            self.rest_tets = f["mesh/rest/tets"][:] if "mesh/rest/tets" in f else None
+            if "surfaces/triangles" in f:
+                self.surface_triangles = f["surfaces/triangles"][:]
+                self.surface_crack = f["surfaces/crack"][:]
+            else:
+                self.surface_triangles = np.zeros((0, 3), int)
+                self.surface_crack = np.zeros(0, int)
+            self.observables = {}
+            for name, g in f["observables"].items():
+                unit = g["value"].attrs.get("unit", "")
+                if isinstance(unit, bytes):
+                    unit = unit.decode()
+                self.observables[name] = Series(g["time"][:], g["value"][:], unit)
+            self.parameters = {k: f["parameters"][k][()] for k in f["parameters"].keys()
+                               if k != "scene"}
+            self.obstacles = read_obstacles(self.parameters)
+
+    @property
+    def n_fragments(self):
+        return len(self.fragments["parent"])
+
+    def fragment(self, i):
+        """Fragment i's record with its surface (triangles on rest_nodes)."""
+        fr = self.fragments
+        a = int(fr["surface_first"][i]) if "surface_first" in fr else 0
+        n = int(fr["surface_count"][i]) if "surface_count" in fr else 0
+        return Fragment(i, int(fr["parent"][i]), float(fr["birth_time"][i]),
+                        float(fr["mass"][i]), int(fr["n_tets"][i]),
+                        fr["com_rest"][i] if "com_rest" in fr else np.zeros(3),
+                        self.surface_triangles[a:a + n], self.surface_crack[a:a + n])
+
+    def children(self, i):
+        """Ids of the fragments born of fragment i."""
+        return [int(j) for j in np.nonzero(self.fragments["parent"] == i)[0]]
+
+    def alive(self, frame):
+        """Ids of the fragments alive at a frame (index into times; -1 the last)."""
+        ids = self.ids[frame]
+        return [int(j) for j in ids[ids >= 0]]
+
+    def pose(self, i, frame):
+        """(com [3] m, R [3][3]) of fragment i at a frame, None when not alive."""
+        if i >= self.ids.shape[1] or self.ids[frame, i] < 0:
+            return None
+        return self.position[frame, i], quat_to_matrix(self.orientation[frame, i])
+
+    def frame_at(self, t):
+        """The last frame at or before time t, s."""
+        return max(0, int(np.searchsorted(self.times, t, side="right")) - 1)
+
+    def surfaces_at(self, frame):
+        """Every alive fragment's surface at a frame, posed in the world:
+        yields (id, vertices [n][3] m, triangles [m][3] into vertices, crack [m])."""
+        for i in self.alive(frame):
+            frag = self.fragment(i)
+            if len(frag.triangles) == 0:
+                continue
+            used, tris = np.unique(frag.triangles, return_inverse=True)
+            com, R = self.pose(i, frame)
+            verts = (self.rest_nodes[used] - frag.com_rest) @ R.T + com
+            yield i, verts, tris.reshape(-1, 3), frag.crack
+
+    def bounds(self):
+        """Box (lo [3], hi [3]) around the rest mesh and every fragment's centre."""
+        pts = [self.rest_nodes] if self.rest_nodes is not None else []
+        pos = self.position.reshape(-1, 3)
+        pts.append(pos[np.isfinite(pos).all(axis=1)])
+        allp = np.concatenate(pts)
+        return allp.min(axis=0), allp.max(axis=0)
+
+
+OBSTACLE_TYPES = ("plane", "sphere", "box", "mesh")
+
+
+def read_obstacles(params):
+    """The scene's obstacles from /parameters/obstacle_* (written at t = 0):
+    a list of dicts with type, point, normal (planes), center (at t = 0),
+    radius, half_extents, velocity (m, m/s)."""
+    if "obstacle_type" not in params:
+        return []
+    types = np.atleast_1d(params["obstacle_type"]).astype(int)
+    n = len(types)
+    vec = {k: np.reshape(params[f"obstacle_{k}"], (n, 3))
+           for k in ("point", "normal", "center", "half_extents", "velocity")}
+    radius = np.atleast_1d(params["obstacle_radius"])
+    return [dict(type=OBSTACLE_TYPES[t], radius=float(radius[j]),
+                 **{k: v[j] for k, v in vec.items()}) for j, t in enumerate(types)]
+
+
+def load(path):
+    """Read a cohfrac output file: a Run."""
+    return Run(path)
+
+
+if __name__ == "__main__":
+    import sys
+    r = load(sys.argv[1])
+    last = -1
+    print(f"{r.path}: {len(r.times)} frames to t = {r.times[last]:.4g} s, "
+          f"{r.n_fragments} fragments ever, {len(r.alive(last))} alive at the end")
+    masses = sorted(((r.fragments['mass'][i], i) for i in r.alive(last)), reverse=True)
+    for m, i in masses[:5]:
+        f = r.fragment(i)
+        print(f"  fragment {i}: {m:.4g} kg, {f.n_tets} tets, {len(f.triangles)} surface "
+              f"triangles ({int(f.crack.sum())} on cracks)")

@@ -1,0 +1,162 @@
+#!/usr/bin/python3
+"""Render a cohfrac run: PNG frames and an MP4 of every fragment's surface.
+
+    tools/render.py OUT.h5 [-o DIR] [--fps N] [--size WxH] [--frames a:b]
+
+Writes DIR/frame_0000.png ... (one per output frame) and DIR/<name>.mp4
+(ffmpeg, H.264); without -o the frames go to OUT minus .h5 plus "_frames"
+and the movie beside the file, as OUT minus .h5 plus ".mp4".  The camera
+looks at the whole run (the rest mesh and every fragment's path) from above
+and to the side, +z up; the ground plane and the other obstacles are drawn
+(spheres and boxes where they are at each frame); fragments are coloured by
+id, crack faces darker.  Reads the file with tools/cohfrac_h5.py.
+
+Exit status: 0 done, 2 the file has no geometry (an older file), 3
+matplotlib is missing, 5 ffmpeg failed or is missing (the PNGs stay).
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+try:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+except ImportError:
+    print("render.py: matplotlib is missing (Debian: python3-matplotlib)", file=sys.stderr)
+    sys.exit(3)
+import numpy as np
+
+import cohfrac_h5
+
+LIGHT = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+
+
+def shade(rgb, normals):
+    """Lambert shading of base colours [n][3] by unit normals [n][3]."""
+    lam = np.clip(np.abs(normals @ LIGHT), 0.0, 1.0)
+    return np.clip(rgb * (0.35 + 0.65 * lam)[:, None], 0, 1)
+
+
+def fragment_polys(run, frame, cmap):
+    """Triangles [n][3][3] and face colours [n][4] of every alive fragment."""
+    polys, colours = [], []
+    for i, verts, tris, crack in run.surfaces_at(frame):
+        tri = verts[tris]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+        base = np.tile(np.array(cmap(i % 20)[:3]), (len(tri), 1))
+        base[crack.astype(bool)] *= 0.55
+        polys.append(tri)
+        colours.append(np.column_stack([shade(base, n), np.ones(len(tri))]))
+    if not polys:
+        return np.zeros((0, 3, 3)), np.zeros((0, 4))
+    return np.concatenate(polys), np.concatenate(colours)
+
+
+def obstacle_artists(ax, run, t, lo, hi):
+    """Draw the obstacles at time t inside the box lo..hi."""
+    for o in run.obstacles:
+        c = np.asarray(o["center"]) + t * np.asarray(o["velocity"])
+        if o["type"] == "plane":
+            n = np.asarray(o["normal"])
+            p = np.asarray(o["point"])
+            if abs(n[2]) > 0.9:          # a floor: a square under the run
+                z = p[2] - (n[0] * 0 + n[1] * 0)
+                sq = np.array([[lo[0], lo[1], z], [hi[0], lo[1], z],
+                               [hi[0], hi[1], z], [lo[0], hi[1], z]])
+                ax.add_collection3d(Poly3DCollection([sq], facecolor=(0.82, 0.82, 0.78, 1),
+                                                     edgecolor=(0.6, 0.6, 0.6, 1)))
+        elif o["type"] == "sphere":
+            u, v = np.mgrid[0:2 * np.pi:24j, 0:np.pi:12j]
+            r = o["radius"]
+            ax.plot_surface(c[0] + r * np.cos(u) * np.sin(v), c[1] + r * np.sin(u) * np.sin(v),
+                            c[2] + r * np.cos(v), color=(0.55, 0.6, 0.7), alpha=0.5,
+                            linewidth=0)
+        elif o["type"] == "box":
+            h = np.asarray(o["half_extents"])
+            corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1)
+                                for sz in (-1, 1)]) * h + c
+            faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4],
+                     [1, 3, 7, 5]]
+            ax.add_collection3d(Poly3DCollection([corners[f] for f in faces],
+                                                 facecolor=(0.55, 0.6, 0.7, 0.4),
+                                                 edgecolor=(0.4, 0.4, 0.5, 0.6)))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("h5")
+    ap.add_argument("-o", "--output", help="directory for the frames and the movie")
+    ap.add_argument("--fps", type=int, default=24)
+    ap.add_argument("--size", default="960x720", help="WxH in pixels")
+    ap.add_argument("--frames", default=":", help="a:b, a Python slice of the frames")
+    a = ap.parse_args()
+    run = cohfrac_h5.load(a.h5)
+    if run.rest_nodes is None:
+        print(f"render.py: {a.h5} holds no geometry (/mesh/rest): written by an older "
+              "cohfrac; run the scene again", file=sys.stderr)
+        return 2
+    out = a.output or os.path.splitext(a.h5)[0] + "_frames"
+    os.makedirs(out, exist_ok=True)
+    w, h = (int(x) for x in a.size.lower().split("x"))
+    lo, hi = run.bounds()
+    pad = 0.15 * (hi - lo).max()
+    lo, hi = lo - pad, hi + pad
+    floor = [o for o in run.obstacles if o["type"] == "plane" and abs(o["normal"][2]) > 0.9]
+    if floor:
+        lo[2] = min(lo[2], floor[0]["point"][2])
+    cmap = plt.get_cmap("tab20")
+    start, _, stop = a.frames.partition(":")
+    frames = range(len(run.times))[slice(int(start) if start else None,
+                                         int(stop) if stop else None)]
+    dpi = 100
+    for k, fr in enumerate(frames):
+        fig = plt.figure(figsize=(w / dpi, h / dpi), dpi=dpi)
+        ax = fig.add_subplot(projection="3d")
+        ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
+        ax.set_box_aspect(hi - lo)
+        ax.view_init(elev=18, azim=-60)
+        ax.set_axis_off()
+        ax.computed_zorder = False  # the floor first, then the fragments over it
+        t = run.times[fr]
+        obstacle_artists(ax, run, t, lo, hi)
+        polys, colours = fragment_polys(run, fr, cmap)
+        if len(polys):
+            ax.add_collection3d(Poly3DCollection(polys, facecolors=colours, edgecolors="none"))
+        n_alive = len(run.alive(fr))
+        ax.set_title(f"{run.name}   t = {t:.3f} s   {n_alive} fragment{'s' * (n_alive != 1)}",
+                     fontsize=11)
+        fig.subplots_adjust(0, 0, 1, 0.95)
+        fig.savefig(os.path.join(out, f"frame_{k:04d}.png"), dpi=dpi)
+        plt.close(fig)
+        if sys.stderr.isatty():
+            print(f"\rrender: frame {k + 1}/{len(frames)} (t = {t:.3f} s)", end="",
+                  file=sys.stderr, flush=True)
+        elif (k + 1) % 20 == 0 or k + 1 == len(frames):
+            print(f"render: frame {k + 1}/{len(frames)} (t = {t:.3f} s)", file=sys.stderr)
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    movie = (os.path.join(out, (run.name or "run") + ".mp4") if a.output
+             else os.path.splitext(a.h5)[0] + ".mp4")
+    ffmpeg = shutil.which("ffmpeg")
+    if not ffmpeg:
+        print("render.py: ffmpeg is missing (Debian: ffmpeg): PNG frames only", file=sys.stderr)
+        return 5
+    cmd = [ffmpeg, "-y", "-loglevel", "error", "-framerate", str(a.fps), "-i",
+           os.path.join(out, "frame_%04d.png"), "-c:v", "libx264", "-pix_fmt", "yuv420p",
+           "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", movie]
+    if subprocess.run(cmd).returncode != 0:
+        print(f"render.py: ffmpeg failed: PNG frames in {out}", file=sys.stderr)
+        return 5
+    print(f"render: {len(frames)} frames, {movie} ({len(frames) / a.fps:.1f} s at {a.fps} fps)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
