@@ -17,6 +17,22 @@ grep '^fragments' "$tmp/run.txt"
 /usr/bin/python3 "$src/tools/cohfrac_h5.py" "$tmp/box.h5"
 "$exe" export "$tmp/box.h5" --format gltf -o "$tmp/box.glb"
 /usr/bin/python3 "$src/tools/check_gltf.py" "$tmp/box.h5" "$tmp/box.glb"
+"$exe" export "$tmp/box.h5" --format pvd -o "$tmp/pvd"
+/usr/bin/python3 - "$tmp/box.h5" "$tmp/pvd" "$src/tools" <<'PY'
+# The ParaView series: a .vtu per frame whose cells carry every alive
+# fragment (read back with meshio), and a .pvd that lists them.
+import os, sys
+sys.path.insert(0, sys.argv[3])
+import meshio, numpy as np, cohfrac_h5
+run = cohfrac_h5.load(sys.argv[1])
+for k in (0, len(run.times) - 1):
+    m = meshio.read(os.path.join(sys.argv[2], f"frame_{k:04d}.vtu"))
+    got = sorted(set(np.concatenate(m.cell_data["fragment"]).tolist()))
+    assert got == sorted(run.alive(k)), (k, got, run.alive(k))
+print(f"pvd: frames 0 and {len(run.times) - 1} hold the alive fragments "
+      f"({len(run.alive(0))} and {len(run.alive(-1))})")
+PY
+grep -q 'frame_0000.vtu' "$tmp/pvd/box_break.pvd"
 if ! command -v ffmpeg >/dev/null; then
     echo "ffmpeg is not installed (make test's set-up installs it): render not checked"
     exit 0

@@ -204,13 +204,13 @@ static void write_scenario(const char *path)
     assert_int_equal(cf_h5_open(path, "drop", SCENE_TEXT, &h, &err), CF_OK);
     assert_non_null(h);
 
-    const cf_frag_info first = {0, -1, 0.0, 2.5, 100, {1.0, 2.0, 3.0}, 0, 0, 0};
+    const cf_frag_info first = {0, -1, 0.0, 2.5, 100, {1.0, 2.0, 3.0}, 0, 0, 0, {0, 0, 0}, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &first, 1, &err), CF_OK);
     for (int t = 0; t < NFRAMES; ++t) {
         if (t == 2) {
             /* the split's children, given out of id order */
-            const cf_frag_info kids[2] = {{2, 0, 0.02, 1.0, 40, {0.1, 0.2, 0.3}, 0, 0, 0},
-                                          {1, 0, 0.02, 1.5, 60, {0.4, 0.5, 0.6}, 0, 0, 0}};
+            const cf_frag_info kids[2] = {{2, 0, 0.02, 1.0, 40, {0.1, 0.2, 0.3}, 0, 0, 0, {0, 0, 0}, 0, 0},
+                                          {1, 0, 0.02, 1.5, 60, {0.4, 0.5, 0.6}, 0, 0, 0, {0, 0, 0}, 0, 0}};
             assert_int_equal(cf_h5_add_fragments(h, kids, 2, &err), CF_OK);
         }
         cf_frag_frame frames[NFRAGS];
@@ -458,7 +458,7 @@ static void test_growth(void **state)
     for (int t = 0; t < T; ++t) {
         int n = t + 1 < NMAX ? t + 1 : NMAX;
         if (t < NMAX) {
-            cf_frag_info fi = {t, t == 0 ? -1 : 0, 0.001 * t, 1.0, 4, {1, 1, 1}, 0, 0, 0};
+            cf_frag_info fi = {t, t == 0 ? -1 : 0, 0.001 * t, 1.0, 4, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
             assert_int_equal(cf_h5_add_fragments(h, &fi, 1, &err), CF_OK);
         }
         for (int j = 0; j < n; ++j)
@@ -561,7 +561,7 @@ static void test_readable_while_open(void **state)
     cf_error err = {0};
     cf_h5 *h = NULL;
     assert_int_equal(cf_h5_open(path, "live", "x = 1", &h, &err), CF_OK);
-    const cf_frag_info fi = {0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0};
+    const cf_frag_info fi = {0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &fi, 1, &err), CF_OK);
     for (int t = 0; t < 2; ++t) {
         cf_frag_frame fr = frag_state(0, t, 0);
@@ -606,8 +606,8 @@ static void test_killed_writer(void **state)
     if (pid == 0) {
         cf_error err = {0};
         cf_h5 *h = NULL;
-        const cf_frag_info fi[2] = {{0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0},
-                                    {1, -1, 0.0, 2.0, 20, {2, 2, 2}, 0, 0, 0}};
+        const cf_frag_info fi[2] = {{0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0},
+                                    {1, -1, 0.0, 2.0, 20, {2, 2, 2}, 0, 0, 0, {0, 0, 0}, 0, 0}};
         if (cf_h5_open(path, "killed", "", &h, &err) != CF_OK ||
             cf_h5_add_fragments(h, fi, 2, &err) != CF_OK)
             _exit(2);
@@ -721,13 +721,13 @@ static void test_bad_arguments(void **state)
     cf_h5 *h = NULL;
     assert_int_equal(cf_h5_open(path, NULL, NULL, &h, &err), CF_OK);
 
-    const cf_frag_info skip = {1, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0};
+    const cf_frag_info skip = {1, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &skip, 1, &err), CF_ERR_OUTPUT);
     assert_non_null(strstr(err.msg, path));
-    const cf_frag_info twice[2] = {{0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0},
-                                   {0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0}};
+    const cf_frag_info twice[2] = {{0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0},
+                                   {0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0}};
     assert_int_equal(cf_h5_add_fragments(h, twice, 2, &err), CF_ERR_OUTPUT);
-    const cf_frag_info orphan = {0, 5, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0};
+    const cf_frag_info orphan = {0, 5, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &orphan, 1, &err), CF_ERR_OUTPUT);
 
     cf_frag_frame dup[2] = {frag_state(3, 0, 0), frag_state(3, 0, 0)};

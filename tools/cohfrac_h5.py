@@ -150,14 +150,56 @@ def read_obstacles(params):
                  **{k: v[j] for k, v in vec.items()}) for j, t in enumerate(types)]
 
 
+def export_pvd(run, out_dir):
+    """Write a ParaView time series: out_dir/frame_NNNN.vtu (every alive
+    fragment's posed surface as triangles, cell data `fragment` and `crack`,
+    through meshio) and out_dir/<name>.pvd listing them with their times.
+    Returns the .pvd path."""
+    import meshio
+    import os
+    from xml.sax.saxutils import quoteattr
+    os.makedirs(out_dir, exist_ok=True)
+    entries = []
+    for k, t in enumerate(run.times):
+        pts, tris, fid, crack, base = [], [], [], [], 0
+        for i, verts, tri, cr in run.surfaces_at(k):
+            pts.append(verts)
+            tris.append(tri + base)
+            fid.append(np.full(len(tri), i, np.int32))
+            crack.append(cr.astype(np.int32))
+            base += len(verts)
+        if not pts:
+            continue
+        name = f"frame_{k:04d}.vtu"
+        meshio.write(os.path.join(out_dir, name),
+                     meshio.Mesh(np.concatenate(pts), [("triangle", np.concatenate(tris))],
+                                 cell_data={"fragment": [np.concatenate(fid)],
+                                            "crack": [np.concatenate(crack)]}),
+                     binary=True)
+        entries.append(f'    <DataSet timestep="{t:.9g}" file={quoteattr(name)}/>')
+    pvd = os.path.join(out_dir, (run.name or "run") + ".pvd")
+    with open(pvd, "w") as f:
+        f.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
+                "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
+    return pvd
+
+
 def load(path):
     """Read a cohfrac output file: a Run."""
     return Run(path)
 
 
 if __name__ == "__main__":
-    import sys
-    r = load(sys.argv[1])
+    import argparse
+    ap = argparse.ArgumentParser(description="Summarise a cohfrac output file, or write "
+                                 "its fragments' surfaces as a ParaView time series.")
+    ap.add_argument("h5")
+    ap.add_argument("--pvd", metavar="DIR", help="write DIR/frame_NNNN.vtu and DIR/<name>.pvd")
+    a = ap.parse_args()
+    r = load(a.h5)
+    if a.pvd:
+        print(f"wrote {export_pvd(r, a.pvd)}")
+        raise SystemExit(0)
     last = -1
     print(f"{r.path}: {len(r.times)} frames to t = {r.times[last]:.4g} s, "
           f"{r.n_fragments} fragments ever, {len(r.alive(last))} alive at the end")

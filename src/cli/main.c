@@ -91,11 +91,14 @@ static const struct {
      "          --fps N                     frames per second of the movie (default 24)\n"
      "          --size WxH                  pixels (default 960x720)\n"},
     {"export",
-     "  cohfrac export OUT.h5 --format gltf -o FILE.glb\n"
-     "                                      the fragments for Blender, three.js, game engines:\n"
-     "                                      a mesh per fragment, one animation of their poses\n"
-     "      -f, --format gltf               the format (glTF 2.0 binary)\n"
-     "      -o, --output FILE               the file to write (default: OUT minus .h5, .glb)\n"},
+     "  cohfrac export OUT.h5 --format gltf|pvd [-o PATH]\n"
+     "                                      the fragments for other tools: gltf (Blender,\n"
+     "                                      three.js, game engines: a mesh per fragment, one\n"
+     "                                      animation of their poses) or pvd (ParaView: a\n"
+     "                                      .vtu of the posed surfaces per frame, a .pvd)\n"
+     "      -f, --format gltf|pvd           the format (default gltf: glTF 2.0 binary)\n"
+     "      -o, --output PATH               gltf: the file (default OUT minus .h5, .glb);\n"
+     "                                      pvd: the directory (default OUT minus .h5, _pvd)\n"},
     {"bench",
      "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 3.1 m/s)\n"
      "                                      against the memory floor, 1 against N threads\n"
@@ -539,12 +542,13 @@ static int cmd_export(int argc, char **argv)
                                        {"output", required_argument, 0, 'o'},
                                        {0, 0, 0, 0}};
     const char *out = NULL;
-    int c;
+    int c, pvd = 0;
     while ((c = getopt_long(argc, argv, "f:o:", lo, NULL)) != -1) {
         switch (c) {
         case 'f':
-            if (strcmp(optarg, "gltf") != 0 && strcmp(optarg, "glb") != 0)
-                return usage_error("--format: only gltf (glTF 2.0 binary, .glb) is written");
+            pvd = strcmp(optarg, "pvd") == 0;
+            if (!pvd && strcmp(optarg, "gltf") != 0 && strcmp(optarg, "glb") != 0)
+                return usage_error("--format is gltf (glTF 2.0 binary, .glb) or pvd (ParaView)");
             break;
         case 'o': out = optarg; break;
         default: return usage_error("bad option for 'export'");
@@ -557,8 +561,14 @@ static int cmd_export(int argc, char **argv)
     if (!out) {
         const char *dot = strrchr(in, '.');
         int len = dot && !strchr(dot, '/') ? (int)(dot - in) : (int)strlen(in);
-        snprintf(def, sizeof def, "%.*s.glb", len, in);
+        snprintf(def, sizeof def, "%.*s%s", len, in, pvd ? "_pvd" : ".glb");
         out = def;
+    }
+    if (pvd) { /* tools/cohfrac_h5.py writes it (meshio) */
+        const char *args[] = {in, "--pvd", out, NULL};
+        return cf_report_plot("cohfrac_h5.py", NULL, args, "no ParaView series")
+                   ? 0
+                   : cf_status_exit_code(CF_ERR_EXTERNAL);
     }
     cf_error err = {0};
     if (cf_export_gltf(in, out, &err) != CF_OK)

@@ -180,7 +180,9 @@ static cf_status drain_events(cf_sim *sim, cf_error *err)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
             for (int k = 0; k < e->count; k++)
                 cf_world_fragment_info(sim->world, e->first + k, &info[k]);
+            double t0 = cf_wall_time();
             st = write_surfaces(sim, info, e->first, e->count, err);
+            sim->output_time += cf_wall_time() - t0;
             if (st == CF_OK)
                 st = cf_h5_add_fragments(sim->h5, info, e->count, err);
             free(info);
@@ -287,8 +289,10 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
         st = cf_h5_open(def->output.file, def->name, def->resolved, &sim->h5, err);
         if (st == CF_OK)
             st = write_initial_bounds(sim, err);
+        double t0 = cf_wall_time();
         if (st == CF_OK)
             st = write_rest_mesh(sim, err);
+        sim->output_time += cf_wall_time() - t0;
     }
     if (st == CF_OK)
         st = drain_events(sim, err);

@@ -1,0 +1,56 @@
+#!/bin/sh
+# Other tools open the exported fragments of a cube that cracks on the
+# ground (tests/data/box_break.lua):
+#   blender   Blender 3.4 (Debian `blender`, headless) imports `cohfrac export`'s
+#             glTF: a mesh object per fragment with a surface, and the largest
+#             fragment at the end where the HDF5 file has it (within 1 mm);
+#   paraview  ParaView 5.11 (`paraview`, `python3-paraview`, through xvfb-run)
+#             plays `cohfrac export --format pvd`: at the last frame the
+#             connected surface pieces are the fragments alive.
+# Skipped, with a line saying so, where the program is not installed.
+#   tests/output_viewers.sh blender|paraview COHFRAC SOURCE_DIR MESH_DIR
+set -eu
+tool=$1
+exe=$2
+src=$3
+need=blender
+[ "$tool" = paraview ] && need="pvpython xvfb-run"
+for p in $need; do
+    if ! command -v "$p" >/dev/null; then
+        echo "$p is not installed (make test's set-up installs it): $tool not checked"
+        exit 0
+    fi
+done
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+"$exe" run "$src/tests/data/box_break.lua" -q -m "$4" -o "$tmp/box.h5" > /dev/null
+# What the HDF5 file says: fragments with a surface, alive at the end, the
+# largest of those, the last time and its position there.
+set -- $(/usr/bin/python3 - "$tmp/box.h5" "$src/tools" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[2])
+import cohfrac_h5
+r = cohfrac_h5.load(sys.argv[1])
+n = sum(1 for i in range(r.n_fragments) if len(r.fragment(i).triangles))
+big = max(r.alive(-1), key=lambda i: r.fragments["mass"][i])
+print(n, len(r.alive(-1)), big, r.times[-1], *r.position[-1, big])
+PY
+)
+n=$1 alive=$2 big=$3 t_end=$4 hx=$5 hy=$6 hz=$7
+if [ "$tool" = blender ]; then
+    "$exe" export "$tmp/box.h5" --format gltf -o "$tmp/box.glb" > /dev/null
+    HOME=$tmp blender -b --factory-startup --python "$src/tools/blender_check.py" -- \
+        "$tmp/box.glb" "$big" "$t_end" > "$tmp/out.txt" 2>&1 || { cat "$tmp/out.txt"; exit 1; }
+    got=$(awk '$1 == "objects" {print $2}' "$tmp/out.txt")
+    pos=$(awk '$1 == "position" {print $2, $3, $4}' "$tmp/out.txt")
+    echo "Blender: $got mesh objects (HDF5: $n fragments with a surface); fragment $big at t = $t_end s: ($pos) m, HDF5 ($hx, $hy, $hz) m"
+    [ "$got" = "$n" ]
+    /usr/bin/python3 -c "import sys; a = [float(v) for v in sys.argv[1].split()]; b = [float(v) for v in sys.argv[2:]]; sys.exit(max(abs(p - q) for p, q in zip(a, b)) > 1e-3)" "$pos" "$hx" "$hy" "$hz"
+else
+    "$exe" export "$tmp/box.h5" --format pvd -o "$tmp/pvd" > /dev/null
+    HOME=$tmp xvfb-run -a pvpython "$src/tools/paraview_check.py" "$tmp/pvd/box_break.pvd" \
+        > "$tmp/out.txt" 2>&1 || { cat "$tmp/out.txt"; exit 1; }
+    pieces=$(awk '$1 == "pieces" {print $2}' "$tmp/out.txt")
+    echo "ParaView: $(awk '$1 == "times" {print $2}' "$tmp/out.txt") time steps; at the last, $pieces connected surface pieces; the HDF5 file has $alive fragments alive"
+    [ "$pieces" = "$alive" ]
+fi
