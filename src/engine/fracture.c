@@ -151,7 +151,7 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
         /* With PBD the crack faces are kept apart by the constraint in the
          * projection; the penalty is for explicit runs. */
         double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;
-        cf_cohesive_forces(s, &sim->ppr, f->coh.v, f->coh.n, dt, kp);
+        cf_cohesive_forces(s, sim->law, sim->law_params, f->coh.v, f->coh.n, dt, kp);
     } else {
         for (int i = 0; i < f->nodes.n; i++) {
             int a = f->nodes.v[i];

@@ -458,7 +458,8 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
     sim->bullet_base = cfb_allocated_bytes();
     if (scene->solver.threads > 0)
         omp_set_num_threads(scene->solver.threads);
-    cf_ppr_init(&sim->ppr, &scene->material);
+    sim->law = &cf_law_ppr;
+    sim->law->init(sim->law_params, &scene->material);
 
     cf_mesh all = {0};
     int *body = NULL, *bc = NULL;

@@ -5,7 +5,7 @@
 
 #include "cf_bullet.h"
 #include "clock.h"
-#include "cohesive_ppr.h"
+#include "cohesive.h"
 #include "contact.h"
 #include "decompose.h"
 #include "cohfrac/world.h"
@@ -84,7 +84,8 @@ struct cf_world {
     cf_world_def def;        /* the world's copy (obstacles and boundaries too) */
     const cf_world_def *scene; /* &def */
     cf_solid solid;
-    cf_ppr ppr;
+    const cf_cohesive_law *law; /* the cohesive law (PPR) and its parameters */
+    double law_params[CF_LAW_PARAMS_MAX];
     cf_obstacles obs;
     cf_fragment *frag;
     int n_frag, cap_frag;

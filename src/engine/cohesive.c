@@ -1,0 +1,195 @@
+/* Cohesive elements (cohesive.h): forces, energy, state and the
+ * crack-contact constraint, for any cohesive law (cohesive_law.h). */
+#include "cohesive.h"
+
+#include "linalg.h"
+
+#include <string.h>
+
+/* The current nodes of pair i of element ce, side A and side B. */
+static void pair_nodes(const cf_solid *s, const cf_cohesive *ce, int i, int *a, int *b)
+{
+    *a = s->tet[4 * ce->tet[0] + ce->slot[0][i]];
+    *b = s->tet[4 * ce->tet[1] + ce->slot[1][i]];
+}
+
+/* Unit normal (A -> B) and area of element ce's mid-surface at positions pos. */
+static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double *pos, int a[3],
+                         int b[3], double n[3])
+{
+    double mid[3][3];
+    for (int i = 0; i < 3; i++) {
+        pair_nodes(s, ce, i, &a[i], &b[i]);
+        for (int k = 0; k < 3; k++)
+            mid[i][k] = 0.5 * (pos[3 * a[i] + k] + pos[3 * b[i] + k]);
+    }
+    double e1[3], e2[3];
+    v3_sub(mid[1], mid[0], e1), v3_sub(mid[2], mid[0], e2), v3_cross(e1, e2, n);
+    double nn = v3_norm(n);
+    for (int k = 0; k < 3 && nn > 0; k++)
+        n[k] /= nn;
+    return 0.5 * nn;
+}
+
+/* Work absorbed by one scalar traction-opening component between the last
+ * evaluation (d0, T0) and this one (d, T), trapezoidal in the opening.  The
+ * normal law is discontinuous at zero opening (penalty below, cohesive
+ * above): a step that crosses zero is split there, t0plus being the
+ * cohesive traction at 0+. */
+static double component_work(double d0, double T0, double d, double T, double t0plus)
+{
+    if (d0 <= 0 && d > 0)
+        return -0.5 * T0 * d0 + 0.5 * (t0plus + T) * d;
+    if (d0 > 0 && d <= 0)
+        return -0.5 * (T0 + t0plus) * d0 + 0.5 * T * d;
+    return 0.5 * (T0 + T) * (d - d0);
+}
+
+int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
+                       const int *elems, int n, double dt, double kp)
+{
+    int n_failed = 0;
+    for (int e = 0; e < n; e++) {
+        cf_cohesive *ce = &s->coh[elems[e]];
+        int a[3], b[3];
+        double nrm[3];
+        double area = mid_normal(s, ce, s->x, a, b, nrm);
+        if (area == 0)
+            continue;
+        /* The law of the facet's strength (material.strength). */
+        double scaled[CF_LAW_PARAMS_MAX];
+        const void *p = params;
+        if (ce->strength != 1.0) {
+            memcpy(scaled, params, law->params_size);
+            law->scale(scaled, ce->strength);
+            p = scaled;
+        }
+        for (int i = 0; i < 3; i++) {
+            if (a[i] == b[i]) /* the crack has not opened at this vertex yet */
+                continue;
+            double d[3], tv[3];
+            v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
+            double dn = v3_dot(d, nrm);
+            for (int k = 0; k < 3; k++)
+                tv[k] = d[k] - dn * nrm[k];
+            double dtl = v3_norm(tv);
+            double Tn, Tt, e0n, e0t;
+            law->envelope(p, 0, ce->dt_max[i], &e0n, &e0t);
+            double t0plus = ce->dn_max[i] > 0 ? 0 : e0n; /* secant or envelope at 0+ */
+            law->traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
+            n_failed += ce->failed[i];
+            /* Stability cap of a node pair at step dt: a node pair is shared
+             * by up to ~8 elements, so a sixteenth of the two-mass limit
+             * 4/(dt^2 (wa + wb)) keeps their sum stable. */
+            double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
+            double cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
+            if (dn <= 0) { /* compression: penalty, while the faces still face each other */
+                double facing = kp >= 0 && v3_dot(d, d) <= 0.25 * area;
+                Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
+            }
+            /* The tangential traction rises from zero with the capped
+             * stiffness: at zero tangential opening its direction is
+             * undefined, and a jump to tau_max there would act in a
+             * direction set by round-off (time continuity, Papoulia et al.
+             * 2003). */
+            Tt = fmin(Tt, cap * dtl);
+            if (!ce->started[i]) {
+                law->envelope(p, 0, 0, &e0n, &e0t);
+                ce->last[i][0] = 0, ce->last[i][1] = 0, ce->last[i][2] = e0n;
+                ce->last[i][3] = ce->dt_max[i] > 0 ? 0 : e0t; /* secant or envelope at 0 */
+                ce->started[i] = 1;
+            }
+            double *L = ce->last[i];
+            ce->work[i] += area / 3.0 *
+                           (component_work(L[0], L[2], dn, Tn, t0plus) + 0.5 * (L[3] + Tt) * (dtl - L[1]));
+            double elastic = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
+            ce->dissipated[i] = fmax(ce->dissipated[i], ce->work[i] - elastic);
+            ce->stored[i] = ce->work[i] - ce->dissipated[i];
+            L[0] = dn, L[1] = dtl, L[2] = Tn, L[3] = Tt;
+            double fvec[3] = {0, 0, 0};
+            v3_axpy(area / 3.0 * Tn, nrm, fvec);
+            if (dtl > 0)
+                v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
+            v3_axpy(1.0, fvec, &s->f[3 * a[i]]); /* pulls A towards B */
+            v3_axpy(-1.0, fvec, &s->f[3 * b[i]]);
+        }
+    }
+    return n_failed;
+}
+
+void cf_cohesive_energy(const cf_solid *s, const int *elems, int n, double *stored,
+                        double *dissipated)
+{
+    double st = 0, w = 0;
+    int count = elems ? n : s->n_coh;
+    for (int e = 0; e < count; e++) {
+        const cf_cohesive *ce = &s->coh[elems ? elems[e] : e];
+        for (int i = 0; i < 3; i++)
+            st += ce->stored[i], w += ce->dissipated[i];
+    }
+    *stored = st;
+    *dissipated = w;
+}
+
+double cf_cohesive_release(cf_solid *s, const int *elems, int n)
+{
+    double dropped = 0;
+    for (int e = 0; e < n; e++) {
+        cf_cohesive *ce = &s->coh[elems[e]];
+        for (int i = 0; i < 3; i++) {
+            dropped += ce->stored[i];
+            ce->work[i] -= ce->stored[i];
+            ce->stored[i] = 0;
+            ce->started[i] = 0;
+        }
+    }
+    return dropped;
+}
+
+void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
+{
+    for (int e = 0; e < n; e++) {
+        int a[3], b[3];
+        double nrm[3];
+        double area = mid_normal(s, &s->coh[elems[e]], s->p, a, b, nrm);
+        if (area == 0)
+            continue;
+        for (int i = 0; i < 3; i++) {
+            if (a[i] == b[i])
+                continue;
+            double d[3];
+            v3_sub(&s->p[3 * b[i]], &s->p[3 * a[i]], d);
+            double dn = v3_dot(d, nrm);
+            /* Only faces still facing each other: once the sides have moved
+             * apart by more than the facet's size the mid-surface means nothing. */
+            if (dn >= 0 || v3_dot(d, d) > 0.25 * area)
+                continue;
+            double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]], c = dn / (wa + wb);
+            v3_axpy(wa * c, nrm, &s->p[3 * a[i]]);
+            v3_axpy(-wb * c, nrm, &s->p[3 * b[i]]);
+        }
+    }
+}
+
+void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double normal[3],
+                       double *area, double *opening, double *sliding, int *failed)
+{
+    const cf_cohesive *ce = &s->coh[e];
+    int a[3], b[3];
+    *area = mid_normal(s, ce, s->x, a, b, normal);
+    *opening = *sliding = 0;
+    *failed = ce->failed[0] && ce->failed[1] && ce->failed[2];
+    centroid[0] = centroid[1] = centroid[2] = 0;
+    for (int i = 0; i < 3; i++) {
+        double d[3], mid[3];
+        v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
+        double dn = v3_dot(d, normal);
+        for (int k = 0; k < 3; k++) {
+            mid[k] = 0.5 * (s->x[3 * a[i] + k] + s->x[3 * b[i] + k]);
+            centroid[k] += mid[k] / 3.0;
+            d[k] -= dn * normal[k];
+        }
+        *opening += dn / 3.0;
+        *sliding += v3_norm(d) / 3.0;
+    }
+}
