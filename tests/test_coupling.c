@@ -87,7 +87,7 @@ static cf_sim *make_sim(const char *text, cf_world_def *sc)
     cf_status st = cf_scene_load(path, NULL, 0, COHFRAC_MESH_DIR, sc, &err);
     if (st != CF_OK)
         fail_msg("scene: %s", err.msg);
-    cf_run_options opt = {0, 0, COHFRAC_MESH_DIR};
+    cf_run_options opt = {.mesh_dir = COHFRAC_MESH_DIR};
     cf_sim *sim = NULL;
     st = cf_sim_create(sc, &opt, &sim, &err);
     if (st != CF_OK)
@@ -403,7 +403,7 @@ static int expanding_bar(const char *strength, int threads, uint64_t *hash)
     cf_error err = {0};
     if (cf_scene_load(path, sets, 3, COHFRAC_MESH_DIR, &sc, &err) != CF_OK)
         fail_msg("scene: %s", err.msg);
-    cf_run_options opt = {0, 0, COHFRAC_MESH_DIR};
+    cf_run_options opt = {.mesh_dir = COHFRAC_MESH_DIR};
     cf_sim *sim = NULL;
     if (cf_sim_create(&sc, &opt, &sim, &err) != CF_OK)
         fail_msg("sim: %s", err.msg);

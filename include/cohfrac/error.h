@@ -15,6 +15,8 @@
  *      last frame
  *   4  output could not be written
  *   5  a required external program or resource failed (tetgen, gmsh, memory)
+ *   130, 143  interrupted by SIGINT, SIGTERM (128 + the signal): the current
+ *      frame was finished and the output file closed, readable
  */
 #ifndef COHFRAC_ERROR_H
 #define COHFRAC_ERROR_H
@@ -39,7 +41,8 @@
     X(CF_ERR_DIVERGED, 3, "simulation diverged")                               \
     X(CF_ERR_OUTPUT, 4, "output file could not be written")                    \
     X(CF_ERR_EXTERNAL, 5, "external program failed")                           \
-    X(CF_ERR_NOMEM, 5, "out of memory")
+    X(CF_ERR_NOMEM, 5, "out of memory")                                      \
+    X(CF_ERR_INTERRUPTED, 130, "interrupted by a signal")
 
 typedef enum {
 #define CF_X_ENUM(name, code, text) name,

@@ -102,6 +102,10 @@ typedef struct cf_frag_frame {
     double w[3];             /* rad/s */
 } cf_frag_frame;
 
+/* 1 when `path` is an HDF5 file that cohfrac wrote (root attribute
+ * creator = "cohfrac"), 0 otherwise (absent, not HDF5, another writer's). */
+int cf_h5_is_output(const char *path);
+
 /* Create (truncate) `path` and write the root attributes and the scene text.
  * The parent directory is created if missing.  Also writes `<path minus .h5>.xdmf`
  * on close.  Error CF_ERR_OUTPUT names the path and the HDF5 reason; on any
@@ -130,7 +134,7 @@ cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int
                                 const char *unit, cf_error *err);
 
 /* Append `n` rows to /cracks (created on the first call, even with n = 0).
- * Flushes. */
+ * Reaches the disk with the next flush (the frame's). */
 cf_status cf_h5_add_cracks(cf_h5 *h, const cf_crack_row *rows, int n, cf_error *err);
 
 /* Geometry (docs/output.md).  The rest mesh once: /mesh/rest/nodes[n][3]

@@ -13,6 +13,7 @@
 #ifndef COHFRAC_SIM_H
 #define COHFRAC_SIM_H
 
+#include <signal.h>
 #include <stdio.h>
 
 #include "cohfrac/error.h"
@@ -27,10 +28,17 @@ typedef struct cf_run_options {
     int threads;          /* OpenMP threads for element loops; 0: the definition's setting */
     const char *mesh_dir; /* where primitives are meshed and cached (NULL:
                              cf_default_mesh_dir) */
+    int force;            /* 1: overwrite an existing output file that is not a cohfrac
+                             output (otherwise CF_ERR_OUTPUT: nothing the user did not
+                             ask to lose is overwritten) */
+    const volatile sig_atomic_t *stop; /* when set and *stop becomes nonzero (a signal handler),
+                             cf_sim_run finishes the step, writes a last frame,
+                             closes the file and returns CF_ERR_INTERRUPTED */
 } cf_run_options;
 
 /* Errors: those of cf_world_meshes_load, cf_world_create, and CF_ERR_OUTPUT
- * (cf_h5_open).  `def` is read during the call only. */
+ * (cf_h5_open; or the output file exists and is not a cohfrac output, and
+ * opt->force is 0).  `def` is read during the call only. */
 cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
                         cf_error *err);
 
@@ -41,7 +49,7 @@ cf_status cf_sim_advance(cf_sim *sim, cf_error *err);
 int cf_sim_done(const cf_sim *sim);
 
 /* Advance to the duration, then close the output file (also on error: what
- * was written stays readable). */
+ * was written stays readable).  CF_ERR_INTERRUPTED when opt->stop was set. */
 cf_status cf_sim_run(cf_sim *sim, cf_error *err);
 
 /* The world being run: for every query of cohfrac/world.h. */

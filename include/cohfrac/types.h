@@ -168,6 +168,13 @@ typedef struct cf_world_def {
                        mesh paths absolute); loading it again gives this scene */
 } cf_world_def;
 
+/* Bounds on the work one setting can ask for (cf_world_def_check rejects
+ * more with CF_ERR_SCENE_VALUE): fracture steps in one rigid step
+ * (dt_rigid / dt_fracture), and PBD iterations and Bullet sub-steps per
+ * step.  A run that needs more is a scene to rethink, not to wait for. */
+#define CF_MAX_SUBSTEPS 1000000
+#define CF_MAX_ITERATIONS 1000
+
 /* Defaults of every setting, as documented in the scene schema
  * (cohfrac/scene.h); a scene key left out takes the same value. */
 cf_material cf_default_material(void);

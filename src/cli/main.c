@@ -18,6 +18,8 @@
 
 #include <errno.h>
 #include <getopt.h>
+#include <signal.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,7 +37,8 @@ static const struct {
     const char *name, *help;
 } commands[] = {
     {"run",
-     "  cohfrac run SCENE.lua [options]     run a scene, write its HDF5 output\n"
+     "  cohfrac run SCENE.lua [options]     run a scene, write its HDF5 output (SIGINT or\n"
+     "                                      SIGTERM: the output is closed, exit 130 or 143)\n"
      "      -s, --set KEY.PATH=VALUE        override a scene key (Lua value), repeatable\n"
      "      -m, --mesh-dir DIR              where prepared meshes live (default: $COHFRAC_MESH_DIR,\n"
      "                                      else the build's mesh directory)\n"
@@ -43,7 +46,9 @@ static const struct {
      "                                      (default: the scene's output.file, relative to the\n"
      "                                      scene file: out/<name>.h5 beside the scene)\n"
      "      -t, --threads N                 threads for element loops (default: all cores)\n"
-     "      -q, --quiet                     no progress display\n"},
+     "      -q, --quiet                     no progress display\n"
+     "          --force                     overwrite an output file that is not a cohfrac\n"
+     "                                      output (refused otherwise)\n"},
     {"compare",
      "  cohfrac compare SCENE.lua [options] run the scene with both rigid backends (bullet,\n"
      "                                      pbd) in lockstep; write compare.md, compare.csv,\n"
@@ -143,6 +148,33 @@ static int usage_error(const char *msg)
     return cf_status_exit_code(CF_ERR_USAGE);
 }
 
+/* A whole number >= lo from an option's text, or -1 with a message. */
+static int count_arg(const char *opt, const char *text, int lo)
+{
+    char *end;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end || v < lo || v > 1000000) {
+        fprintf(stderr, "cohfrac: %s needs a whole number from %d to 1000000, got '%s'\n", opt,
+                lo, text);
+        return -1;
+    }
+    return (int)v;
+}
+
+/* A finite number >= lo from an option's text into *out; 0, or -1 with a
+ * message. */
+static int real_arg(const char *opt, const char *text, double lo, double *out)
+{
+    char *end;
+    double v = strtod(text, &end);
+    if (end == text || *end || !isfinite(v) || v < lo) {
+        fprintf(stderr, "cohfrac: %s needs a number >= %g, got '%s'\n", opt, lo, text);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
 static int cmd_mesh(int argc, char **argv)
 {
     static const struct option lo[] = {{"output", required_argument, 0, 'o'},
@@ -155,7 +187,10 @@ static int cmd_mesh(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "o:q", lo, NULL)) != -1) {
         switch (c) {
         case 'o': o.output = optarg; break;
-        case 't': o.target_tets = atoi(optarg); break;
+        case 't':
+            if ((o.target_tets = count_arg("--target-tets", optarg, 4)) < 0)
+                return cf_status_exit_code(CF_ERR_USAGE);
+            break;
         case 'q': o.verbose = 0; break;
         default: return usage_error("bad option for 'mesh'");
         }
@@ -217,7 +252,7 @@ typedef struct scene_args {
     int n_sets;
     const char *mesh_dir, *output, *scene;
     int output_at; /* --sets given before the last --output */
-    int threads, progress;
+    int threads, progress, force;
 } scene_args;
 
 /* Returns 0, or the usage exit code (a message printed); free a->sets. */
@@ -228,6 +263,7 @@ static int parse_scene_args(int argc, char **argv, const char *cmd, scene_args *
                                        {"output", required_argument, 0, 'o'},
                                        {"threads", required_argument, 0, 't'},
                                        {"quiet", no_argument, 0, 'q'},
+                                       {"force", no_argument, 0, 'F'},
                                        {0, 0, 0, 0}};
     char msg[64];
     memset(a, 0, sizeof *a);
@@ -240,8 +276,12 @@ static int parse_scene_args(int argc, char **argv, const char *cmd, scene_args *
         case 's': a->sets[a->n_sets++] = optarg; break;
         case 'm': a->mesh_dir = optarg; break;
         case 'o': a->output = optarg, a->output_at = a->n_sets; break;
-        case 't': a->threads = atoi(optarg); break;
+        case 't':
+            if ((a->threads = count_arg("--threads", optarg, 1)) < 0)
+                return cf_status_exit_code(CF_ERR_USAGE);
+            break;
         case 'q': a->progress = 0; break;
+        case 'F': a->force = 1; break;
         default:
             snprintf(msg, sizeof msg, "bad option for '%s'", cmd);
             return usage_error(msg);
@@ -254,6 +294,11 @@ static int parse_scene_args(int argc, char **argv, const char *cmd, scene_args *
     a->scene = argv[optind];
     return 0;
 }
+
+/* The signal that asked a run to stop (0: none). */
+static volatile sig_atomic_t stop_signal = 0;
+
+static void on_stop_signal(int sig) { stop_signal = sig; }
 
 static int cmd_run(int argc, char **argv)
 {
@@ -279,7 +324,16 @@ static int cmd_run(int argc, char **argv)
     cf_error err = {0};
     cf_world_def scene;
     cf_sim *sim = NULL;
-    cf_run_options opt = {.progress = a.progress, .threads = a.threads, .mesh_dir = a.mesh_dir};
+    cf_run_options opt = {.progress = a.progress, .threads = a.threads, .mesh_dir = a.mesh_dir,
+                          .force = a.force, .stop = &stop_signal};
+    /* SIGINT, SIGTERM: finish the step, close the file (a second one kills). */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sa.sa_flags = SA_RESETHAND;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
     if (cf_scene_load(a.scene, a.sets, a.n_sets, a.mesh_dir, &scene, &err) != CF_OK) {
         rc = fail(&err);
     } else {
@@ -288,8 +342,13 @@ static int cmd_run(int argc, char **argv)
             st = cf_sim_run(sim, &err);
         if (sim)
             cf_sim_print_summary(sim, stdout);
-        if (st != CF_OK)
+        if (st == CF_ERR_INTERRUPTED) {
+            fprintf(stderr, "cohfrac: %s: %s\n", stop_signal == SIGTERM ? "SIGTERM" : "SIGINT",
+                    err.msg);
+            rc = 128 + (stop_signal ? stop_signal : SIGINT);
+        } else if (st != CF_OK) {
             rc = fail(&err);
+        }
         cf_sim_destroy(sim);
         cf_scene_free(&scene);
     }
@@ -365,16 +424,20 @@ static int cmd_study(int argc, char **argv)
         case 'r': ref[o.n_reference++] = optarg; break;
         case 's': sets[o.n_overrides++] = optarg; break;
         case 'o': o.out_dir = optarg; break;
-        case 'j': o.jobs = atoi(optarg); break;
-        case 't': o.threads = atoi(optarg); break;
+        case 'j': rc = (o.jobs = count_arg("--jobs", optarg, 1)) < 0; break;
+        case 't': rc = (o.threads = count_arg("--threads", optarg, 1)) < 0; break;
         case 'm': o.mesh_dir = optarg; break;
-        case 'T': o.tolerance = atof(optarg); break;
+        case 'T': rc = real_arg("--tolerance", optarg, 0, &o.tolerance); break;
         case 'q': o.progress = 0; break;
         default: rc = usage_error("bad option for 'study'");
         }
     }
-    if (rc == 0 && optind != argc - 1)
+    if (rc != 0)
+        rc = cf_status_exit_code(CF_ERR_USAGE);
+    else if (optind != argc - 1)
         rc = usage_error("'study' needs exactly one scene file");
+    else if (o.n_vary == 0)
+        rc = usage_error("'study' needs at least one --vary KEY.PATH=V1,V2,...");
     else if (rc == 0 && (o.jobs < 1 || o.threads < 0 || o.tolerance < 0))
         rc = usage_error("'study': --jobs must be >= 1, --threads and --tolerance >= 0");
     char *cmd = rc == 0 ? command_line("cohfrac study", argc - 1, argv + 1) : NULL;
@@ -413,19 +476,6 @@ static char *peer_path(void)
     char *slash = strrchr(path, '/');
     strcpy(slash ? slash + 1 : path, "cohfrac_softbody_peer");
     return access(path, X_OK) == 0 ? path : NULL;
-}
-
-/* A whole number >= lo from an option's text, or -1 with a message. */
-static int count_arg(const char *opt, const char *text, int lo)
-{
-    char *end;
-    long v = strtol(text, &end, 10);
-    if (end == text || *end || v < lo || v > 1000000) {
-        fprintf(stderr, "cohfrac: %s needs a whole number from %d to 1000000, got '%s'\n", opt,
-                lo, text);
-        return -1;
-    }
-    return (int)v;
 }
 
 static int cmd_bench(int argc, char **argv)

@@ -178,7 +178,7 @@ static cf_status make_sim(const char *scene, const cf_stability_case *c, double 
     cf_status st = cf_scene_load(scene, ovp, n, NULL, sc, err);
     if (st != CF_OK)
         return st;
-    cf_run_options opt = {0, 1, NULL};
+    cf_run_options opt = {.progress = 0, .threads = 1};
     st = cf_sim_create(sc, &opt, sim, err);
     if (st != CF_OK)
         cf_scene_free(sc);

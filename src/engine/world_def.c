@@ -108,6 +108,7 @@ static const interval AT_LEAST_ONE = {1.0, INFINITY, 1, 0};
 static const interval UNIT = {0.0, 1.0, 1, 1};
 static const interval POISSON = {-1.0, 0.5, 0, 0};
 static const interval PPR_SHAPE = {1.0, INFINITY, 0, 0};
+static const interval ITERATIONS = {1.0, CF_MAX_ITERATIONS, 1, 1};
 
 static cf_status in_interval(const char *key, double v, const interval *r, cf_error *err)
 {
@@ -222,8 +223,19 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("material.restitution", m->restitution, UNIT);
     CHECK("material.strength.modulus", m->weibull_modulus, POSITIVE);
     CHECK("solver.dt_rigid", s->dt_rigid, POSITIVE);
-    CHECK("solver.rigid_substeps", s->rigid_substeps, AT_LEAST_ONE);
+    CHECK("solver.rigid_substeps", s->rigid_substeps, ITERATIONS);
     CHECK("solver.dt_fracture", s->dt_fracture, POSITIVE);
+    if (s->dt_rigid > d->duration)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'solver.dt_rigid' (%g s) exceeds 'duration' (%g s): the run is "
+                            "whole rigid steps; lower solver.dt_rigid to at most the duration",
+                            s->dt_rigid, d->duration);
+    if (s->dt_rigid / s->dt_fracture > CF_MAX_SUBSTEPS)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'solver.dt_rigid' / 'solver.dt_fracture' = %.3g fracture steps in one "
+                            "rigid step, above the limit %d: lower solver.dt_rigid or raise "
+                            "solver.dt_fracture",
+                            s->dt_rigid / s->dt_fracture, CF_MAX_SUBSTEPS);
     if (s->dt_fracture > s->dt_rigid)
         return cf_error_set(err, CF_ERR_SCENE_VALUE,
                             "'solver.dt_fracture' must not exceed solver.dt_rigid (%g), got %g",
@@ -236,7 +248,7 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("solver.sleeping.linear", s->sleep_linear, NON_NEGATIVE);
     CHECK("solver.sleeping.angular", s->sleep_angular, NON_NEGATIVE);
     CHECK("solver.pbd.k_stiffness", s->k_stiffness, UNIT);
-    CHECK("solver.pbd.iterations", s->iterations, AT_LEAST_ONE);
+    CHECK("solver.pbd.iterations", s->iterations, ITERATIONS);
     CHECK("solver.pbd.k_damping", s->k_damping, UNIT);
     CHECK("solver.xpbd.compliance_scale", s->compliance_scale, POSITIVE);
     CHECK("solver.contact_stiffness", s->contact_stiffness, NON_NEGATIVE);

@@ -1132,8 +1132,6 @@ static cf_status add_cracks_impl(cf_h5 *h, const cf_crack_row *r, int n, cf_erro
     if (st == CF_OK && (!ibuf || !dbuf))
         st = no_memory(err, h->path);
     free(ibuf), free(dbuf);
-    if (st == CF_OK && H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
-        st = h5_fail(err, h->path, "flushing /cracks");
     if (st == CF_OK)
         h->ncracks += (hsize_t)n;
     return st;
@@ -1155,6 +1153,41 @@ cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
     cf_status st = add_handoff_impl(h, r, err);
     quiet_end(&q);
     return st;
+}
+
+/* ---- recognising our own files ----------------------------------------- */
+
+int cf_h5_is_output(const char *path)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    int ours = 0;
+    if (H5Fis_hdf5(path) > 0) {
+        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        if (f >= 0) {
+            if (H5Aexists(f, "creator") > 0) {
+                hid_t a = H5Aopen(f, "creator", H5P_DEFAULT);
+                hid_t t = a >= 0 ? H5Aget_type(a) : H5I_INVALID_HID;
+                char *v = NULL;
+                hid_t mt = string_type(); /* as written: variable-length UTF-8 */
+                if (t >= 0 && mt >= 0 && H5Tis_variable_str(t) > 0 && H5Aread(a, mt, &v) >= 0 &&
+                    v) {
+                    ours = strcmp(v, "cohfrac") == 0;
+                    H5free_memory(v);
+                }
+                if (mt >= 0)
+                    H5Tclose(mt);
+                if (t >= 0)
+                    H5Tclose(t);
+                if (a >= 0)
+                    H5Aclose(a);
+            }
+            H5Fclose(f);
+        }
+    }
+    H5Eclear2(H5E_DEFAULT);
+    quiet_end(&q);
+    return ours;
 }
 
 /* ---- geometry ---------------------------------------------------------- */

@@ -1812,6 +1812,47 @@ static char *resolved_text(const cf_world_def *s)
 
 /* ---------------------------------------------------------------- API */
 
+/* Limits on a scene script (docs/reliability.md): a script that loops
+ * forever or fills memory stops with an error naming the limit. */
+#define SCENE_MAX_INSTRUCTIONS 200000000L /* about a second of Lua */
+#define SCENE_MAX_BYTES (256L << 20)
+#define SCENE_HOOK_EVERY 100000
+
+typedef struct script_budget {
+    size_t bytes;
+    long instructions;
+} script_budget;
+
+static void *budget_alloc(void *ud, void *ptr, size_t osize, size_t nsize)
+{
+    script_budget *b = ud;
+    size_t old = ptr ? osize : 0;
+    if (nsize == 0) {
+        b->bytes -= old;
+        free(ptr);
+        return NULL;
+    }
+    if (nsize > old && b->bytes + (nsize - old) > (size_t)SCENE_MAX_BYTES)
+        return NULL; /* Lua raises "not enough memory" */
+    void *p = realloc(ptr, nsize);
+    if (p)
+        b->bytes = b->bytes - old + nsize;
+    return p;
+}
+
+static void budget_hook(lua_State *L, lua_Debug *ar)
+{
+    (void)ar;
+    void *ud;
+    lua_getallocf(L, &ud);
+    script_budget *b = ud;
+    b->instructions += SCENE_HOOK_EVERY;
+    if (b->instructions > SCENE_MAX_INSTRUCTIONS)
+        luaL_error(L, "the script ran more than %d million Lua instructions (an endless "
+                      "loop?): a scene only builds a table",
+                   (int)(SCENE_MAX_INSTRUCTIONS / 1000000));
+}
+
 static cf_status load(loader *ld)
 {
     lua_State *L = ld->L;
@@ -1841,7 +1882,12 @@ static cf_status load(loader *ld)
                                    strstr(lua_tostring(L, -1), "binary chunk")
                                ? " (scenes must be Lua source text)"
                                : NULL);
-    if (lua_pcall(L, 0, 1, 0) != LUA_OK) {
+    rc = lua_pcall(L, 0, 1, 0);
+    if (rc == LUA_ERRMEM)
+        return fail(ld, CF_ERR_SCENE_SYNTAX,
+                    "the script used more than %ld MiB of memory: a scene only builds a table",
+                    SCENE_MAX_BYTES >> 20);
+    if (rc != LUA_OK) {
         const char *msg = lua_tostring(L, -1);
         return lua_failure(ld, CF_ERR_SCENE_SYNTAX,
                            msg && strstr(msg, "(global '")
@@ -1900,9 +1946,11 @@ static cf_status load_scene(const char *path, const char *text, const char *cons
     else
         return fail(&ld, CF_ERR_FILE_OPEN, "scene path too long");
 
-    ld.L = luaL_newstate();
+    script_budget budget = {0, 0};
+    ld.L = lua_newstate(budget_alloc, &budget);
     if (!ld.L)
         return fail(&ld, CF_ERR_NOMEM, "cannot create a Lua state");
+    lua_sethook(ld.L, budget_hook, LUA_MASKCOUNT, SCENE_HOOK_EVERY);
     st = load(&ld);
     lua_close(ld.L);
     if (st != CF_OK)

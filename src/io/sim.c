@@ -63,6 +63,7 @@ struct cf_sim {
     int n_outer;
     int *tet_frag;              /* [n_tets] */
     int topology_changed;
+    long frames_written;
 };
 
 cf_world *cf_sim_world(const cf_sim *sim) { return sim->world; }
@@ -285,6 +286,12 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
     if (st == CF_OK)
         st = cf_world_create(&w, &sim->world, err);
     free(w.bodies), free(w.obstacles);
+    if (st == CF_OK && def->output.file[0] && !opt->force &&
+        access(def->output.file, F_OK) == 0 && !cf_h5_is_output(def->output.file))
+        st = cf_error_set(err, CF_ERR_OUTPUT,
+                          "refusing to overwrite %s: it is not a cohfrac output file (give "
+                          "another output file, or --force to overwrite it)",
+                          def->output.file);
     if (st == CF_OK && def->output.file[0]) {
         st = cf_h5_open(def->output.file, def->name, def->resolved, &sim->h5, err);
         if (st == CF_OK)
@@ -355,9 +362,8 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     }
     double t = cf_world_time(w);
     long step = cf_world_step_count(w);
-    cf_status st = cf_h5_write_frame(sim->h5, step, t, fr, n, err);
-    free(fs), free(fr);
-    unsigned long long mem = cf_h5_memory(sim->h5);
+    cf_status st = CF_OK;
+    unsigned long long mem = cf_h5_memory(sim->h5); /* as of the last frame */
     sim->output_peak = mem > sim->output_peak ? mem : sim->output_peak;
     cf_world_stats ws;
     cf_world_stats_get(w, &ws);
@@ -401,6 +407,12 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
                                     err);
     if (st == CF_OK && sim->output.cracks)
         st = write_cracks(sim, err);
+    /* The frame last: its write flushes everything above with it, so a
+     * frame on disk has its observables, cracks and map. */
+    if (st == CF_OK)
+        st = cf_h5_write_frame(sim->h5, step, t, fr, n, err);
+    sim->frames_written += st == CF_OK;
+    free(fs), free(fr);
     sim->output_time += cf_wall_time() - t0;
     return st;
 }
@@ -471,8 +483,23 @@ cf_status cf_sim_run(cf_sim *sim, cf_error *err)
                 ws.dt_outer / ws.dt_cfl);
     cf_status st = write_frame(sim, err);
     sim->next_frame = sim->output.frame_interval;
-    while (st == CF_OK && !cf_sim_done(sim))
+    int last_written = 1;
+    while (st == CF_OK && !cf_sim_done(sim)) {
+        if (sim->opt.stop && *sim->opt.stop) {
+            /* A signal: the state after this step as the last frame. */
+            if (!last_written)
+                st = write_frame(sim, err);
+            if (st == CF_OK)
+                st = cf_error_set(err, CF_ERR_INTERRUPTED,
+                                  "interrupted at t = %.6g s; the output file holds every "
+                                  "frame up to then and is closed",
+                                  cf_world_time(sim->world));
+            break;
+        }
+        long frames = sim->frames_written;
         st = cf_sim_advance(sim, err);
+        last_written = sim->frames_written > frames;
+    }
     progress(sim, 1);
     cf_error cerr;
     if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK && st == CF_OK) {

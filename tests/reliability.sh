@@ -1,0 +1,83 @@
+#!/bin/sh
+# Nothing lost, nothing hangs (docs/reliability.md): bounded scene scripts
+# and settings, strict numbers on the command line, no overwriting of files
+# that are not cohfrac outputs, and SIGINT/SIGTERM closing the output with
+# every frame complete.  One case per defect; each failed before the fix.
+#   tests/reliability.sh COHFRAC SOURCE_DIR MESH_DIR
+set -u
+exe=$1
+src=$2
+meshes=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+expect() { # expect CODE WHAT CMD...
+    code=$1; what=$2; shift 2
+    "$@" >"$tmp/log" 2>&1
+    rc=$?
+    if [ "$rc" -eq "$code" ]; then echo "ok    exit $rc: $what: $(grep -m1 'cohfrac' "$tmp/log" | cut -c1-150)"
+    else echo "FAIL  exit $rc (want $code): $what"; sed 's/^/      /' "$tmp/log" | tail -5; fails=$((fails + 1)); fi
+}
+spin=$src/scenes/verification/free_spin.lua
+
+# Hangs: a scene script that never returns, or fills memory; settings that
+# ask for millions of sub-steps or iterations.
+echo 'while true do end' > "$tmp/loop.lua"
+expect 2 "an endless scene script stops (instruction limit)" timeout 60 "$exe" run "$tmp/loop.lua"
+echo 'local t = {} for i = 1, 1e9 do t[i] = string.rep("x", 100) .. i end return t' > "$tmp/mem.lua"
+expect 2 "a scene script that fills memory stops (memory limit)" timeout 120 "$exe" run "$tmp/mem.lua"
+expect 2 "dt_rigid larger than the duration" timeout 60 "$exe" run "$spin" -q -m "$meshes" \
+    --set solver.dt_rigid=10 --set duration=1
+expect 2 "fracture sub-steps per rigid step above the cap" timeout 60 "$exe" run "$spin" -q \
+    -m "$meshes" --set solver.dt_rigid=1 --set duration=2 --set solver.dt_fracture=1e-7
+expect 2 "PBD iterations above the cap" timeout 60 "$exe" run "$spin" -q -m "$meshes" \
+    --set solver.pbd.iterations=1e9
+
+# Numbers on the command line are checked.
+expect 1 "run -t abc" "$exe" run "$spin" -t abc
+expect 1 "run -t -3" "$exe" run "$spin" -t -3
+expect 1 "mesh --target-tets abc" "$exe" mesh /usr/share/glmark2/models/bunny.obj -o "$tmp/b" --target-tets abc
+expect 1 "study --tolerance abc" "$exe" study "$spin" --vary duration=0.01 --tolerance abc
+expect 1 "study -j abc" "$exe" study "$spin" --vary duration=0.01 -j abc
+expect 1 "study without --vary" "$exe" study "$spin"
+
+# -o never overwrites what is not a cohfrac output, unless --force.
+cp "$spin" "$tmp/spin.lua"
+cp "$tmp/spin.lua" "$tmp/keep.lua"
+expect 4 "-o onto the scene file itself" "$exe" run "$tmp/spin.lua" -q -m "$meshes" -o "$tmp/spin.lua"
+if cmp -s "$tmp/spin.lua" "$tmp/keep.lua"; then echo "ok    the scene file is unchanged"
+else echo "FAIL  the scene file was overwritten"; fails=$((fails + 1)); fi
+echo "my notes" > "$tmp/notes.h5"
+expect 4 "-o onto a file that is not a cohfrac output" "$exe" run "$spin" -q -m "$meshes" -o "$tmp/notes.h5"
+expect 0 "... and with --force" "$exe" run "$spin" -q -m "$meshes" --set duration=0.002 -o "$tmp/notes.h5" --force
+expect 0 "-o onto an earlier cohfrac output" "$exe" run "$spin" -q -m "$meshes" --set duration=0.002 -o "$tmp/notes.h5"
+
+# SIGINT and SIGTERM: the step ends, a last frame, the file closes whole.
+for sig in INT TERM; do
+    want=130; [ $sig = TERM ] && want=143
+    "$exe" run "$src/scenes/bunny_drop.lua" -q -m "$meshes" -o "$tmp/sig.h5" >/dev/null 2>"$tmp/sig.err" &
+    pid=$!
+    sleep 3
+    kill -$sig $pid
+    wait $pid
+    rc=$?
+    frames=$(/usr/bin/python3 - "$tmp/sig.h5" <<'PY'
+import sys, h5py
+f = h5py.File(sys.argv[1], "r")
+g = f["particles/fragments"]
+counts = {len(g["position/step"])} | {g[k + "/value"].shape[0] for k in
+          ("id", "position", "orientation", "velocity", "angular_velocity", "mode")}
+counts |= {o["value"].shape[0] for o in f["observables"].values()}
+print(counts.pop() if len(counts) == 1 else -1)
+PY
+)
+    if [ "$rc" -eq "$want" ] && [ "$frames" -gt 0 ] && [ -f "$tmp/sig.xdmf" ]; then
+        echo "ok    exit $rc: SIG$sig after 3 s: the file opens, every dataset holds $frames frames, sidecar written; $(cut -c1-120 "$tmp/sig.err")"
+    else
+        echo "FAIL  SIG$sig: exit $rc (want $want), frames $frames (-1: datasets disagree)"
+        cat "$tmp/sig.err"; fails=$((fails + 1))
+    fi
+    rm -f "$tmp/sig.h5" "$tmp/sig.xdmf"
+done
+[ "$fails" -eq 0 ] && echo "all reliability cases hold"
+exit $((fails != 0))
