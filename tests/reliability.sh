@@ -33,6 +33,20 @@ expect 2 "fracture sub-steps per rigid step above the cap" timeout 60 "$exe" run
 expect 2 "PBD iterations above the cap" timeout 60 "$exe" run "$spin" -q -m "$meshes" \
     --set solver.pbd.iterations=1e9
 
+# Input files parsed strictly: counts checked against the file before any
+# allocation, no float-to-int overflow, bad input reported as bad input.
+echo 666666666 > "$tmp/big.node"
+printf '1 4\n' > "$tmp/big.ele"
+expect 2 "a .node header announcing 666666666 nodes in a one-line file" timeout 60 "$exe" run \
+    "$spin" -q --set "bodies[1].mesh=\"$tmp/big.node\""
+printf '4 1e20 0 0\n0 0 0 0\n' > "$tmp/dim.node"
+cp "$tmp/big.ele" "$tmp/dim.ele"
+expect 2 "a .node header whose dimension overflows an int" timeout 60 "$exe" run \
+    "$spin" -q --set "bodies[1].mesh=\"$tmp/dim.node\""
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e10\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' > "$tmp/far.obj"
+expect 2 "a surface with a vertex at 1e10 is bad input, not out of memory" timeout 120 \
+    "$exe" mesh "$tmp/far.obj" -o "$tmp/far"
+
 # Numbers on the command line are checked.
 expect 1 "run -t abc" "$exe" run "$spin" -t abc
 expect 1 "run -t -3" "$exe" run "$spin" -t -3

@@ -204,8 +204,10 @@ static int split(const cf_solid *s, cluster *c, cluster *d)
         if (above)
             hi[nh++] = t;
     }
-    memcpy(pc, c->planes, (size_t)c->np * 4 * sizeof(double));
-    memcpy(pd, c->planes, (size_t)c->np * 4 * sizeof(double));
+    if (c->np > 0) { /* the first cell has no planes (and a NULL list) */
+        memcpy(pc, c->planes, (size_t)c->np * 4 * sizeof(double));
+        memcpy(pd, c->planes, (size_t)c->np * 4 * sizeof(double));
+    }
     memcpy(&pc[4 * c->np], pl, sizeof pl);
     for (int a = 0; a < 4; a++)
         pd[4 * c->np + a] = -pl[a];

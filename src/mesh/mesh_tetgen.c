@@ -69,6 +69,29 @@ static int read_numbers(const char *s, double *out, int max, char bad[32])
 
 static int is_int(double v) { return v == floor(v) && fabs(v) < (double)INT_MAX; }
 
+/* Header entry k as an int (absent: def); *ok cleared when it is not a
+ * whole number in int range (no float-to-int overflow). */
+static int header_int(const double *h, int nh, int k, int def, int *ok)
+{
+    if (k >= nh)
+        return def;
+    if (!is_int(h[k])) {
+        *ok = 0;
+        return def;
+    }
+    return (int)h[k];
+}
+
+/* Lines left in the text after the iterator: an upper bound on the entries
+ * it can hold, checked against a header's count before allocating. */
+static long lines_left(const line_iter *it)
+{
+    long n = 1;
+    for (const char *q = it->p; *q; q++)
+        n += *q == '\n';
+    return n;
+}
+
 /* `base` without a trailing ".node" / ".ele". Caller frees. */
 static char *strip_ext(const char *base)
 {
@@ -102,8 +125,13 @@ static cf_status parse_node(const char *path, char *text, cf_mesh *m, int *first
         return cf_error_set(err, CF_ERR_MESH_PARSE,
                             "%s:%d: bad header; expected '<#points> 3 <#attributes> <#markers>'",
                             path, it.line);
-    int n = (int)h[0], dim = nh > 1 ? (int)h[1] : 3;
-    int nattr = nh > 2 ? (int)h[2] : 0, nmark = nh > 3 ? (int)h[3] : 0;
+    int ok = 1, n = (int)h[0], dim = header_int(h, nh, 1, 3, &ok);
+    int nattr = header_int(h, nh, 2, 0, &ok), nmark = header_int(h, nh, 3, 0, &ok);
+    if (!ok)
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s:%d: bad header: its counts must be whole numbers; expected "
+                            "'<#points> 3 <#attributes> <#markers>'",
+                            path, it.line);
     if (dim != 3)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
                             "%s:%d: dimension is %d; only 3-D meshes are supported", path,
@@ -114,6 +142,11 @@ static cf_status parse_node(const char *path, char *text, cf_mesh *m, int *first
         return cf_error_set(err, CF_ERR_MESH_PARSE,
                             "%s:%d: bad attribute/marker counts (%d, %d) in header", path,
                             it.line, nattr, nmark);
+    if (n > lines_left(&it))
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s:%d: the header announces %d nodes but the file has only %ld more "
+                            "lines (truncated file, or not a TetGen .node file?)",
+                            path, it.line, n, lines_left(&it));
     m->x = malloc((size_t)n * 3 * sizeof(double));
     if (!m->x)
         return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory for %d nodes", path, n);
@@ -168,7 +201,12 @@ static cf_status parse_ele(const char *path, char *text, cf_mesh *m, int first, 
     if (nh < 1 || !is_int(h[0]) || h[0] < 0)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
                             "%s:%d: bad header; expected '<#tets> 4 <#attributes>'", path, it.line);
-    int n = (int)h[0], npt = nh > 1 ? (int)h[1] : 4;
+    int ok = 1, n = (int)h[0], npt = header_int(h, nh, 1, 4, &ok);
+    if (!ok)
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s:%d: bad header: its counts must be whole numbers; expected "
+                            "'<#tets> 4 <#attributes>'",
+                            path, it.line);
     if (npt != 4)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
                             "%s:%d: %d nodes per tet; only linear 4-node tets are supported "
@@ -176,6 +214,11 @@ static cf_status parse_ele(const char *path, char *text, cf_mesh *m, int first, 
                             path, it.line, npt);
     if (n == 0)
         return cf_error_set(err, CF_ERR_MESH_PARSE, "%s:%d: the mesh has no tets", path, it.line);
+    if (n > lines_left(&it))
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s:%d: the header announces %d tets but the file has only %ld more "
+                            "lines (truncated file, or not a TetGen .ele file?)",
+                            path, it.line, n, lines_left(&it));
     m->tets = malloc((size_t)n * 4 * sizeof(int));
     if (!m->tets)
         return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory for %d tets", path, n);

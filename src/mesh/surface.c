@@ -973,17 +973,23 @@ static long find_pairs(const cf_surface *s, int **out)
     double span = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     if (!(h > 0))
         h = span > 0 ? span : 1.0;
+    /* Counted in doubles: a far-away vertex (1e10 m) must not overflow an
+     * int before the cell size has grown to fit (the loop ends with every
+     * count at most 8 nt + 64). */
     int dim[3];
+    double dd[3];
     for (;;) {
         double cells = 1.0;
         for (int k = 0; k < 3; k++) {
-            dim[k] = (int)floor((hi[k] - lo[k]) / h) + 1;
-            cells *= dim[k];
+            dd[k] = floor((hi[k] - lo[k]) / h) + 1;
+            cells *= dd[k];
         }
         if (cells <= 8.0 * nt + 64)
             break;
         h *= 1.25;
     }
+    for (int k = 0; k < 3; k++)
+        dim[k] = (int)dd[k];
     free(ext);
     size_t ncell = (size_t)dim[0] * dim[1] * dim[2];
     size_t *start = calloc(ncell + 1, sizeof *start);
