@@ -6,7 +6,7 @@ BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
 MESHES    := $(BUILD)/meshes
 JOBS      ?= 2
 
-.PHONY: all deps build meshes run test bench bench-scaling install clean
+.PHONY: all deps build meshes run test test-sanitize bench bench-scaling install clean
 
 all: build
 
@@ -47,5 +47,15 @@ install: build
 test: build
 	cd $(BUILD) && ctest --output-on-failure
 
+# The fast tests (label unit) built with AddressSanitizer and
+# UndefinedBehaviorSanitizer in build-sanitize/; any report fails them,
+# including one from a `cohfrac` process a test runs.
+SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:abort_on_error=0:detect_leaks=1 \
+                UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+test-sanitize: deps
+	@cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCOHFRAC_SANITIZE=ON >/dev/null
+	@cmake --build build-sanitize -j $(JOBS)
+	cd build-sanitize && $(SANITIZE_ENV) ctest -L unit --output-on-failure
+
 clean:
-	rm -rf $(BUILD) out
+	rm -rf $(BUILD) build-sanitize out

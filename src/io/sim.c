@@ -277,8 +277,10 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
     w.obstacles = malloc((no + 1) * sizeof *w.obstacles);
     cf_status st = w.bodies && w.obstacles ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     if (st == CF_OK) {
-        memcpy(w.bodies, def->bodies, nb * sizeof *w.bodies);
-        memcpy(w.obstacles, def->obstacles, no * sizeof *w.obstacles);
+        if (nb) /* (a definition without obstacles may hold a NULL list) */
+            memcpy(w.bodies, def->bodies, nb * sizeof *w.bodies);
+        if (no)
+            memcpy(w.obstacles, def->obstacles, no * sizeof *w.obstacles);
         if (opt->threads > 0)
             w.solver.threads = opt->threads;
         st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
