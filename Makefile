@@ -6,7 +6,7 @@ BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
 MESHES    := $(BUILD)/meshes
 JOBS      ?= 2
 
-.PHONY: all deps build meshes run test test-sanitize bench bench-scaling install clean
+.PHONY: all deps build build-fuzz meshes run test test-sanitize fuzz bench bench-scaling install clean
 
 all: build
 
@@ -56,6 +56,25 @@ test-sanitize: deps
 	@cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCOHFRAC_SANITIZE=ON >/dev/null
 	@cmake --build build-sanitize -j $(JOBS)
 	cd build-sanitize && $(SANITIZE_ENV) ctest -L unit --output-on-failure
+	@$(MAKE) --no-print-directory build-fuzz
+	cd build-fuzz && $(SANITIZE_ENV) ctest -L fuzz --output-on-failure
+
+# The libFuzzer harnesses (tests/fuzz, clang, ASan + UBSan) in build-fuzz/:
+# `make fuzz` runs each for SECONDS (default 60); `make test-sanitize` runs
+# them for 15 s each through ctest (label fuzz).
+SECONDS ?= 60
+FUZZERS := surface tetgen gmsh scene
+build-fuzz: deps
+	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	    -DCOHFRAC_SANITIZE=ON -DCOHFRAC_FUZZ=ON >/dev/null
+	@cmake --build build-fuzz -j $(JOBS) --target $(addprefix fuzz_,$(FUZZERS)) \
+	    > build-fuzz/build.log 2>&1 || { cat build-fuzz/build.log; exit 1; }
+fuzz: build-fuzz
+	@for h in $(FUZZERS); do mkdir -p build-fuzz/tests/fuzz/corpus_$$h; \
+	    $(SANITIZE_ENV) build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(SECONDS) -timeout=10 \
+	    -rss_limit_mb=2048 -print_final_stats=1 build-fuzz/tests/fuzz/corpus_$$h \
+	    tests/fuzz/corpus/$$h 2>&1 | grep -E 'stat::number_of_executed_units|ERROR|SUMMARY|Done' \
+	    | sed "s/^/fuzz_$$h: /" || exit 1; done
 
 clean:
-	rm -rf $(BUILD) build-sanitize out
+	rm -rf $(BUILD) build-sanitize build-fuzz out

@@ -66,6 +66,12 @@ expect 4 "-o onto a file that is not a cohfrac output" "$exe" run "$spin" -q -m 
 expect 0 "... and with --force" "$exe" run "$spin" -q -m "$meshes" --set duration=0.002 -o "$tmp/notes.h5" --force
 expect 0 "-o onto an earlier cohfrac output" "$exe" run "$spin" -q -m "$meshes" --set duration=0.002 -o "$tmp/notes.h5"
 
+# Messages that say why: an output path that is a directory, a surface
+# path that is a directory.
+mkdir -p "$tmp/outdir" "$tmp/dir.stl"
+expect 4 "-o onto a directory says so" sh -c "'$exe' run '$spin' -q -m '$meshes' -o '$tmp/outdir' --force 2>&1 | tee /dev/stderr | grep -q 'is a directory' && exit 4"
+expect 2 "cohfrac mesh on a directory says so" sh -c "'$exe' mesh '$tmp/dir.stl' -o '$tmp/d' 2>&1 | grep -q 'is a directory' && exit 2"
+
 # SIGINT and SIGTERM: the step ends, a last frame, the file closes whole.
 for sig in INT TERM; do
     want=130; [ $sig = TERM ] && want=143

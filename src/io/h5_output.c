@@ -25,6 +25,7 @@
 #include <hdf5.h>
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -34,6 +35,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
+#include <unistd.h>
 
 #ifndef COHFRAC_VERSION
 #define COHFRAC_VERSION "0.1.0"
@@ -708,6 +710,20 @@ static cf_status open_impl(const char *path, const char *scene_name, const char 
     cf_status st = make_parent_dirs(path, err);
     if (st != CF_OK)
         return st;
+    /* Say why a file cannot be created, before HDF5 says only that it failed. */
+    struct stat sb;
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return cf_error_set(err, CF_ERR_OUTPUT,
+                            "output file '%s' is a directory: give a file name, e.g. %s/out.h5",
+                            path, path);
+    if (stat(path, &sb) == 0 && access(path, W_OK) != 0)
+        return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s' cannot be written: %s", path,
+                            strerror(errno));
+    int fd = open(path, O_WRONLY | O_CREAT, 0644); /* HDF5 truncates it next */
+    if (fd < 0)
+        return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s' cannot be created: %s", path,
+                            strerror(errno));
+    close(fd);
     cf_h5 *h = calloc(1, sizeof *h);
     if (!h)
         return no_memory(err, path);

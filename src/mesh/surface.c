@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* ====================================================================== */
 /* Growable arrays and file input                                         */
@@ -466,6 +467,12 @@ static int ext_is(const char *path, const char *ext)
 cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err)
 {
     memset(s, 0, sizeof *s);
+    struct stat sb;
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return cf_error_set(err, CF_ERR_FILE_OPEN,
+                            "%s is a directory, not a surface file: give a .obj, .off or .stl "
+                            "file",
+                            path);
     int kind = ext_is(path, ".obj") ? 0 : ext_is(path, ".off") ? 1 : ext_is(path, ".stl") ? 2 : -1;
     if (kind < 0)
         return cf_error_set(err, CF_ERR_FILE_OPEN,
