@@ -73,7 +73,7 @@ fuzz: build-fuzz
 	@for h in $(FUZZERS); do mkdir -p build-fuzz/tests/fuzz/corpus_$$h; \
 	    $(SANITIZE_ENV) build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(SECONDS) -timeout=10 \
 	    -rss_limit_mb=2048 -print_final_stats=1 build-fuzz/tests/fuzz/corpus_$$h \
-	    tests/fuzz/corpus/$$h 2>&1 | grep -E 'stat::number_of_executed_units|ERROR|SUMMARY|Done' \
+	    tests/fuzz/corpus/$$h $$([ $$h = scene ] && echo scenes scenes/verification) 2>&1 | grep -E 'stat::number_of_executed_units|ERROR|SUMMARY|Done' \
 	    | sed "s/^/fuzz_$$h: /" || exit 1; done
 
 clean:

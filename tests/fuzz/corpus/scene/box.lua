@@ -1,0 +1,10 @@
+return { name = "seed", duration = 0.1, gravity = {0, 0, -9.81},
+  material = { E = 1e5, nu = 0.3, rho = 1000, sigma_max = 3e3,
+               strength = { distribution = "weibull", modulus = 8, seed = 2 } },
+  bodies = { { mesh = { type = "box", size = {0.1, 0.1, 0.1}, cells = {2, 2, 2} },
+               position = {0, 0, 1}, velocity = {0, 0, -1}, angular_velocity = {0, 1, 0} } },
+  obstacles = { { type = "plane", point = {0, 0, 0}, normal = {0, 0, 1} },
+                { type = "sphere", center = {1, 0, 0}, radius = 0.2, velocity = {-1, 0, 0} } },
+  solver = { mode = "hybrid", dt_rigid = 1e-3, dt_fracture = 1e-5, constraints = "xpbd",
+             pbd = { iterations = 4 }, criterion = "source" },
+  output = { file = "", frame_interval = 0.01 } }
