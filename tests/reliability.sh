@@ -72,6 +72,23 @@ mkdir -p "$tmp/outdir" "$tmp/dir.stl"
 expect 4 "-o onto a directory says so" sh -c "'$exe' run '$spin' -q -m '$meshes' -o '$tmp/outdir' --force 2>&1 | tee /dev/stderr | grep -q 'is a directory' && exit 4"
 expect 2 "cohfrac mesh on a directory says so" sh -c "'$exe' mesh '$tmp/dir.stl' -o '$tmp/d' 2>&1 | grep -q 'is a directory' && exit 2"
 
+# A full disk: a 64 KiB tmpfs as the output directory (needs root; skipped
+# otherwise).  Exit 4 naming the reason, no crash, and a file h5py opens.
+mkdir -p "$tmp/full"
+if mount -t tmpfs -o size=64k tmpfs "$tmp/full" 2>/dev/null; then
+    expect 4 "the output disk fills up" "$exe" run "$src/scenes/bunny_drop.lua" -q -m "$meshes" \
+        -o "$tmp/full/x.h5"
+    if grep -q 'No space left on device' "$tmp/log" &&
+       /usr/bin/python3 -c "import h5py, sys; h5py.File(sys.argv[1], 'r')" "$tmp/full/x.h5"; then
+        echo "ok    ... the message names the reason and h5py opens what was written"
+    else
+        echo "FAIL  disk full: no reason given, or the file does not open"; fails=$((fails + 1))
+    fi
+    umount "$tmp/full"
+else
+    echo "skip  disk full: cannot mount a tmpfs here (not root)"
+fi
+
 # SIGINT and SIGTERM: the step ends, a last frame, the file closes whole.
 for sig in INT TERM; do
     want=130; [ $sig = TERM ] && want=143

@@ -699,6 +699,8 @@ static cf_status build_layout(cf_h5 *h, const char *scene_name, const char *scen
     return CF_OK;
 }
 
+static void h5_init_once(void);
+
 static cf_status open_impl(const char *path, const char *scene_name, const char *scene_text,
                            cf_h5 **out, cf_error *err)
 {
@@ -747,6 +749,7 @@ static cf_status open_impl(const char *path, const char *scene_name, const char 
 cf_status cf_h5_open(const char *path, const char *scene_name, const char *scene_text,
                      cf_h5 **out, cf_error *err)
 {
+    h5_init_once(); /* before any HDF5 call, quiet_begin's included */
     quiet_state q;
     quiet_begin(&q);
     cf_status st = open_impl(path, scene_name, scene_text, out, err);
@@ -1173,8 +1176,22 @@ cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
 
 /* ---- recognising our own files ----------------------------------------- */
 
+/* HDF5 closes what is still open when the process exits; after a failed
+ * close (a full disk) that second attempt crashes inside HDF5 (SIGSEGV in
+ * H5F__close_cb).  Every file this writer opens is closed by cf_h5_close,
+ * so the exit-time clean-up is turned off before HDF5's first use. */
+static void h5_init_once(void)
+{
+    static int done = 0;
+    if (!done) {
+        done = 1;
+        H5dont_atexit();
+    }
+}
+
 int cf_h5_is_output(const char *path)
 {
+    h5_init_once(); /* before any HDF5 call */
     quiet_state q;
     quiet_begin(&q);
     int ours = 0;
