@@ -75,16 +75,11 @@ static const char *impact_scene =
     "  output = {file = ''},\n"
     "}\n";
 
+/* The scene text loaded in memory (no file), and its run. */
 static cf_sim *make_sim(const char *text, cf_world_def *sc)
 {
-    char path[512];
-    snprintf(path, sizeof path, "%s/scene.lua", dir);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
     cf_error err = {0};
-    cf_status st = cf_scene_load(path, NULL, 0, COHFRAC_MESH_DIR, sc, &err);
+    cf_status st = cf_scene_load_text("scene.lua", text, NULL, 0, COHFRAC_MESH_DIR, sc, &err);
     if (st != CF_OK)
         fail_msg("scene: %s", err.msg);
     cf_run_options opt = {.mesh_dir = COHFRAC_MESH_DIR};
