@@ -208,9 +208,12 @@ static void test_load_errors(void **state)
     cf_error err = {0};
     assert_int_equal(cf_surface_load(tpath("none.obj"), &s, &err), CF_ERR_FILE_OPEN);
     assert_non_null(strstr(err.msg, "none.obj"));
-    put("x.ply", "ply\n");
-    assert_int_equal(cf_surface_load(tpath("x.ply"), &s, &err), CF_ERR_FILE_OPEN);
+    put("x.xyz9", "ply\n");
+    assert_int_equal(cf_surface_load(tpath("x.xyz9"), &s, &err), CF_ERR_FILE_OPEN);
     assert_non_null(strstr(err.msg, ".obj, .off or .stl"));
+    put("x.ply", "ply\n"); /* assimp's formats: its reason, the file named */
+    assert_int_equal(cf_surface_load(tpath("x.ply"), &s, &err), CF_ERR_MESH_PARSE);
+    assert_non_null(strstr(err.msg, "x.ply"));
     put("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
     assert_int_equal(cf_surface_load(tpath("bad.obj"), &s, &err), CF_ERR_MESH_INDEX);
     assert_non_null(strstr(err.msg, "bad.obj:4:"));
@@ -224,6 +227,24 @@ static void test_load_errors(void **state)
     assert_int_equal(cf_surface_load(tpath("idx.off"), &s, &err), CF_ERR_MESH_INDEX);
     assert_non_null(strstr(err.msg, "idx.off:6:"));
     assert_null(s.v);
+}
+
+/* Formats beyond OBJ/OFF/STL come through assimp: the unit cube as ASCII
+ * PLY (quads, triangulated on the way in) encloses volume 1. */
+static void test_load_ply_through_assimp(void **state)
+{
+    (void)state;
+    put("cube.ply", "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\n"
+                    "property float y\nproperty float z\nelement face 6\n"
+                    "property list uchar int vertex_indices\nend_header\n"
+                    "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n"
+                    "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n");
+    cf_surface s;
+    cf_error err = {0};
+    assert_int_equal(cf_surface_load(tpath("cube.ply"), &s, &err), CF_OK);
+    assert_int_equal(s.n_tris, 12);
+    assert_true(fabs(cf_surface_volume(&s) - 1.0) < 1e-12);
+    cf_surface_free(&s);
 }
 
 static void test_enclosed_volume(void **state)
@@ -727,6 +748,7 @@ int main(void)
         cmocka_unit_test(test_load_off),
         cmocka_unit_test(test_load_stl),
         cmocka_unit_test(test_load_errors),
+        cmocka_unit_test(test_load_ply_through_assimp),
         cmocka_unit_test(test_enclosed_volume),
         cmocka_unit_test(test_intersection_cases),
         cmocka_unit_test(test_intersections_grid_vs_brute_force),

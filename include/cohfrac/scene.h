@@ -71,7 +71,8 @@
  *                 a box's center and half_extents and a mesh's file (no
  *                 sensible default).  Spheres and boxes move at their constant
  *                 velocity m/s (kinematic), planes and meshes are static.
- *                 mesh: a triangle surface (.obj, .off or .stl), closed or
+ *                 mesh: a triangle surface (.obj, .off, .stl, or what assimp
+ *                 reads: .ply, .gltf, .glb, .3ds, .fbx, .dae, ...), closed or
  *                 open; relative paths start at the scene file's directory
  *                 (as body mesh paths do) and the file must exist; its
  *                 vertices are scaled, then rotated, then moved by position

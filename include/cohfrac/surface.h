@@ -1,6 +1,7 @@
 /* cohfrac — closed triangle surfaces and mesh preparation.
  *
- * Reads OBJ / OFF / STL (ASCII and binary) surfaces, finds and repairs
+ * Reads OBJ / OFF / STL (ASCII and binary) surfaces, and through assimp
+ * every format it supports (PLY, glTF, 3DS, FBX, COLLADA, ...), finds and repairs
  * self-intersections, and turns a closed surface into a Tet4 mesh by running
  * the `tetgen` program (run as a program, never linked: AGPL).
  */
@@ -27,6 +28,12 @@ typedef struct cf_surface {
  * Errors: CF_ERR_FILE_OPEN, CF_ERR_MESH_PARSE (file:line), CF_ERR_MESH_INDEX
  * (file:line), CF_ERR_NOMEM. */
 cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err);
+
+/* 1 when cf_surface_load reads files named like `path`: .obj, .off, .stl
+ * (any case), or an extension assimp supports (.ply, .gltf, .glb, .3ds,
+ * .fbx, .dae, ...; those are read with assimp: every mesh, node transforms
+ * applied, triangulated, identical vertices joined). */
+int cf_surface_format_known(const char *path);
 
 /* Write as OFF, 0-based, coordinates with %.17g (used to hand the surface
  * to tetgen).  Error CF_ERR_OUTPUT. */

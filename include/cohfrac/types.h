@@ -98,7 +98,7 @@ typedef struct cf_obstacle {
     const int *triangles;        /* mesh: [n_triangles][3] 0-based vertex indices */
     int n_vertices, n_triangles;
     char file[1024];             /* mesh: resolved path of a closed or open
-                                    triangle surface (.obj/.off/.stl) */
+                                    triangle surface (.obj/.off/.stl, or a format assimp reads) */
     double scale;                /* mesh: applied first */
     double orientation[4];       /* mesh: w,x,y,z, normalised, then */
     double position[3];          /* mesh: where the file's origin goes, m */

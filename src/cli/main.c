@@ -60,7 +60,8 @@ static const struct {
      "      -q, --quiet                     no progress display\n"},
     {"mesh",
      "  cohfrac mesh SURFACE -o OUT [options]\n"
-     "                                      repair a closed surface (OBJ/OFF/STL), run tetgen,\n"
+     "                                      repair a closed surface (OBJ/OFF/STL, or PLY,\n"
+     "                                      glTF, 3DS, FBX... through assimp), run tetgen,\n"
      "                                      write OUT.node/OUT.ele (cached)\n"
      "      -o, --output OUT                the TetGen base to write (OUT.node, OUT.ele)\n"
      "          --target-tets N             about this many tets (default: tetgen's own)\n"

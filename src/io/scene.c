@@ -16,6 +16,7 @@
 #define _XOPEN_SOURCE 700 /* realpath (XSI), stat */
 
 #include "cohfrac/scene.h"
+#include "cohfrac/surface.h"
 
 #include <lauxlib.h>
 #include <lua.h>
@@ -726,18 +727,6 @@ static cf_status resolve_mesh(loader *ld, const char *key, const char *name, cha
     return absolute_path(ld, key, base, "mesh", out, size);
 }
 
-/* A case-insensitive suffix test, for file extensions. */
-static int ends_with_nocase(const char *s, const char *suffix)
-{
-    size_t ls = strlen(s), lx = strlen(suffix);
-    if (ls < lx)
-        return 0;
-    for (size_t i = 0; i < lx; i++)
-        if (tolower((unsigned char)s[ls - lx + i]) != tolower((unsigned char)suffix[i]))
-            return 0;
-    return 1;
-}
-
 /* Turn a triangle-surface path (an obstacle's `file`) into an absolute path:
  * relative paths start at the scene file's directory, as body mesh paths
  * do; the directory part goes through realpath, the file name is kept. */
@@ -747,10 +736,10 @@ static cf_status resolve_surface(loader *ld, const char *key, const char *name, 
     char path[2048];
     int w;
 
-    if (!ends_with_nocase(name, ".obj") && !ends_with_nocase(name, ".off") &&
-        !ends_with_nocase(name, ".stl"))
+    if (!cf_surface_format_known(name))
         return fail(ld, CF_ERR_SCENE_VALUE,
-                    "'%s' is \"%s\"; a triangle surface must be an .obj, .off or .stl file",
+                    "'%s' is \"%s\"; a triangle surface must be an .obj, .off or .stl file, "
+                    "or a format assimp reads (.ply, .gltf, .glb, .3ds, .fbx, .dae, ...)",
                     kp(ld, key), name);
     if (name[0] == '/')
         w = snprintf(path, sizeof path, "%s", name);

@@ -6,12 +6,18 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
+
+#include <assimp/cimport.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 
 /* ====================================================================== */
 /* Growable arrays and file input                                         */
@@ -464,6 +470,67 @@ static int ext_is(const char *path, const char *ext)
     return 1;
 }
 
+/* Any other format assimp reads (PLY, glTF, 3DS, FBX, COLLADA, ...):
+ * every mesh of the file, node transforms applied, triangulated, identical
+ * vertices joined; coordinates as the file has them. */
+static cf_status load_with_assimp(const char *path, cf_surface *s, cf_error *err)
+{
+    const struct aiScene *sc =
+        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                               aiProcess_PreTransformVertices);
+    if (!sc)
+        return cf_error_set(err, CF_ERR_MESH_PARSE, "%s: %s (read with assimp)", path,
+                            aiGetErrorString());
+    size_t nv = 0, nt = 0;
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        nv += sc->mMeshes[i]->mNumVertices;
+        for (unsigned f = 0; f < sc->mMeshes[i]->mNumFaces; f++)
+            nt += sc->mMeshes[i]->mFaces[f].mNumIndices == 3;
+    }
+    cf_status st = CF_OK;
+    if (nt == 0 || nv > INT_MAX / 3 || nt > INT_MAX / 3)
+        st = cf_error_set(err, CF_ERR_MESH_PARSE,
+                          "%s: %zu triangles in %u meshes (read with assimp): a surface needs "
+                          "triangles, and at most %d of them",
+                          path, nt, sc->mNumMeshes, INT_MAX / 3);
+    if (st == CF_OK) {
+        s->v = malloc(nv * 3 * sizeof(double));
+        s->tri = malloc(nt * 3 * sizeof(int));
+        if (!s->v || !s->tri)
+            st = cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory for %zu triangles", path, nt);
+    }
+    for (unsigned i = 0, base = 0; st == CF_OK && i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        for (unsigned v = 0; v < m->mNumVertices; v++) {
+            s->v[3 * (size_t)s->n_verts + 0] = m->mVertices[v].x;
+            s->v[3 * (size_t)s->n_verts + 1] = m->mVertices[v].y;
+            s->v[3 * (size_t)s->n_verts + 2] = m->mVertices[v].z;
+            s->n_verts++;
+        }
+        for (unsigned f = 0; f < m->mNumFaces; f++) {
+            const struct aiFace *face = &m->mFaces[f];
+            if (face->mNumIndices != 3)
+                continue; /* points and lines */
+            for (int k = 0; k < 3; k++)
+                s->tri[3 * (size_t)s->n_tris + k] = (int)(base + face->mIndices[k]);
+            s->n_tris++;
+        }
+        base += m->mNumVertices;
+    }
+    aiReleaseImport(sc);
+    if (st != CF_OK)
+        cf_surface_free(s);
+    return st;
+}
+
+int cf_surface_format_known(const char *path)
+{
+    if (ext_is(path, ".obj") || ext_is(path, ".off") || ext_is(path, ".stl"))
+        return 1;
+    const char *dot = strrchr(path, '.');
+    return dot && !strchr(dot, '/') && aiIsExtensionSupported(dot);
+}
+
 cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err)
 {
     memset(s, 0, sizeof *s);
@@ -474,9 +541,19 @@ cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err)
                             "file",
                             path);
     int kind = ext_is(path, ".obj") ? 0 : ext_is(path, ".off") ? 1 : ext_is(path, ".stl") ? 2 : -1;
-    if (kind < 0)
+    if (kind < 0) {
+        const char *dot = strrchr(path, '.');
+        if (dot && !strchr(dot, '/') && aiIsExtensionSupported(dot)) {
+            if (access(path, R_OK) != 0)
+                return cf_error_set(err, CF_ERR_FILE_OPEN, "%s: cannot read it: %s", path,
+                                    strerror(errno));
+            return load_with_assimp(path, s, err);
+        }
         return cf_error_set(err, CF_ERR_FILE_OPEN,
-                            "%s: unknown surface format; use a .obj, .off or .stl file", path);
+                            "%s: unknown surface format; use .obj, .off or .stl, or a format "
+                            "assimp reads (.ply, .gltf, .glb, .3ds, .fbx, .dae, ...)",
+                            path);
+    }
     size_t len;
     unsigned char *buf = (unsigned char *)cf_file_read(path, &len);
     if (!buf)
