@@ -5,16 +5,7 @@
 set -u
 exe=$1
 meshes=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fails=0
-expect() { # expect CODE WHAT CMD...
-    code=$1; what=$2; shift 2
-    "$@" >"$tmp/log" 2>&1
-    rc=$?
-    if [ "$rc" -eq "$code" ]; then echo "ok    exit $rc: $what"
-    else echo "FAIL  exit $rc (want $code): $what"; sed 's/^/      /' "$tmp/log"; fails=$((fails + 1)); fi
-}
+. "$(dirname "$0")/expect.sh"
 cat >"$tmp/drop.lua" <<LUA
 return { name = "tiny", duration = 0.002,
   bodies = { { mesh = "bunny_small", position = {0, 0, 2} } },

@@ -8,16 +8,7 @@ set -u
 exe=$1
 src=$2
 meshes=$3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fails=0
-expect() { # expect CODE WHAT CMD...
-    code=$1; what=$2; shift 2
-    "$@" >"$tmp/log" 2>&1
-    rc=$?
-    if [ "$rc" -eq "$code" ]; then echo "ok    exit $rc: $what: $(grep -m1 'cohfrac' "$tmp/log" | cut -c1-150)"
-    else echo "FAIL  exit $rc (want $code): $what"; sed 's/^/      /' "$tmp/log" | tail -5; fails=$((fails + 1)); fi
-}
+. "$(dirname "$0")/expect.sh"
 spin=$src/scenes/verification/free_spin.lua
 
 # Hangs: a scene script that never returns, or fills memory; settings that

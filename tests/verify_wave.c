@@ -26,7 +26,7 @@ static double gauge_stress(const cf_sim *sim, double x0, double x1)
             c += 0.25 * s->X[3 * s->tet[4 * t + j]];
         if (c >= x0 && c <= x1) {
             double sig[9];
-            cf_tet4_stress(s, t, cf_sim_world(sim)->scene->solver.elasticity, sig);
+            cf_tet4_stress(s, t, cf_sim_world(sim)->def.solver.elasticity, sig);
             sum += sig[0] * s->vol[t], vol += s->vol[t];
         }
     }

@@ -38,7 +38,7 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, int n_hot, int 
 {
     cf_solid *s = &sim->solid;
     double t0 = cf_wall_time();
-    int nc = cf_insertion_candidates(s, f->tets, f->nt, sim->scene->solver.criterion, n_hot,
+    int nc = cf_insertion_candidates(s, f->tets, f->nt, sim->def.solver.criterion, n_hot,
                                      &sim->cand);
     if (nc < 0)
         return CF_ERR_NOMEM;
@@ -103,7 +103,7 @@ static double contact_velocities(cf_world *sim, cf_fragment *f, double t)
 static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
 {
     cf_solid *s = &sim->solid;
-    const cf_boundary *bc = &sim->scene->boundaries[s->bc[a]];
+    const cf_boundary *bc = &sim->def.boundaries[s->bc[a]];
     double work = 0;
     for (int k = 0; k < 3; k++)
         if (bc->axes & (1 << k)) {
@@ -122,8 +122,8 @@ static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
 static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
 {
     cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->scene->solver;
-    const double *g = sim->scene->gravity;
+    const cf_solver_settings *set = &sim->def.solver;
+    const double *g = sim->def.gravity;
     double t0 = cf_wall_time();
     f->e_strain = 0;
     if (fracture) {
@@ -193,7 +193,7 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
     if (!fracture) {
         cf_node_state before, after;
         cf_nodes_momenta(s, nodes, nn, &before);
-        cf_global_damping(s, nodes, nn, sim->scene->solver.k_damping);
+        cf_global_damping(s, nodes, nn, sim->def.solver.k_damping);
         cf_nodes_momenta(s, nodes, nn, &after);
         sim->flow.damping += before.ke - after.ke;
     }
@@ -250,7 +250,7 @@ static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next,
 static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int fracture)
 {
     cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->scene->solver;
+    const cf_solver_settings *set = &sim->def.solver;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, mesh_obstacles = 0;
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++) /* FCL queries: one thread */
@@ -383,7 +383,7 @@ int cf_pbd_impact(const cf_world *sim, int fi, double dt)
 {
     const cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;
-    const double *g = sim->scene->gravity;
+    const double *g = sim->def.gravity;
     for (int i = 0; i < f->nodes.n; i++) {
         int a = f->nodes.v[i];
         double v[3], p[3];
@@ -398,7 +398,7 @@ int cf_pbd_impact(const cf_world *sim, int fi, double dt)
             double u[3], vr[3];
             cf_obstacle_velocity(&sim->obs.o[j], u);
             v3_sub(v, u, vr);
-            if (-v3_dot(vr, n) > sim->scene->solver.impact_threshold)
+            if (-v3_dot(vr, n) > sim->def.solver.impact_threshold)
                 return 1;
         }
     }

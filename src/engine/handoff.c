@@ -97,7 +97,7 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     /* Continuous collision detection for fragments that move more than their
      * smallest radius of gyration in a sub-step; the swept sphere stays
      * inside the fragment. */
-    if (sim->scene->solver.ccd) {
+    if (sim->def.solver.ccd) {
         double rg = sqrt(fmin(f->principal[0], fmin(f->principal[1], f->principal[2])) / f->mass);
         cfb_set_ccd(sim->bullet, f->body, rg, 0.5 * rg);
     }

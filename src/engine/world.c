@@ -177,7 +177,7 @@ static int node_body(const cf_solid *s, const int *body, int a)
  * others as not candidates. */
 static cf_status select_crack_plane(cf_world *sim, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
+    const cf_solver_settings *set = &sim->def.solver;
     cf_solid *s = &sim->solid;
     if (!set->has_crack_plane || !s->facet)
         return CF_OK;
@@ -259,7 +259,7 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
                                        bd->expansion_rate[k2] * (s->x[3 * a + k2] - xe[k2]);
             }
     }
-    int fracture = sim->scene->solver.mode == CF_RUN_FRACTURE;
+    int fracture = sim->def.solver.mode == CF_RUN_FRACTURE;
     for (int fi = 0; fi < sim->n_frag; fi++) {
         cf_fragment *f = &sim->frag[fi];
         int *tt = realloc(f->tets, (size_t)f->nt * sizeof(int));
@@ -292,7 +292,7 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
 static cf_status add_obstacles(cf_world *sim, const cf_world_def *def, cf_error *err)
 {
     int n = def->n_obstacles;
-    sim->obs.o = sim->scene->obstacles;
+    sim->obs.o = sim->def.obstacles;
     sim->obstacle_body = malloc(((size_t)n + 1) * sizeof(int));
     sim->obstacle_moving = calloc((size_t)n + 1, 1);
     if (!sim->obstacle_body || !sim->obstacle_moving)
@@ -383,7 +383,7 @@ int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
 static void initial_bounds(cf_world *sim)
 {
     const cf_solid *s = &sim->solid;
-    const cf_world_def *sc = sim->scene;
+    const cf_world_def *sc = &sim->def;
     cf_initial_bounds *b = &sim->bounds;
     double v2 = 0;
     for (int k = 0; k < 3; k++)
@@ -436,7 +436,6 @@ static cf_status copy_def(cf_world *sim, const cf_world_def *def, cf_error *err)
     sim->def.obstacles = copy_array(def->obstacles, def->n_obstacles, sizeof *def->obstacles, &fail);
     sim->def.boundaries = copy_array(def->boundaries, def->n_boundaries, sizeof *def->boundaries,
                                      &fail);
-    sim->scene = &sim->def;
     for (int j = 0; sim->def.obstacles && j < def->n_obstacles; j++) /* FCL and Bullet copy them */
         sim->def.obstacles[j].vertices = NULL, sim->def.obstacles[j].triangles = NULL;
     return fail ? cf_error_set(err, CF_ERR_NOMEM, "out of memory copying the world definition")
@@ -453,7 +452,7 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
     if (!sim)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     st = copy_def(sim, def, err);
-    const cf_world_def *scene = sim->scene;
+    const cf_world_def *scene = &sim->def;
     sim->wall_start = cf_wall_time();
     sim->bullet_base = cfb_allocated_bytes();
     if (scene->solver.threads > 0)
@@ -572,7 +571,7 @@ double cf_body_kinetic_energy(const cf_world *sim, int fi)
  * in free flight, J. */
 static double body_energy(const cf_world *sim, const cf_fragment *f, const cfb_state *st)
 {
-    return state_kinetic_energy(f, st) - f->mass * v3_dot(sim->scene->gravity, st->pos);
+    return state_kinetic_energy(f, st) - f->mass * v3_dot(sim->def.gravity, st->pos);
 }
 
 void cf_world_ledger(const cf_world *sim, cf_ledger *l)
@@ -602,7 +601,7 @@ void cf_world_ledger(const cf_world *sim, cf_ledger *l)
     cf_cohesive_energy(s, NULL, 0, &l->cohesive_stored, &l->cohesive_dissipated);
     double dmx[3];
     v3_sub(l->mass_moment, sim->mx0, dmx);
-    l->work_gravity = v3_dot(sim->scene->gravity, dmx);
+    l->work_gravity = v3_dot(sim->def.gravity, dmx);
     l->work_boundary = sim->flow.boundary;
     l->work_obstacles = sim->flow.obstacles;
     l->contact = sim->flow.contact, l->pbd = sim->flow.pbd;
@@ -744,7 +743,7 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 static int can_break(const cf_world *sim, const cf_fragment *f)
 {
     const cf_solid *s = &sim->solid;
-    if (sim->scene->solver.criterion == CF_CRITERION_NONE)
+    if (sim->def.solver.criterion == CF_CRITERION_NONE)
         return 0;
     for (int i = 0; i < f->nt; i++)
         for (int k = 0; k < 4; k++) {
@@ -760,7 +759,7 @@ static int can_break(const cf_world *sim, const cf_fragment *f)
 static int impact(const cf_world *sim, const cf_fragment *f)
 {
     double dv = (cfb_contact_impulse(sim->bullet, f->body) + f->pushed) / f->mass;
-    return dv > sim->scene->solver.impact_threshold && can_break(sim, f);
+    return dv > sim->def.solver.impact_threshold && can_break(sim, f);
 }
 
 /* One Bullet step.  Fragments hit harder than the impact threshold go to
@@ -770,8 +769,8 @@ static int impact(const cf_world *sim, const cf_fragment *f)
  * exchanged with it through its nodes). */
 static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
-    int n = sim->n_frag, no = sim->scene->n_obstacles;
+    const cf_solver_settings *set = &sim->def.solver;
+    int n = sim->n_frag, no = sim->def.n_obstacles;
     cfb_state *pre = malloc((size_t)(n + no) * sizeof *pre), *pre_obs = pre + n;
     if (!pre)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
@@ -857,7 +856,7 @@ static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
 
 static cf_status diverged(const cf_world *sim, cf_error *err, const char *what)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
+    const cf_solver_settings *set = &sim->def.solver;
     const char *fix = set->constraints == CF_CONSTRAINTS_NONE
                           ? "lower solver.dt_fracture (or solver.cfl_fraction) below dt_cfl, or use "
                             "solver.constraints = "
@@ -879,7 +878,7 @@ static double contact_pad(const cf_world *sim, int fi, double dt)
         const double *v = &sim->solid.v[3 * f->nodes.v[i]];
         v2 = fmax(v2, v3_dot(v, v));
     }
-    return dt * (sqrt(v2) + dt * v3_norm(sim->scene->gravity));
+    return dt * (sqrt(v2) + dt * v3_norm(sim->def.gravity));
 }
 
 /* Sub-cycle every fracture-mode fragment through the rigid step, all of
@@ -897,7 +896,7 @@ static long sub_steps(const cf_world *sim, double dt, double *h)
 
 static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
+    const cf_solver_settings *set = &sim->def.solver;
     int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
     int bodies = cf_body_contact_needed(sim);
     for (int fi = 0; fi < n; fi++) {
@@ -964,20 +963,20 @@ static cf_status check_energy(cf_world *sim, cf_error *err)
     double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated;
     double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
                    fmax(0.0, l.work_obstacles);
-    if (have <= (1 + sim->scene->solver.max_energy_growth) * input + 1e-12)
+    if (have <= (1 + sim->def.solver.max_energy_growth) * input + 1e-12)
         return CF_OK;
     char what[200];
     snprintf(what, sizeof what,
              "energy grew with no work input: %.4g J against %.4g J put in (more than "
              "solver.guard.max_energy_growth = %g)",
-             have, input, sim->scene->solver.max_energy_growth);
+             have, input, sim->def.solver.max_energy_growth);
     return diverged(sim, err, what);
 }
 
 /* Fracture-mode fragments that have been quiet long enough go back to rigid mode. */
 static cf_status return_to_rigid(cf_world *sim, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
+    const cf_solver_settings *set = &sim->def.solver;
     int n = sim->n_frag;
     for (int fi = 0; fi < n; fi++) {
         cf_fragment *f = &sim->frag[fi];
@@ -1039,7 +1038,7 @@ double cf_world_dt_cfl(const cf_world *sim) { return sim->solid.dt_cfl; }
 
 cf_status cf_world_step(cf_world *sim, cf_error *err)
 {
-    const cf_world_def *sc = sim->scene;
+    const cf_world_def *sc = &sim->def;
     double dt = sim->dt_outer, h, t0 = sim->t;
     long n_sub = sub_steps(sim, dt, &h);
     /* The last step is cut short so that the run ends at the duration: in
@@ -1174,7 +1173,7 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
 
 void cf_world_step_stats(const cf_world *sim, cf_step_stats *o)
 {
-    const cf_solver_settings *set = &sim->scene->solver;
+    const cf_solver_settings *set = &sim->def.solver;
     memset(o, 0, sizeof *o);
     o->fracture_steps = sim->steps_fracture;
     o->stress = sim->prof.stress, o->insertion = sim->prof.insertion;

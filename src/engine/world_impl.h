@@ -82,7 +82,6 @@ typedef struct cf_profile {
 
 struct cf_world {
     cf_world_def def;        /* the world's copy (obstacles and boundaries too) */
-    const cf_world_def *scene; /* &def */
     cf_solid solid;
     const cf_cohesive_law *law; /* the cohesive law (PPR) and its parameters */
     double law_params[CF_LAW_PARAMS_MAX];
