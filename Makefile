@@ -49,11 +49,13 @@ test: build
 
 # The fast tests (label unit) built with AddressSanitizer and
 # UndefinedBehaviorSanitizer in build-sanitize/; any report fails them,
-# including one from a `cohfrac` process a test runs.
+# including one from a `cohfrac` process a test runs.  Built without MPI,
+# which also checks that the program builds and says what to do without it.
 SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:abort_on_error=0:detect_leaks=1 \
                 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 test-sanitize: deps
-	@cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCOHFRAC_SANITIZE=ON >/dev/null
+	@cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCOHFRAC_SANITIZE=ON \
+	    -DCOHFRAC_MPI=OFF >/dev/null
 	@cmake --build build-sanitize -j $(JOBS)
 	cd build-sanitize && $(SANITIZE_ENV) ctest -L unit --output-on-failure
 	@$(MAKE) --no-print-directory build-fuzz

@@ -860,8 +860,8 @@ static void test_error_shell_obstacle_keys(void **state)
         {OBSTACLE("{ type = 'mesh', file = 'sub/nosuch.stl' }"), CF_ERR_FILE_OPEN,
          "(relative paths start at the scene file's directory)"},
         {OBSTACLE("{ type = 'mesh', file = 'cube.node' }"), CF_ERR_SCENE_VALUE,
-         "'obstacles[1].file' is \"cube.node\"; a triangle surface must be an .obj, .off or "
-         ".stl file"},
+         "'obstacles[1].file' is \"cube.node\"; a triangle surface must be in a format "
+         "assimp reads"},
         {OBSTACLE("{ type = 'mesh', file = 3 }"), CF_ERR_SCENE_TYPE,
          "'obstacles[1].file' must be a string, got number"},
         {OBSTACLE("{ type = 'mesh', file = 'sub/wall.obj', scale = 0 }"), CF_ERR_SCENE_VALUE,

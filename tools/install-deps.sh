@@ -6,7 +6,8 @@ PKGS="gcc g++ make cmake pkg-config libbullet-dev libbullet-extras-dev libccd-de
       libhdf5-dev libcmocka-dev liblua5.4-dev tetgen gmsh glmark2-data python3 python3-h5py
       python3-numpy python3-matplotlib ffmpeg libtinygltf-dev nlohmann-json3-dev
       blender python3-meshio paraview python3-paraview xvfb
-      clang libomp-dev libassimp-dev"
+      clang libomp-dev libassimp-dev libmeshoptimizer-dev
+      libopenmpi-dev openmpi-bin"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||

@@ -1,7 +1,7 @@
 /* cohfrac — closed triangle surfaces and mesh preparation.
  *
- * Reads OBJ / OFF / STL (ASCII and binary) surfaces, and through assimp
- * every format it supports (PLY, glTF, 3DS, FBX, COLLADA, ...), finds and repairs
+ * Reads surfaces through assimp (OBJ, OFF, STL, PLY, glTF, 3DS, FBX,
+ * COLLADA, ...), decimates them with meshoptimizer, finds and repairs
  * self-intersections, and turns a closed surface into a Tet4 mesh by running
  * the `tetgen` program (run as a program, never linked: AGPL).
  */
@@ -18,21 +18,23 @@ typedef struct cf_surface {
     int *tri;  /* [n_tris][3] 0-based, counter-clockwise seen from outside */
 } cf_surface;
 
-/* Load a surface; the format is taken from the extension (.obj, .off, .stl;
- * any case).  OBJ polygons are fan-triangulated (negative, relative indices
- * allowed); normals/texcoords are ignored; OFF may be COFF/NOFF... with
- * extra per-line data; STL may be ASCII or binary (told apart by the binary
- * size rule 84 + 50 n) and its vertices are welded exactly.  Triangles with
- * a repeated corner are dropped.  Vertices are kept as given (unused ones
- * too).  On error `s` is left empty.
- * Errors: CF_ERR_FILE_OPEN, CF_ERR_MESH_PARSE (file:line), CF_ERR_MESH_INDEX
- * (file:line), CF_ERR_NOMEM. */
+/* Load a surface with assimp (Debian libassimp-dev): every format it reads,
+ * chosen by the extension (.obj, .off, .stl ASCII or binary, .ply, .gltf,
+ * .glb, .3ds, .fbx, .dae, ...).  Every mesh of the file, node transforms
+ * applied, polygons triangulated, corners at one position joined (normals,
+ * texture coordinates and colours are dropped first); points, lines and
+ * triangles with a repeated corner are dropped.  Coordinates as the file
+ * has them (file units), read in single precision (assimp's; about 7
+ * digits).  Vertices come in first-use order, triangles in file order;
+ * unused vertices are not kept.  On error `s` is left empty.
+ * Errors: CF_ERR_FILE_OPEN (missing, unreadable, a directory, or an
+ * extension assimp does not know), CF_ERR_MESH_PARSE (assimp's reason, the
+ * file named; no triangles; a coordinate that is not finite),
+ * CF_ERR_MESH_INDEX (a face index past the vertex list), CF_ERR_NOMEM. */
 cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err);
 
-/* 1 when cf_surface_load reads files named like `path`: .obj, .off, .stl
- * (any case), or an extension assimp supports (.ply, .gltf, .glb, .3ds,
- * .fbx, .dae, ...; those are read with assimp: every mesh, node transforms
- * applied, triangulated, identical vertices joined). */
+/* 1 when cf_surface_load reads files named like `path` (an extension
+ * assimp supports, any case). */
 int cf_surface_format_known(const char *path);
 
 /* Write as OFF, 0-based, coordinates with %.17g (used to hand the surface
@@ -45,7 +47,8 @@ cf_status cf_surface_write_off(const cf_surface *s, const char *path, cf_error *
  * the total number found, -1 when out of memory.  Shared vertices and edges
  * of neighbouring triangles do not count; touching elsewhere does.  Uses
  * double-precision orientation tests (exact for exactly coplanar input such
- * as axis-aligned faces) and a uniform grid, O(n) for even meshes. */
+ * as axis-aligned faces) and a uniform grid, O(n) for even meshes.  A
+ * triangle with a repeated corner intersects every triangle near it. */
 int cf_surface_self_intersections(const cf_surface *s, int *pairs, int max_pairs);
 
 /* Repair the defect class of docs/scenes.md: a valence-3 vertex whose three
@@ -77,16 +80,14 @@ int cf_surface_remove_unused(cf_surface *s);
  * indices, in `why` if non-NULL), -1 out of memory. */
 int cf_surface_check_closed(const cf_surface *s, char *why, size_t why_len);
 
-/* Reduce to about `target_tris` triangles by quadric-error edge collapse
- * (Garland & Heckbert 1997), cheapest collapse first with a fixed
- * tie-break, so the result is reproducible.  A collapse is refused when it
- * breaks the link condition (would pinch the surface), leaves a vertex of
- * valence < 4 (tetgen turns those into slivers where the surface is flat),
- * flips or turns a triangle by more than 60 degrees or makes a needle;
- * boundary edges are never collapsed.  Stops early when no valid collapse
- * is left.  The vertex positions move (optimal quadric points);
- * unused vertices are dropped.  Returns the new triangle count, -1 when out
- * of memory.  It does not test for self-intersections: check afterwards. */
+/* Reduce to about `target_tris` triangles with meshoptimizer's
+ * topology-preserving edge collapse (meshopt_simplify, Debian
+ * libmeshoptimizer-dev: quadric error, no flipped triangles, the kept
+ * vertices keep their positions), then drop unused vertices and repair
+ * valence-3 vertices (cf_surface_repair_valence3: tetgen turns those into
+ * slivers where the surface is flat).  Reproducible.  Stops early when no
+ * valid collapse is left.  Returns the new triangle count, -1 when out of
+ * memory.  It does not test for self-intersections: check afterwards. */
 int cf_surface_decimate(cf_surface *s, int target_tris);
 
 void cf_surface_free(cf_surface *s);

@@ -137,6 +137,13 @@ double cf_world_time(const cf_world *sim);
 double cf_world_dt_fracture(const cf_world *sim);
 double cf_world_dt_cfl(const cf_world *sim);
 
+/* The explicit stability limit of a Tet4 mesh before any world is made:
+ * min over tets of h / c_d, h twice the inradius (6 V / total face area)
+ * and c_d = sqrt(E (1 - nu) / (rho (1 + nu) (1 - 2 nu))) the dilatational
+ * wave speed (docs/physics.md §3), the mesh scaled by `scale` first.  In s;
+ * INFINITY for a mesh without tets, NaN when a tet is degenerate. */
+double cf_mesh_dt_cfl(const cf_mesh *m, double scale, const cf_material *mat);
+
 /* The energy ledger and momenta now. */
 void cf_world_ledger(const cf_world *sim, cf_ledger *out);
 

@@ -14,6 +14,7 @@
 #include "cohfrac/study.h"
 #include "cohfrac/surface.h"
 
+#include "mpi_cases.h"
 #include "report.h"
 
 #include <errno.h>
@@ -60,8 +61,8 @@ static const struct {
      "      -q, --quiet                     no progress display\n"},
     {"mesh",
      "  cohfrac mesh SURFACE -o OUT [options]\n"
-     "                                      repair a closed surface (OBJ/OFF/STL, or PLY,\n"
-     "                                      glTF, 3DS, FBX... through assimp), run tetgen,\n"
+     "                                      repair a closed surface (OBJ, OFF, STL, PLY,\n"
+     "                                      glTF, 3DS, FBX... read with assimp), run tetgen,\n"
      "                                      write OUT.node/OUT.ele (cached)\n"
      "      -o, --output OUT                the TetGen base to write (OUT.node, OUT.ele)\n"
      "          --target-tets N             about this many tets (default: tetgen's own)\n"
@@ -232,7 +233,7 @@ static int cmd_stability(int argc, char **argv)
     int rc = 0;
     if (cf_stability_run(&o, &res, &err) != CF_OK) {
         rc = fail(&err);
-    } else {
+    } else if (cf_mpi_rank() == 0) {
         int unstable = 0;
         for (int i = 0; i < res.n; i++)
             unstable += !res.cases[i].stable;
@@ -450,7 +451,7 @@ static int cmd_study(int argc, char **argv)
         cf_study_result res;
         if (cf_study_run(&o, &res, &err) != CF_OK) {
             rc = fail(&err);
-        } else {
+        } else if (cf_mpi_rank() == 0) {
             printf("%d cases; report: %s/study.md%s\n", res.n_cases, res.out_dir,
                    res.plot_made ? " (plot: study.png)" : "");
             if (res.best >= 0)
@@ -663,7 +664,16 @@ int main(int argc, char **argv)
             print_usage(stdout, current);
             return 0;
         }
-        return table[i].run(argc - 1, argv + 1);
+        /* study and stability spread their cases over MPI ranks when an
+         * MPI launcher started them (mpi_cases.h) */
+        int spread = !strcmp(current, "study") || !strcmp(current, "stability");
+        cf_error err = {0};
+        if (spread && cf_mpi_start(&argc, &argv, &err) < 0)
+            return fail(&err);
+        int rc = table[i].run(argc - 1, argv + 1);
+        if (spread)
+            cf_mpi_finish();
+        return rc;
     }
     return usage_error("unknown command");
 }

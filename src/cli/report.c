@@ -18,7 +18,7 @@
 cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error *err)
 {
     snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
-    snprintf(o->tmp, sizeof o->tmp, "%s/%s.tmp", dir, name);
+    snprintf(o->tmp, sizeof o->tmp, "%s/%s.%ld.tmp", dir, name, (long)getpid());
     o->f = fopen(o->tmp, "w");
     if (!o->f)
         return cf_error_set(err, CF_ERR_OUTPUT, "cannot write %s: %s", o->tmp, strerror(errno));

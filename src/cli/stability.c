@@ -1,5 +1,6 @@
 /* cohfrac — the stability map (see include/cohfrac/stability.h for the
  * cases, the criteria and the files). */
+#define _GNU_SOURCE
 #include "cohfrac/stability.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/scene.h"
@@ -7,6 +8,7 @@
 #include "clock.h"
 #include "file_text.h"
 #include "linalg.h"
+#include "mpi_cases.h"
 #include "report.h"
 
 #include <math.h>
@@ -419,6 +421,75 @@ static cf_status write_md(const cf_stability_result *r, int quick, const char *c
     return cf_out_close(&o, err);
 }
 
+/* ---- Cases over MPI ranks (mpi_cases.h), or on this process alone ---- */
+
+static const char *const REASONS[] = {"", "nan", "energy", "inverted", "escaped", "error"};
+enum { N_REASONS = sizeof REASONS / sizeof REASONS[0] };
+
+/* A case's results as the ranks send them: stable, reason (index in
+ * REASONS), failing step, energy ratio, dt, wall time. */
+enum { CASE_FIGURES = 6 };
+
+typedef struct spread {
+    cf_stability_result *r;
+    const cf_stability_options *opt;
+    const char *scene, *pair;
+    int finished;
+} spread;
+
+static void run_spread(int i, double *out, void *user)
+{
+    spread *sp = user;
+    cf_stability_case c = sp->r->cases[i];
+    cf_error e = {0};
+    if (run_case(c.mass_ratio > 0 ? sp->pair : sp->scene, &c, &e) != CF_OK) {
+        fprintf(stderr, "cohfrac stability: case %d: %s\n", i + 1, e.msg);
+        c.stable = 0, c.reason = "error", c.fail_step = 0;
+    }
+    int reason = 0;
+    while (reason < N_REASONS - 1 && strcmp(REASONS[reason], c.reason))
+        reason++;
+    double fig[CASE_FIGURES] = {c.stable, reason, (double)c.fail_step, c.energy_ratio, c.dt,
+                                c.wall};
+    memcpy(out, fig, sizeof fig);
+}
+
+static void spread_done(int i, const double *fig, int rank, void *user)
+{
+    spread *sp = user;
+    cf_stability_case *c = &sp->r->cases[i];
+    c->stable = (int)fig[0], c->reason = REASONS[(int)fig[1]], c->fail_step = (long)fig[2];
+    c->energy_ratio = fig[3], c->dt = fig[4], c->wall = fig[5];
+    sp->finished++;
+    if (!sp->opt->progress)
+        return;
+    fprintf(stderr, "stability %3d/%d  %-12s E %-8.3g dt/dt_cfl %-6g v %-4g %-7s mass ratio "
+                    "%-5g %s%s",
+            sp->finished, sp->r->n, cf_stability_mode_name(c->mode), c->E, c->dt_ratio,
+            c->speed, c->sliver ? "sliver" : "regular", c->mass_ratio,
+            c->stable ? "stable" : "unstable: ", c->reason);
+    if (cf_mpi_size() > 1)
+        fprintf(stderr, " (case %d, rank %d)", i + 1, rank);
+    fputc('\n', stderr);
+}
+
+/* Largest first: two-body cases have twice the tets, and the constraint
+ * modes differ in iterations per step; all run CF_STABILITY_STEPS steps. */
+static double case_cost(const cf_stability_case *c)
+{
+    int iterations[CF_STAB_N_MODES] = {[CF_STAB_NONE] = 0, [CF_STAB_PBD_SRC] = 3,
+                                       [CF_STAB_PBD_STIFF] = 10, [CF_STAB_XPBD] = 3};
+    return (c->mass_ratio > 0 ? 2 : 1) * (1 + iterations[c->mode]);
+}
+
+static int by_cost(const void *a, const void *b, void *cases)
+{
+    const cf_stability_case *c = cases;
+    int x = *(const int *)a, y = *(const int *)b;
+    double cx = case_cost(&c[x]), cy = case_cost(&c[y]);
+    return cx < cy ? 1 : cx > cy ? -1 : x - y;
+}
+
 /* Write `text` to DIR/NAME (whole or not at all); path gets DIR/NAME. */
 static cf_status write_scene(const char *dir, const char *name, const char *text, char path[1100],
                              cf_error *err)
@@ -452,17 +523,20 @@ cf_status cf_stability_run(const cf_stability_options *opt, cf_stability_result 
     if (!r->cases)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     build_cases(opt->quick, r->cases);
-    for (int i = 0; i < r->n; i++) {
-        cf_stability_case *c = &r->cases[i];
-        if ((st = run_case(c->mass_ratio > 0 ? pair : scene, c, err)) != CF_OK)
-            return st;
-        if (opt->progress)
-            fprintf(stderr, "stability %3d/%d  %-12s E %-8.3g dt/dt_cfl %-6g v %-4g %-7s "
-                            "mass ratio %-5g %s%s\n",
-                    i + 1, r->n, cf_stability_mode_name(c->mode), c->E, c->dt_ratio, c->speed,
-                    c->sliver ? "sliver" : "regular", c->mass_ratio,
-                    c->stable ? "stable" : "unstable: ", c->reason);
+    spread sp = {r, opt, scene, pair, 0};
+    int *order = malloc((size_t)r->n * sizeof *order);
+    double *fig = malloc((size_t)r->n * CASE_FIGURES * sizeof *fig);
+    if (!order || !fig)
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int i = 0; st == CF_OK && i < r->n; i++)
+        order[i] = i;
+    if (st == CF_OK) {
+        qsort_r(order, (size_t)r->n, sizeof *order, by_cost, r->cases);
+        st = cf_mpi_cases(r->n, order, CASE_FIGURES, fig, run_spread, spread_done, &sp, err);
     }
+    free(order), free(fig);
+    if (st != CF_OK || cf_mpi_rank() > 0)
+        return st; /* the other ranks only run cases */
     if ((st = write_csv(r, err)) != CF_OK ||
         (st = write_md(r, opt->quick, opt->command, quality, err)) != CF_OK)
         return st;

@@ -3,12 +3,14 @@
 #define _GNU_SOURCE
 #include "cohfrac/study.h"
 #include "cohfrac/surface.h"
+#include "cohfrac/world.h"
 
 #include "clock.h"
 #include "cohfrac/scene.h"
 #include "file_text.h"
 #include "hash.h"
 #include "linalg.h"
+#include "mpi_cases.h"
 #include "process.h"
 #include "report.h"
 #include "trajectory.h"
@@ -20,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -47,6 +50,7 @@ typedef struct job {
     char lua[1200], h5[1200], log[1200], meta[1200];
     pid_t pid;
     double t_start;
+    double cost;        /* the work estimate that orders cases over MPI ranks */
 } job;
 
 /* Split "key=v1,v2" at the commas outside {}, (), [] and quotes. */
@@ -108,6 +112,30 @@ static char *format(const char *fmt, const char *a, const char *b)
     return s;
 }
 
+/* The work a case asks for if it stayed in fracture mode throughout, to
+ * hand out the largest cases first: tets x fracture steps (duration /
+ * dt_fracture, or over cfl_fraction x dt_cfl) x (1 + PBD iterations).
+ * Only an ordering: 0 when the meshes cannot be made (the run will say
+ * why). */
+static double case_cost(cf_world_def *sc, const char *mesh_dir)
+{
+    cf_world_meshes wm;
+    cf_error e;
+    if (cf_world_meshes_load(sc, mesh_dir, &wm, &e) != CF_OK)
+        return 0;
+    double tets = 0, dt_cfl = INFINITY;
+    for (int b = 0; b < sc->n_bodies; b++) {
+        const cf_body_def *body = &sc->bodies[b];
+        tets += body->tet_mesh->n_tets;
+        dt_cfl = fmin(dt_cfl, cf_mesh_dt_cfl(body->tet_mesh, body->scale, &sc->material));
+    }
+    cf_world_meshes_free(&wm);
+    const cf_solver_settings *so = &sc->solver;
+    double dt = so->cfl_fraction > 0 ? so->cfl_fraction * dt_cfl : so->dt_fracture;
+    double cost = tets * sc->duration / dt * (1 + so->iterations);
+    return isfinite(cost) ? cost : 0;
+}
+
 /* Load the case's scene (common overrides, its own, no output file) and
  * hash the resolved text; the scene's name into `name` (128 bytes). */
 static cf_status resolve_case(const cf_study_options *o, job *j, cf_study_case *c, char *name,
@@ -132,6 +160,8 @@ static cf_status resolve_case(const cf_study_options *o, job *j, cf_study_case *
     h = cf_fnv1a(h, COHFRAC_VERSION, strlen(COHFRAC_VERSION));
     snprintf(c->hash, sizeof c->hash, "%016" PRIx64, h);
     snprintf(name, 128, "%s", sc.name);
+    if (cf_mpi_size() > 1 && cf_mpi_rank() == 0)
+        j->cost = case_cost(&sc, o->mesh_dir);
     j->text = strdup(sc.resolved);
     cf_scene_free(&sc);
     return j->text ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
@@ -154,13 +184,19 @@ static cf_status write_run_file(const char *runs, const char *hash, const char *
     return cf_out_close(&f, err);
 }
 
-/* Name the case's files under `runs` and write runs/<hash>.lua. */
-static cf_status write_case(job *j, const cf_study_case *c, const char *runs, cf_error *err)
+/* Name the case's files under `runs`. */
+static void name_case(job *j, const cf_study_case *c, const char *runs)
 {
     snprintf(j->lua, sizeof j->lua, "%s/%s.lua", runs, c->hash);
     snprintf(j->h5, sizeof j->h5, "%s/%s.h5", runs, c->hash);
     snprintf(j->log, sizeof j->log, "%s/%s.log", runs, c->hash);
     snprintf(j->meta, sizeof j->meta, "%s/%s.meta", runs, c->hash);
+}
+
+/* Write runs/<hash>.lua. */
+static cf_status write_case(const job *j, const cf_study_case *c, const char *runs,
+                            cf_error *err)
+{
     return write_run_file(runs, c->hash, "lua", err, "-- %s (resolved by cohfrac %s)\n%s",
                           c->label, COHFRAC_VERSION, j->text);
 }
@@ -191,7 +227,20 @@ static cf_status start_case(const cf_study_options *o, job *j, int threads, cf_e
     return CF_OK;
 }
 
-/* Wait for any running case; record its figures and write its .meta. */
+/* Record a finished case's figures and write its .meta. */
+static cf_status record_case(const job *j, cf_study_case *c, int status, const struct rusage *ru,
+                             const char *runs, cf_error *err)
+{
+    c->wall = cf_wall_time() - j->t_start;
+    c->cpu = ru->ru_utime.tv_sec + 1e-6 * ru->ru_utime.tv_usec + ru->ru_stime.tv_sec +
+             1e-6 * ru->ru_stime.tv_usec;
+    c->peak_rss = 1024.0 * (double)ru->ru_maxrss;
+    c->exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return write_run_file(runs, c->hash, "meta", err, "%d %.6f %.6f %.0f\n", c->exit_code,
+                          c->wall, c->cpu, c->peak_rss);
+}
+
+/* Wait for any running case; record it. */
 static cf_status reap_case(job *jobs, cf_study_case *cases, int n, const char *runs, int *done,
                            cf_error *err)
 {
@@ -204,16 +253,9 @@ static cf_status reap_case(job *jobs, cf_study_case *cases, int n, const char *r
     for (int i = 0; i < n; i++) {
         if (jobs[i].pid != pid)
             continue;
-        cf_study_case *c = &cases[i];
-        c->wall = cf_wall_time() - jobs[i].t_start;
-        c->cpu = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec +
-                 1e-6 * ru.ru_stime.tv_usec;
-        c->peak_rss = 1024.0 * (double)ru.ru_maxrss;
-        c->exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
         jobs[i].pid = 0;
         *done = i;
-        return write_run_file(runs, c->hash, "meta", err, "%d %.6f %.6f %.0f\n", c->exit_code,
-                              c->wall, c->cpu, c->peak_rss);
+        return record_case(&jobs[i], &cases[i], status, &ru, runs, err);
     }
     *done = -1;
     return CF_OK;
@@ -559,9 +601,14 @@ static cf_status write_md(const cf_study_options *o, const cf_study_result *res,
     fprintf(m, "Scene `%s`", o->scene);
     for (int i = 0; i < o->n_overrides; i++)
         fprintf(m, "%s `%s`", i ? "," : " with", o->overrides[i]);
-    fprintf(m, ". Machine: %s; cohfrac %s; %s. %d cases, %d at a time with %d thread%s "
-               "each; %d reused from the cache.\n\n",
-            mach, COHFRAC_VERSION, date, res->n_cases, o->jobs, threads, threads > 1 ? "s" : "",
+    char spread[64];
+    if (cf_mpi_size() > 1)
+        snprintf(spread, sizeof spread, "over %d MPI ranks", cf_mpi_size());
+    else
+        snprintf(spread, sizeof spread, "%d at a time", o->jobs);
+    fprintf(m, ". Machine: %s; cohfrac %s; %s. %d cases, %s with %d thread%s each; %d "
+               "reused from the cache.\n\n",
+            mach, COHFRAC_VERSION, date, res->n_cases, spread, threads, threads > 1 ? "s" : "",
             res->n_cached);
     fputs("**Reference**:", m);
     for (int i = 0; i < n_ref; i++)
@@ -673,6 +720,82 @@ static cf_status run_cases(const cf_study_options *o, job *jobs, cf_study_case *
     return st;
 }
 
+/* ---- Over MPI ranks (mpi_cases.h) ---------------------------------------- */
+
+/* A case's figures as the ranks send them: exit code, wall, CPU, peak RSS. */
+enum { CASE_FIGURES = 4 };
+
+typedef struct ranked {
+    const cf_study_options *o;
+    job *jobs;
+    cf_study_case *c;
+    const char *runs;
+    int threads, finished, to_run;
+} ranked;
+
+/* On any rank: run case i as a child process and write its .meta. */
+static void run_ranked(int i, double *out, void *user)
+{
+    ranked *r = user;
+    cf_study_case c = r->c[i];
+    cf_error e = {0};
+    int status = 127 << 8; /* "could not run" unless it did */
+    struct rusage ru = {0};
+    cf_status st = start_case(r->o, &r->jobs[i], r->threads, &e);
+    if (st == CF_OK && cf_wait(r->jobs[i].pid, &status, &ru) < 0)
+        st = cf_error_set(&e, CF_ERR_EXTERNAL, "waiting for the case failed (%s)",
+                          strerror(errno));
+    if (st == CF_OK)
+        st = record_case(&r->jobs[i], &c, status, &ru, r->runs, &e);
+    if (st != CF_OK) {
+        fprintf(stderr, "cohfrac study (rank %d): case %d (%s): %s\n", cf_mpi_rank(), i,
+                c.label, e.msg);
+        c.exit_code = 127, c.wall = c.cpu = c.peak_rss = 0;
+    }
+    double fig[CASE_FIGURES] = {c.exit_code, c.wall, c.cpu, c.peak_rss};
+    memcpy(out, fig, sizeof fig);
+}
+
+/* On rank 0, as each case finishes. */
+static void ranked_done(int i, const double *fig, int rank, void *user)
+{
+    ranked *r = user;
+    cf_study_case *c = &r->c[i];
+    c->exit_code = (int)fig[0], c->wall = fig[1], c->cpu = fig[2], c->peak_rss = fig[3];
+    r->finished++;
+    if (r->o->progress)
+        fprintf(stderr, "[%d/%d] %s: %s, %.1f s (rank %d)\n", r->finished, r->to_run, c->label,
+                status_word(c->exit_code), c->wall, rank);
+}
+
+static int by_cost(const void *a, const void *b, void *jobs)
+{
+    const job *j = jobs;
+    int x = *(const int *)a, y = *(const int *)b;
+    return j[x].cost < j[y].cost ? 1 : j[x].cost > j[y].cost ? -1 : x - y;
+}
+
+/* Every case not cached over the MPI ranks, the largest first. */
+static cf_status run_ranks(const cf_study_options *o, job *jobs, cf_study_case *c, int n,
+                           const char *runs, int threads, cf_error *err)
+{
+    ranked r = {o, jobs, c, runs, threads, 0, 0};
+    int *order = malloc(((size_t)n + 1) * sizeof *order);
+    double *fig = malloc(((size_t)n + 1) * CASE_FIGURES * sizeof *fig);
+    cf_status st = CF_OK;
+    if (!order || !fig)
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int i = 0; st == CF_OK && cf_mpi_rank() == 0 && i < n; i++)
+        if (!c[i].cached && jobs[i].same_as < 0)
+            order[r.to_run++] = i;
+    if (st == CF_OK) {
+        qsort_r(order, (size_t)r.to_run, sizeof *order, by_cost, jobs);
+        st = cf_mpi_cases(r.to_run, order, CASE_FIGURES, fig, run_ranked, ranked_done, &r, err);
+    }
+    free(order), free(fig);
+    return st;
+}
+
 cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_error *err)
 {
     cf_study_options o = *opt;
@@ -693,7 +816,11 @@ cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_err
         exe[len] = 0;
         o.exe = exe;
     }
-    int threads = o.threads > 0 ? o.threads : (int)sysconf(_SC_NPROCESSORS_ONLN) / o.jobs;
+    /* Under MPI every rank runs one case at a time: the ranks on one
+     * machine share its cores. */
+    int ranks = cf_mpi_size(), report = cf_mpi_rank() == 0;
+    int share = ranks > 1 ? cf_mpi_local_size() : o.jobs;
+    int threads = o.threads > 0 ? o.threads : (int)sysconf(_SC_NPROCESSORS_ONLN) / share;
     threads = threads < 1 ? 1 : threads;
     const char *const *ref = o.reference ? o.reference : default_reference;
     int n_ref = o.reference ? o.n_reference : 2;
@@ -766,24 +893,35 @@ cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_err
         else
             snprintf(res->out_dir, sizeof res->out_dir, "build/studies/%s", res->scene_name);
         snprintf(runs, sizeof runs, "%s/runs", res->out_dir);
-        st = cf_mkdirs(runs, "study directory", err);
+        if (report)
+            st = cf_mkdirs(runs, "study directory", err);
     }
     for (int i = 0; i < n && st == CF_OK; i++) {
         jobs[i].same_as = -1; /* the same scene twice: run it once */
         for (int k = 0; k < i && jobs[i].same_as < 0; k++)
             if (!strcmp(c[k].hash, c[i].hash))
                 jobs[i].same_as = k;
+        name_case(&jobs[i], &c[i], runs);
+        if (!report)
+            continue; /* rank 0 writes the cases and knows the cache */
         st = write_case(&jobs[i], &c[i], runs, err);
         struct stat sb;
         c[i].cached = st == CF_OK && read_meta(&jobs[i], &c[i]) && stat(jobs[i].h5, &sb) == 0;
         res->n_cached += c[i].cached && jobs[i].same_as < 0;
     }
-    if (st == CF_OK && o.progress)
+    if (st == CF_OK && o.progress && report && ranks > 1)
+        fprintf(stderr, "study %s: %d cases (%d cached) over %d MPI ranks, %d thread%s each\n",
+                res->scene_name, res->n_cases, res->n_cached, ranks, threads,
+                threads > 1 ? "s" : "");
+    else if (st == CF_OK && o.progress && report)
         fprintf(stderr, "study %s: %d cases (%d cached), %d at a time, %d thread%s each\n",
                 res->scene_name, res->n_cases, res->n_cached, o.jobs, threads,
                 threads > 1 ? "s" : "");
     if (st == CF_OK)
-        st = run_cases(&o, jobs, c, res->n_cases, runs, threads, err);
+        st = ranks > 1 ? run_ranks(&o, jobs, c, res->n_cases, runs, threads, err)
+                       : run_cases(&o, jobs, c, res->n_cases, runs, threads, err);
+    if (!report)
+        goto done; /* the other ranks only run cases */
     for (int i = 0; i < n && st == CF_OK; i++) {
         const cf_study_case *k = jobs[i].same_as >= 0 ? &c[jobs[i].same_as] : NULL;
         if (k) {
@@ -839,6 +977,7 @@ cf_status cf_study_run(const cf_study_options *opt, cf_study_result *res, cf_err
                                         "study.md and study.csv");
     }
 
+done:
     for (int i = 0; jobs && i < n; i++) {
         for (int k = 0; i > 0 && jobs[i].sets && k < jobs[i].n_sets; k++)
             free((char *)jobs[i].sets[k]); /* the reference's are the caller's */

@@ -131,6 +131,39 @@ static double tri_area(const double *a, const double *b, const double *c)
     return 0.5 * v3_norm(n);
 }
 
+/* Dilatational wave speed c_d, m/s (docs/physics.md §3). */
+static double wave_speed(const cf_material *mat)
+{
+    return sqrt(mat->E * (1 - mat->nu) / (mat->rho * (1 + mat->nu) * (1 - 2 * mat->nu)));
+}
+
+/* Twice the inradius of a tet of volume `vol`: 6 V / (total face area). */
+static double tet_h(double vol, const double *x0, const double *x1, const double *x2,
+                    const double *x3)
+{
+    double area = tri_area(x1, x2, x3) + tri_area(x0, x3, x2) + tri_area(x0, x1, x3) +
+                  tri_area(x0, x2, x1);
+    return 6.0 * vol / area;
+}
+
+double cf_mesh_dt_cfl(const cf_mesh *m, double scale, const cf_material *mat)
+{
+    double c_d = wave_speed(mat), dt = INFINITY;
+    for (int t = 0; t < m->n_tets; t++) {
+        const int *T = &m->tets[4 * t];
+        const double *x0 = &m->x[3 * T[0]], *x1 = &m->x[3 * T[1]], *x2 = &m->x[3 * T[2]],
+                     *x3 = &m->x[3 * T[3]];
+        double Dm[9];
+        for (int r = 0; r < 3; r++)
+            Dm[3 * r] = x1[r] - x0[r], Dm[3 * r + 1] = x2[r] - x0[r], Dm[3 * r + 2] = x3[r] - x0[r];
+        double h = tet_h(fabs(m3_det(Dm)) / 6.0, x0, x1, x2, x3);
+        if (!(h > 0))
+            return NAN;
+        dt = fmin(dt, scale * h / c_d);
+    }
+    return dt;
+}
+
 /* A Weibull draw of scale 1 and modulus m for facet f: w = (-ln(1 - u))^(1/m),
  * u uniform in (0, 1) from SplitMix64 of (seed, f) (Steele, Lea, Flood 2014),
  * so that it depends on nothing but the seed and the facet. */
@@ -221,7 +254,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     memcpy(s->tet0, mesh->tets, (size_t)nt * 4 * sizeof(int));
     memcpy(s->tet_frag, tet_body, (size_t)nt * sizeof(int));
 
-    double c_d = sqrt(mat->E * (1 - mat->nu) / (mat->rho * (1 + mat->nu) * (1 - 2 * mat->nu)));
+    double c_d = wave_speed(mat);
     s->dt_cfl = INFINITY;
     for (int t = 0; t < nt; t++) {
         const int *T = &s->tet[4 * t];
@@ -239,11 +272,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
                                 t, det / 6.0);
         }
         s->rq[4 * t] = 1, s->rq[4 * t + 1] = s->rq[4 * t + 2] = s->rq[4 * t + 3] = 0;
-        double area = tri_area(x1, x2, x3) + tri_area(x0, x3, x2) + tri_area(x0, x1, x3) +
-                      tri_area(x0, x2, x1);
-        double h = 6.0 * s->vol[t] / area; /* twice the inradius */
-        if (h / c_d < s->dt_cfl)
-            s->dt_cfl = h / c_d;
+        s->dt_cfl = fmin(s->dt_cfl, tet_h(s->vol[t], x0, x1, x2, x3) / c_d);
     }
     if (build_vertex_tets(s)) {
         cf_solid_free(s);

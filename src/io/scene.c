@@ -738,8 +738,8 @@ static cf_status resolve_surface(loader *ld, const char *key, const char *name, 
 
     if (!cf_surface_format_known(name))
         return fail(ld, CF_ERR_SCENE_VALUE,
-                    "'%s' is \"%s\"; a triangle surface must be an .obj, .off or .stl file, "
-                    "or a format assimp reads (.ply, .gltf, .glb, .3ds, .fbx, .dae, ...)",
+                    "'%s' is \"%s\"; a triangle surface must be in a format assimp reads "
+                    "(.obj, .off, .stl, .ply, .gltf, .glb, .3ds, .fbx, .dae, ...)",
                     kp(ld, key), name);
     if (name[0] == '/')
         w = snprintf(path, sizeof path, "%s", name);

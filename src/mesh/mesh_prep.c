@@ -1,7 +1,7 @@
 /* cohfrac — `cohfrac mesh`: closed surface -> checked Tet4 mesh.
  *
  * Pipeline: load the surface, report and repair self-intersections, check
- * it is closed, coarsen it by quadric decimation when the wanted tet count
+ * it is closed, coarsen it (meshoptimizer, cf_surface_decimate) when the wanted tet count
  * needs a coarser boundary, run the `tetgen` program (never linked: AGPL),
  * orient every tet positively, check the tet volume against the surface's
  * enclosed volume and write <output>.node/.ele plus a stamp for caching.
@@ -46,7 +46,7 @@
 
 /* Bump when the pipeline changes in a way that changes its output, so old
  * cached meshes are rebuilt. */
-#define PREP_VERSION "cohfrac-mesh 1 (repair valence3; qem; tetgen -pYq2.0 [-a])"
+#define PREP_VERSION "cohfrac-mesh 2 (assimp; repair valence3; meshoptimizer; tetgen -pYq2.0 [-a])"
 #define TETS_PER_TRI 2.4 /* tetgen -pYq2.0 tets per surface triangle (bunny: 2.3-2.5) */
 #define BASE_OPTS "pYq2.0"
 #define TOL 0.05

@@ -1,10 +1,8 @@
-/* cohfrac — closed triangle surfaces: OBJ/OFF/STL input, OFF output,
+/* cohfrac — closed triangle surfaces: input through assimp, OFF output,
  * enclosed volume, closedness, self-intersection search, the valence-3
- * repair of docs/scenes.md and quadric-error decimation. */
-#include "file_text.h"
+ * repair of docs/scenes.md and decimation through meshoptimizer. */
 #include "cohfrac/surface.h"
 
-#include <ctype.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -18,32 +16,16 @@
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <meshoptimizer.h>
 
 /* ====================================================================== */
-/* Growable arrays and file input                                         */
+/* Input through assimp                                                   */
 /* ====================================================================== */
 
-typedef struct dbuf {
-    double *a;
-    size_t n, cap;
-} dbuf;
 typedef struct ibuf {
     int *a;
     size_t n, cap;
 } ibuf;
-
-static int dbuf_push(dbuf *b, double v)
-{
-    if (b->n == b->cap) {
-        size_t nc = b->cap ? 2 * b->cap : 1024;
-        double *na = realloc(b->a, nc * sizeof *na);
-        if (!na)
-            return -1;
-        b->a = na, b->cap = nc;
-    }
-    b->a[b->n++] = v;
-    return 0;
-}
 
 static int ibuf_push(ibuf *b, int v)
 {
@@ -58,475 +40,97 @@ static int ibuf_push(ibuf *b, int v)
     return 0;
 }
 
+/* assimp reports some defects only to its log and goes on: an OFF face
+ * index past the vertex list, for one, is logged and clamped.  The first
+ * logged "out of range" refuses the file; its other errors (a missing
+ * material library, an OBJ without an object name) do not concern the
+ * geometry. */
+static char ai_first_error[256];
 
-/* Cut the next line out of *p (NUL-terminating it in place). */
-static char *take_line(char **p, int *line)
+static void ai_log(const char *msg, char *user)
 {
-    if (!**p)
-        return NULL;
-    char *s = *p, *e = s;
-    while (*e && *e != '\n')
-        e++;
-    *p = *e ? e + 1 : e;
-    *e = '\0';
-    (*line)++;
-    return s;
+    (void)user;
+    const char *tag = "Error, ";
+    if (ai_first_error[0] || strncmp(msg, tag, strlen(tag)) != 0 || !strstr(msg, "out of range"))
+        return;
+    const char *text = strchr(msg + strlen(tag), ':'); /* after "T0:" */
+    text = text ? text + 1 + (text[1] == ' ') : msg;
+    snprintf(ai_first_error, sizeof ai_first_error, "%s", text);
+    ai_first_error[strcspn(ai_first_error, "\r\n")] = '\0';
 }
 
-static char *skip_ws(char *s)
+static const struct aiScene *ai_import(const char *path)
 {
-    while (isspace((unsigned char)*s))
-        s++;
-    return s;
+    struct aiPropertyStore *props = aiCreatePropertyStore();
+    /* Positions only: normals, texture coordinates and colours removed
+     * first, so corners at one position are joined however the file
+     * attributes them. */
+    aiSetImportPropertyInteger(props, AI_CONFIG_PP_RVC_FLAGS,
+                               aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                   aiComponent_COLORS | aiComponent_TEXCOORDS |
+                                   aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                   aiComponent_TEXTURES | aiComponent_LIGHTS |
+                                   aiComponent_CAMERAS | aiComponent_MATERIALS);
+    struct aiLogStream log = {ai_log, NULL};
+    ai_first_error[0] = '\0';
+    aiAttachLogStream(&log);
+    const struct aiScene *sc = aiImportFileExWithProperties(
+        path,
+        aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+            aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure,
+        NULL, props);
+    aiDetachLogStream(&log);
+    aiReleasePropertyStore(props);
+    return sc;
 }
 
-/* Parse a finite double at *s; advances *s.  0 on success. */
-static int parse_double(char **s, double *v)
+/* Copy every triangle of every mesh (node transforms applied by assimp);
+ * triangles with a repeated corner are dropped. */
+static cf_status copy_scene(const char *path, const struct aiScene *sc, cf_surface *s,
+                            cf_error *err)
 {
-    char *p = skip_ws(*s), *end;
-    *v = strtod(p, &end);
-    if (end == p || !isfinite(*v) || (*end && !isspace((unsigned char)*end)))
-        return -1;
-    *s = end;
-    return 0;
-}
-
-static int parse_long(char **s, long *v)
-{
-    char *p = skip_ws(*s), *end;
-    errno = 0;
-    *v = strtol(p, &end, 10);
-    if (end == p || errno)
-        return -1;
-    *s = end;
-    return 0;
-}
-
-/* First token of s (for messages), at most 31 chars. */
-static const char *token_of(const char *s, char out[32])
-{
-    while (isspace((unsigned char)*s))
-        s++;
-    int k = 0;
-    while (s[k] && !isspace((unsigned char)s[k]) && k < 31)
-        out[k] = s[k], k++;
-    out[k] = '\0';
-    return out;
-}
-
-/* ====================================================================== */
-/* Loaders                                                                */
-/* ====================================================================== */
-
-/* Append triangle (a,b,c) unless two corners coincide (such a triangle has
- * no area and no orientation; dropping it is what a mesher would do). */
-static int add_tri(ibuf *t, int a, int b, int c)
-{
-    if (a == b || b == c || a == c)
-        return 0;
-    return (ibuf_push(t, a) || ibuf_push(t, b) || ibuf_push(t, c)) ? -1 : 0;
-}
-
-static cf_status load_obj(const char *path, char *text, dbuf *v, ibuf *t, cf_error *err)
-{
-    ibuf tline = {0}; /* line number of each triangle, for index errors */
-    char *p = text, *s, tok[32];
-    int line = 0;
-    cf_status st = CF_OK;
-    int poly[64];
-    while (st == CF_OK && (s = take_line(&p, &line))) {
-        char *c = strchr(s, '#');
-        if (c)
-            *c = '\0';
-        s = skip_ws(s);
-        if (s[0] == 'v' && isspace((unsigned char)s[1])) {
-            s++;
-            for (int k = 0; k < 3 && st == CF_OK; k++) {
-                double x;
-                if (parse_double(&s, &x))
-                    st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                                      "%s:%d: vertex needs 3 numbers 'v x y z', found '%s'", path,
-                                      line, token_of(s, tok));
-                else if (dbuf_push(v, x))
-                    st = cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-            }
-        } else if (s[0] == 'f' && isspace((unsigned char)s[1])) {
-            s++;
-            int n = 0;
-            for (;;) {
-                s = skip_ws(s);
-                if (!*s)
-                    break;
-                long id;
-                if (parse_long(&s, &id) || id == 0) {
-                    st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                                      "%s:%d: face corner '%s' is not a vertex number", path, line,
-                                      token_of(s, tok));
-                    break;
-                }
-                /* skip "/vt/vn" */
-                while (*s && !isspace((unsigned char)*s))
-                    s++;
-                long nv = (long)(v->n / 3);
-                long idx = id > 0 ? id - 1 : nv + id; /* negative: relative to the end */
-                if (idx < 0) {
-                    st = cf_error_set(err, CF_ERR_MESH_INDEX,
-                                      "%s:%d: face refers to vertex %ld, but only %ld vertices are "
-                                      "defined before it",
-                                      path, line, id, nv);
-                    break;
-                }
-                if (idx > 0x7fffffffL || n == 64) {
-                    st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                                      "%s:%d: face too large (vertex %ld, corner %d)", path, line,
-                                      id, n);
-                    break;
-                }
-                poly[n++] = (int)idx;
-            }
-            if (st != CF_OK)
-                break;
-            if (n < 3) {
-                st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                                  "%s:%d: face has %d corners; a face needs at least 3", path,
-                                  line, n);
-                break;
-            }
-            for (int k = 1; k + 1 < n && st == CF_OK; k++) {
-                size_t before = t->n;
-                if (add_tri(t, poly[0], poly[k], poly[k + 1]))
-                    st = cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-                else if (t->n > before && ibuf_push(&tline, line))
-                    st = cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-            }
-        }
-        /* vt, vn, g, o, s, usemtl, mtllib, l, p ...: not geometry we need */
-    }
-    int nv = (int)(v->n / 3);
-    for (size_t i = 0; st == CF_OK && i < t->n; i++)
-        if (t->a[i] >= nv)
-            st = cf_error_set(err, CF_ERR_MESH_INDEX,
-                              "%s:%d: face refers to vertex %d, but the file has %d vertices",
-                              path, tline.a[i / 3], t->a[i] + 1, nv);
-    free(tline.a);
-    return st;
-}
-
-/* Next non-comment, non-blank line of an OFF file. */
-static char *off_line(char **p, int *line)
-{
-    char *s;
-    while ((s = take_line(p, line))) {
-        char *c = strchr(s, '#');
-        if (c)
-            *c = '\0';
-        s = skip_ws(s);
-        if (*s)
-            return s;
-    }
-    return NULL;
-}
-
-static cf_status load_off(const char *path, char *text, dbuf *v, ibuf *t, cf_error *err)
-{
-    char *p = text, tok[32];
-    int line = 0;
-    char *s = off_line(&p, &line);
-    size_t hl;
-    if (!s || (hl = strcspn(s, " \t\r")) < 3 || strncmp(s + hl - 3, "OFF", 3))
-        return cf_error_set(err, CF_ERR_MESH_PARSE, "%s:%d: expected the header 'OFF'", path, line);
-    s = skip_ws(s + hl);
-    if (!*s && !(s = off_line(&p, &line)))
-        return cf_error_set(err, CF_ERR_MESH_PARSE,
-                            "%s:%d: missing '<#vertices> <#faces> <#edges>'",
-                            path, line);
-    long nv, nf;
-    if (parse_long(&s, &nv) || parse_long(&s, &nf) || nv < 0 || nf < 0 || nv > 0x7fffffffL)
-        return cf_error_set(err, CF_ERR_MESH_PARSE,
-                            "%s:%d: expected '<#vertices> <#faces> <#edges>'", path, line);
-    for (long i = 0; i < nv; i++) {
-        if (!(s = off_line(&p, &line)))
-            return cf_error_set(err, CF_ERR_MESH_PARSE,
-                                "%s:%d: file ends after %ld of %ld vertices", path, line, i, nv);
-        for (int k = 0; k < 3; k++) {
-            double x;
-            if (parse_double(&s, &x))
-                return cf_error_set(err, CF_ERR_MESH_PARSE,
-                                    "%s:%d: vertex needs 3 numbers, found '%s'", path, line,
-                                    token_of(s, tok));
-            if (dbuf_push(v, x))
-                return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-        }
-    }
-    for (long i = 0; i < nf; i++) {
-        if (!(s = off_line(&p, &line)))
-            return cf_error_set(err, CF_ERR_MESH_PARSE, "%s:%d: file ends after %ld of %ld faces",
-                                path, line, i, nf);
-        long n;
-        if (parse_long(&s, &n) || n < 3 || n > 64)
-            return cf_error_set(err, CF_ERR_MESH_PARSE,
-                                "%s:%d: face must start with its corner count (3..64), found '%s'",
-                                path, line, token_of(s, tok));
-        int poly[64];
-        for (long k = 0; k < n; k++) {
-            long id;
-            if (parse_long(&s, &id))
-                return cf_error_set(err, CF_ERR_MESH_PARSE,
-                                    "%s:%d: face has fewer than the %ld corners it announces", path,
-                                    line, n);
-            if (id < 0 || id >= nv)
-                return cf_error_set(err, CF_ERR_MESH_INDEX,
-                                    "%s:%d: face refers to vertex %ld, but vertices are numbered "
-                                    "0..%ld",
-                                    path, line, id, nv - 1);
-            poly[k] = (int)id;
-        }
-        for (long k = 1; k + 1 < n; k++)
-            if (add_tri(t, poly[0], poly[k], poly[k + 1]))
-                return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-    }
-    return CF_OK;
-}
-
-/* ---- STL: triangle soup, welded by exact coordinates ---- */
-
-typedef struct weld {
-    int *slot; /* vertex index or -1 */
-    size_t mask;
-    dbuf *v;
-} weld;
-
-static uint64_t hash3(const double x[3])
-{
-    uint64_t h = 1469598103934665603ULL;
-    for (int k = 0; k < 3; k++) {
-        double d = x[k] + 0.0; /* -0.0 and 0.0 are the same point */
-        uint64_t u;
-        memcpy(&u, &d, sizeof u);
-        h ^= u;
-        h *= 1099511628211ULL;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
-static int weld_init(weld *w, size_t expect, dbuf *v)
-{
-    size_t cap = 1024;
-    while (cap < 2 * expect)
-        cap *= 2;
-    w->slot = malloc(cap * sizeof *w->slot);
-    if (!w->slot)
-        return -1;
-    memset(w->slot, 0xff, cap * sizeof *w->slot);
-    w->mask = cap - 1;
-    w->v = v;
-    return 0;
-}
-
-/* Double the table when half full (keeps probe chains short and
- * guarantees a free slot). */
-static int weld_grow(weld *w)
-{
-    size_t cap = 2 * (w->mask + 1);
-    int *slot = malloc(cap * sizeof *slot);
-    if (!slot)
-        return -1;
-    memset(slot, 0xff, cap * sizeof *slot);
-    int n = (int)(w->v->n / 3);
-    for (int k = 0; k < n; k++) {
-        size_t i = (size_t)hash3(&w->v->a[3 * (size_t)k]) & (cap - 1);
-        while (slot[i] >= 0)
-            i = (i + 1) & (cap - 1);
-        slot[i] = k;
-    }
-    free(w->slot);
-    w->slot = slot;
-    w->mask = cap - 1;
-    return 0;
-}
-
-/* Index of point x, adding it if new; -1 on memory error. */
-static int weld_get(weld *w, const double x[3])
-{
-    if (2 * (w->v->n / 3 + 1) > w->mask + 1 && weld_grow(w))
-        return -1;
-    size_t i = (size_t)hash3(x) & w->mask;
-    for (;;) {
-        int k = w->slot[i];
-        if (k < 0)
-            break;
-        const double *y = &w->v->a[3 * (size_t)k];
-        if (y[0] == x[0] && y[1] == x[1] && y[2] == x[2])
-            return k;
-        i = (i + 1) & w->mask;
-    }
-    int k = (int)(w->v->n / 3);
-    if (dbuf_push(w->v, x[0]) || dbuf_push(w->v, x[1]) || dbuf_push(w->v, x[2]))
-        return -1;
-    w->slot[i] = k;
-    return k;
-}
-
-static uint32_t le32(const unsigned char *b)
-{
-    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
-}
-
-static cf_status load_stl(const char *path, unsigned char *buf, size_t len, dbuf *v, ibuf *t,
-                          cf_error *err)
-{
-    weld w;
-    if (len >= 84 && 84 + 50 * (uint64_t)le32(buf + 80) == len) {
-        uint32_t n = le32(buf + 80);
-        if (n > 0x7fffffffU / 3 || weld_init(&w, 3 * (size_t)n, v))
-            return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-        for (uint32_t i = 0; i < n; i++) {
-            const unsigned char *r = buf + 84 + 50 * (size_t)i + 12; /* skip the normal */
-            int id[3];
-            for (int c = 0; c < 3; c++) {
-                double x[3];
-                for (int k = 0; k < 3; k++) {
-                    uint32_t u = le32(r + 12 * c + 4 * k);
-                    float f;
-                    memcpy(&f, &u, sizeof f);
-                    x[k] = f;
-                }
-                if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(x[2])) {
-                    free(w.slot);
-                    return cf_error_set(err, CF_ERR_MESH_PARSE,
-                                        "%s: triangle %u has a non-finite coordinate", path, i);
-                }
-                if ((id[c] = weld_get(&w, x)) < 0) {
-                    free(w.slot);
-                    return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-                }
-            }
-            if (add_tri(t, id[0], id[1], id[2])) {
-                free(w.slot);
-                return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-            }
-        }
-        free(w.slot);
-        return CF_OK;
-    }
-    char *s = skip_ws((char *)buf), tok[32];
-    if (strncmp(s, "solid", 5))
-        return cf_error_set(err, CF_ERR_MESH_PARSE,
-                            "%s: neither ASCII STL (starts with 'solid') nor binary STL (84 + 50 "
-                            "bytes per triangle; this file has %zu bytes)",
-                            path, len);
-    /* a facet takes at least ~80 bytes: size the table from that */
-    if (weld_init(&w, len / 80 + 16, v))
-        return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-    cf_status st = CF_OK;
-    char *p = (char *)buf;
-    int line = 0, corner = 0, id[3] = {0, 0, 0};
-    while (st == CF_OK && (s = take_line(&p, &line))) {
-        s = skip_ws(s);
-        if (!strncmp(s, "vertex", 6) && isspace((unsigned char)s[6])) {
-            double x[3];
-            s += 6;
-            for (int k = 0; k < 3 && st == CF_OK; k++)
-                if (parse_double(&s, &x[k]))
-                    st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                                      "%s:%d: 'vertex' needs 3 numbers, found '%s'", path, line,
-                                      token_of(s, tok));
-            if (st != CF_OK)
-                break;
-            if (corner == 3) {
-                st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                                  "%s:%d: more than 3 vertices in one facet loop", path, line);
-                break;
-            }
-            if ((id[corner++] = weld_get(&w, x)) < 0)
-                st = cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-        } else if (!strncmp(s, "endloop", 7)) {
-            if (corner != 3)
-                st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                                  "%s:%d: facet loop has %d vertices; STL facets are triangles",
-                                  path, line, corner);
-            else if (add_tri(t, id[0], id[1], id[2]))
-                st = cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory", path);
-            corner = 0;
-        }
-        /* solid, facet normal, outer loop, endfacet, endsolid: structure only */
-    }
-    if (st == CF_OK && corner != 0)
-        st = cf_error_set(err, CF_ERR_MESH_PARSE, "%s:%d: file ends inside a facet (truncated?)",
-                          path, line);
-    free(w.slot);
-    return st;
-}
-
-static int ext_is(const char *path, const char *ext)
-{
-    size_t n = strlen(path), e = strlen(ext);
-    if (n < e)
-        return 0;
-    for (size_t i = 0; i < e; i++)
-        if (tolower((unsigned char)path[n - e + i]) != ext[i])
-            return 0;
-    return 1;
-}
-
-/* Any other format assimp reads (PLY, glTF, 3DS, FBX, COLLADA, ...):
- * every mesh of the file, node transforms applied, triangulated, identical
- * vertices joined; coordinates as the file has them. */
-static cf_status load_with_assimp(const char *path, cf_surface *s, cf_error *err)
-{
-    const struct aiScene *sc =
-        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                               aiProcess_PreTransformVertices);
-    if (!sc)
-        return cf_error_set(err, CF_ERR_MESH_PARSE, "%s: %s (read with assimp)", path,
-                            aiGetErrorString());
     size_t nv = 0, nt = 0;
     for (unsigned i = 0; i < sc->mNumMeshes; i++) {
         nv += sc->mMeshes[i]->mNumVertices;
         for (unsigned f = 0; f < sc->mMeshes[i]->mNumFaces; f++)
             nt += sc->mMeshes[i]->mFaces[f].mNumIndices == 3;
     }
-    cf_status st = CF_OK;
     if (nt == 0 || nv > INT_MAX / 3 || nt > INT_MAX / 3)
-        st = cf_error_set(err, CF_ERR_MESH_PARSE,
-                          "%s: %zu triangles in %u meshes (read with assimp): a surface needs "
-                          "triangles, and at most %d of them",
-                          path, nt, sc->mNumMeshes, INT_MAX / 3);
-    if (st == CF_OK) {
-        s->v = malloc(nv * 3 * sizeof(double));
-        s->tri = malloc(nt * 3 * sizeof(int));
-        if (!s->v || !s->tri)
-            st = cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory for %zu triangles", path, nt);
-    }
-    for (unsigned i = 0, base = 0; st == CF_OK && i < sc->mNumMeshes; i++) {
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s: %zu triangles in %u meshes: a surface needs triangles, and at "
+                            "most %d of them",
+                            path, nt, sc->mNumMeshes, INT_MAX / 3);
+    s->v = malloc(nv * 3 * sizeof(double));
+    s->tri = malloc(nt * 3 * sizeof(int));
+    if (!s->v || !s->tri)
+        return cf_error_set(err, CF_ERR_NOMEM, "%s: out of memory for %zu triangles", path, nt);
+    for (unsigned i = 0, base = 0; i < sc->mNumMeshes; i++) {
         const struct aiMesh *m = sc->mMeshes[i];
         for (unsigned v = 0; v < m->mNumVertices; v++) {
-            s->v[3 * (size_t)s->n_verts + 0] = m->mVertices[v].x;
-            s->v[3 * (size_t)s->n_verts + 1] = m->mVertices[v].y;
-            s->v[3 * (size_t)s->n_verts + 2] = m->mVertices[v].z;
-            s->n_verts++;
+            double *x = &s->v[3 * (size_t)s->n_verts++];
+            x[0] = m->mVertices[v].x, x[1] = m->mVertices[v].y, x[2] = m->mVertices[v].z;
+            if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(x[2]))
+                return cf_error_set(err, CF_ERR_MESH_PARSE,
+                                    "%s: a vertex of mesh %u is not a finite number (%g %g %g)",
+                                    path, i, x[0], x[1], x[2]);
         }
         for (unsigned f = 0; f < m->mNumFaces; f++) {
-            const struct aiFace *face = &m->mFaces[f];
-            if (face->mNumIndices != 3)
-                continue; /* points and lines */
+            const unsigned *c = m->mFaces[f].mIndices;
+            if (m->mFaces[f].mNumIndices != 3 || c[0] == c[1] || c[1] == c[2] || c[2] == c[0])
+                continue; /* points, lines and degenerate triangles */
             for (int k = 0; k < 3; k++)
-                s->tri[3 * (size_t)s->n_tris + k] = (int)(base + face->mIndices[k]);
+                s->tri[3 * (size_t)s->n_tris + k] = (int)(base + c[k]);
             s->n_tris++;
         }
         base += m->mNumVertices;
     }
-    aiReleaseImport(sc);
-    if (st != CF_OK)
-        cf_surface_free(s);
-    return st;
+    if (s->n_tris == 0)
+        return cf_error_set(err, CF_ERR_MESH_PARSE, "%s: the surface has no triangles", path);
+    return CF_OK;
 }
 
 int cf_surface_format_known(const char *path)
 {
-    if (ext_is(path, ".obj") || ext_is(path, ".off") || ext_is(path, ".stl"))
-        return 1;
     const char *dot = strrchr(path, '.');
     return dot && !strchr(dot, '/') && aiIsExtensionSupported(dot);
 }
@@ -540,43 +144,28 @@ cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err)
                             "%s is a directory, not a surface file: give a .obj, .off or .stl "
                             "file",
                             path);
-    int kind = ext_is(path, ".obj") ? 0 : ext_is(path, ".off") ? 1 : ext_is(path, ".stl") ? 2 : -1;
-    if (kind < 0) {
-        const char *dot = strrchr(path, '.');
-        if (dot && !strchr(dot, '/') && aiIsExtensionSupported(dot)) {
-            if (access(path, R_OK) != 0)
-                return cf_error_set(err, CF_ERR_FILE_OPEN, "%s: cannot read it: %s", path,
-                                    strerror(errno));
-            return load_with_assimp(path, s, err);
-        }
+    if (!cf_surface_format_known(path))
         return cf_error_set(err, CF_ERR_FILE_OPEN,
-                            "%s: unknown surface format; use .obj, .off or .stl, or a format "
-                            "assimp reads (.ply, .gltf, .glb, .3ds, .fbx, .dae, ...)",
+                            "%s: unknown surface format; use .obj, .off or .stl, or another "
+                            "format assimp reads (.ply, .gltf, .glb, .3ds, .fbx, .dae, ...)",
                             path);
+    if (access(path, R_OK) != 0)
+        return cf_error_set(err, CF_ERR_FILE_OPEN, "%s: cannot read it: %s", path,
+                            strerror(errno));
+    const struct aiScene *sc = ai_import(path);
+    cf_status st = CF_OK;
+    if (!sc || ai_first_error[0]) {
+        const char *why = ai_first_error[0] ? ai_first_error : aiGetErrorString();
+        int index = strstr(why, "out of range") != NULL;
+        st = cf_error_set(err, index ? CF_ERR_MESH_INDEX : CF_ERR_MESH_PARSE,
+                          "%s: %s (read with assimp)", path, why);
+    } else {
+        st = copy_scene(path, sc, s, err);
     }
-    size_t len;
-    unsigned char *buf = (unsigned char *)cf_file_read(path, &len);
-    if (!buf)
-        return cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
-                            "%s: cannot read (%s)", path, strerror(errno));
-    dbuf v = {0};
-    ibuf t = {0};
-    cf_status st = kind == 0   ? load_obj(path, (char *)buf, &v, &t, err)
-                   : kind == 1 ? load_off(path, (char *)buf, &v, &t, err)
-                               : load_stl(path, buf, len, &v, &t, err);
-    free(buf);
-    if (st == CF_OK && t.n == 0)
-        st = cf_error_set(err, CF_ERR_MESH_PARSE, "%s: the surface has no triangles", path);
-    if (st != CF_OK) {
-        free(v.a);
-        free(t.a);
-        return st;
-    }
-    s->n_verts = (int)(v.n / 3);
-    s->n_tris = (int)(t.n / 3);
-    s->v = v.a;
-    s->tri = t.a;
-    return CF_OK;
+    aiReleaseImport(sc);
+    if (st != CF_OK)
+        cf_surface_free(s);
+    return st;
 }
 
 cf_status cf_surface_write_off(const cf_surface *s, const char *path, cf_error *err)
@@ -983,6 +572,9 @@ static int tri_tri_edge(const double *a, const double *b, const double *c, const
 static int tris_intersect(const cf_surface *s, int ti, int tj)
 {
     const int *A = &s->tri[3 * ti], *B = &s->tri[3 * tj];
+    if (A[0] == A[1] || A[1] == A[2] || A[2] == A[0] || B[0] == B[1] || B[1] == B[2] ||
+        B[2] == B[0])
+        return 1; /* a triangle with a repeated corner is a defect wherever it lies */
     int ia[3], ib[3], ns = 0; /* positions of shared vertices */
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -1344,382 +936,41 @@ int cf_surface_repair_valence3(cf_surface *s)
 }
 
 /* ====================================================================== */
-/* Quadric-error decimation (Garland & Heckbert 1997)                     */
+/* Decimation (meshoptimizer)                                             */
 /* ====================================================================== */
-
-/* Symmetric 4x4 quadric, upper triangle: a2 ab ac ad b2 bc bd c2 cd d2. */
-typedef struct quad {
-    double q[10];
-} quad;
-
-static double quad_eval(const quad *Q, const double *p)
-{
-    const double *q = Q->q;
-    double x = p[0], y = p[1], z = p[2];
-    return q[0] * x * x + 2 * q[1] * x * y + 2 * q[2] * x * z + 2 * q[3] * x + q[4] * y * y +
-           2 * q[5] * y * z + 2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
-}
-
-/* Minimiser of the quadric if well conditioned (0), else -1. */
-static int quad_optimum(const quad *Q, double *p)
-{
-    const double *q = Q->q;
-    double A[3][3] = {{q[0], q[1], q[2]}, {q[1], q[4], q[5]}, {q[2], q[5], q[7]}};
-    double b[3] = {-q[3], -q[6], -q[8]};
-    double c00 = A[1][1] * A[2][2] - A[1][2] * A[2][1], c01 = A[1][2] * A[2][0] - A[1][0] * A[2][2],
-           c02 = A[1][0] * A[2][1] - A[1][1] * A[2][0];
-    double det = A[0][0] * c00 + A[0][1] * c01 + A[0][2] * c02;
-    double tr = A[0][0] + A[1][1] + A[2][2];
-    /* relative test: a flat or ridge-only neighbourhood is singular */
-    if (!(fabs(det) > 1e-9 * tr * tr * tr))
-        return -1;
-    double inv[3][3] = {
-        {c00, A[0][2] * A[2][1] - A[0][1] * A[2][2], A[0][1] * A[1][2] - A[0][2] * A[1][1]},
-        {c01, A[0][0] * A[2][2] - A[0][2] * A[2][0], A[0][2] * A[1][0] - A[0][0] * A[1][2]},
-        {c02, A[0][1] * A[2][0] - A[0][0] * A[2][1], A[0][0] * A[1][1] - A[0][1] * A[1][0]}};
-    for (int i = 0; i < 3; i++)
-        p[i] = (inv[i][0] * b[0] + inv[i][1] * b[1] + inv[i][2] * b[2]) / det;
-    return 0;
-}
-
-typedef struct dec_entry {
-    double cost;
-    int a, b;          /* a < b */
-    unsigned sa, sb;   /* vertex stamps when pushed (stale when changed) */
-} dec_entry;
-
-typedef struct dec_heap {
-    dec_entry *e;
-    size_t n, cap;
-} dec_heap;
-
-/* Strict total order, so the collapse sequence is reproducible. */
-static int dec_less(const dec_entry *x, const dec_entry *y)
-{
-    if (x->cost != y->cost)
-        return x->cost < y->cost;
-    if (x->a != y->a)
-        return x->a < y->a;
-    return x->b < y->b;
-}
-
-static int heap_push(dec_heap *h, dec_entry e)
-{
-    if (h->n == h->cap) {
-        size_t nc = h->cap ? 2 * h->cap : 4096;
-        dec_entry *ne = realloc(h->e, nc * sizeof *ne);
-        if (!ne)
-            return -1;
-        h->e = ne, h->cap = nc;
-    }
-    size_t i = h->n++;
-    while (i > 0) {
-        size_t p = (i - 1) / 2;
-        if (!dec_less(&e, &h->e[p]))
-            break;
-        h->e[i] = h->e[p];
-        i = p;
-    }
-    h->e[i] = e;
-    return 0;
-}
-
-static dec_entry heap_pop(dec_heap *h)
-{
-    dec_entry top = h->e[0], last = h->e[--h->n];
-    size_t i = 0;
-    for (;;) {
-        size_t c = 2 * i + 1;
-        if (c >= h->n)
-            break;
-        if (c + 1 < h->n && dec_less(&h->e[c + 1], &h->e[c]))
-            c++;
-        if (!dec_less(&h->e[c], &last))
-            break;
-        h->e[i] = h->e[c];
-        i = c;
-    }
-    if (h->n > 0)
-        h->e[i] = last;
-    return top;
-}
-
-typedef struct decim {
-    cf_surface *s;
-    quad *Q;
-    unsigned *stamp;
-    char *vdead, *tdead;
-    int **vt; /* per-vertex live triangle lists */
-    int *vtn, *vtcap;
-    int *mark, mark_id;
-    dec_heap heap;
-} decim;
-
-/* Target point of collapsing edge (a,b) and its cost. */
-static double collapse_point(const decim *d, int a, int b, double *p)
-{
-    quad Q;
-    for (int k = 0; k < 10; k++)
-        Q.q[k] = d->Q[a].q[k] + d->Q[b].q[k];
-    const double *xa = &d->s->v[3 * a], *xb = &d->s->v[3 * b];
-    double len2 = 0, mid[3];
-    for (int k = 0; k < 3; k++) {
-        mid[k] = 0.5 * (xa[k] + xb[k]);
-        len2 += (xb[k] - xa[k]) * (xb[k] - xa[k]);
-    }
-    if (quad_optimum(&Q, p) == 0) {
-        double dd = 0;
-        for (int k = 0; k < 3; k++)
-            dd += (p[k] - mid[k]) * (p[k] - mid[k]);
-        if (dd <= len2) /* stay near the edge: far optima fold the surface */
-            return fmax(quad_eval(&Q, p), 0.0);
-    }
-    const double *cand[3] = {xa, xb, mid};
-    double best = INFINITY;
-    for (int c = 0; c < 3; c++) {
-        double e = quad_eval(&Q, cand[c]);
-        if (e < best) {
-            best = e;
-            memcpy(p, cand[c], 3 * sizeof(double));
-        }
-    }
-    return fmax(best, 0.0);
-}
-
-static int push_edge(decim *d, int a, int b)
-{
-    if (a > b) {
-        int t = a;
-        a = b, b = t;
-    }
-    double p[3];
-    dec_entry e = {collapse_point(d, a, b, p), a, b, d->stamp[a], d->stamp[b]};
-    return heap_push(&d->heap, e);
-}
-
-/* Triangle quality 4*sqrt(3)*area / sum of squared edges: 1 equilateral. */
-static double tri_quality(const double *a, const double *b, const double *c, double *n)
-{
-    double u[3], v[3], w[3];
-    sub3(b, a, u);
-    sub3(c, a, v);
-    sub3(c, b, w);
-    cross3(u, v, n);
-    double area2 = sqrt(dot3(n, n)), l = dot3(u, u) + dot3(v, v) + dot3(w, w);
-    return l > 0 ? 2.0 * sqrt(3.0) * area2 / l : 0.0;
-}
-
-/* Would moving a and b to p keep every surviving triangle unflipped and
- * not much worse shaped? */
-static int collapse_ok(decim *d, int a, int b, const double *p)
-{
-    const cf_surface *s = d->s;
-    for (int side = 0; side < 2; side++) {
-        int v = side ? b : a, o = side ? a : b;
-        for (int k = 0; k < d->vtn[v]; k++) {
-            const int *T = &s->tri[3 * d->vt[v][k]];
-            if (T[0] == o || T[1] == o || T[2] == o)
-                continue; /* removed by the collapse */
-            const double *P0[3], *P1[3];
-            for (int c = 0; c < 3; c++) {
-                P0[c] = &s->v[3 * T[c]];
-                P1[c] = T[c] == v ? p : P0[c];
-            }
-            double n0[3], n1[3];
-            double q0 = tri_quality(P0[0], P0[1], P0[2], n0);
-            double q1 = tri_quality(P1[0], P1[1], P1[2], n1);
-            double l0 = sqrt(dot3(n0, n0)), l1 = sqrt(dot3(n1, n1));
-            if (!(l1 > 0) || dot3(n0, n1) < 0.5 * l0 * l1)
-                return 0; /* flips or turns by more than 60 degrees */
-            if (q1 < 0.1 && q1 < q0)
-                return 0; /* needle: tetgen would pay for it inside */
-        }
-    }
-    return 1;
-}
-
-static int vt_add(decim *d, int v, int t)
-{
-    if (d->vtn[v] == d->vtcap[v]) {
-        int nc = d->vtcap[v] ? 2 * d->vtcap[v] : 8;
-        int *na = realloc(d->vt[v], (size_t)nc * sizeof *na);
-        if (!na)
-            return -1;
-        d->vt[v] = na, d->vtcap[v] = nc;
-    }
-    d->vt[v][d->vtn[v]++] = t;
-    return 0;
-}
-
-/* Try to collapse b into a at p.  1 done, 0 refused, -1 out of memory. */
-static int try_collapse(decim *d, int a, int b)
-{
-    cf_surface *s = d->s;
-    double p[3];
-    collapse_point(d, a, b, p);
-    /* The two triangles on edge ab give the opposite corners c and e. */
-    int opp[2], no = 0;
-    for (int k = 0; k < d->vtn[a]; k++) {
-        const int *T = &s->tri[3 * d->vt[a][k]];
-        if (T[0] == b || T[1] == b || T[2] == b) {
-            if (no == 2)
-                return 0; /* non-manifold edge */
-            opp[no++] = T[0] != a && T[0] != b ? T[0] : T[1] != a && T[1] != b ? T[1] : T[2];
-        }
-    }
-    if (no != 2 || opp[0] == opp[1])
-        return 0; /* boundary edge */
-    /* Link condition: a and b share exactly the neighbours c and e.  Mark
-     * a's neighbours with id M, then count b's neighbours that carry M
-     * (re-marking them M+1 so each is counted once). */
-    int M = d->mark_id += 2;
-    for (int k = 0; k < d->vtn[a]; k++)
-        for (int c = 0; c < 3; c++)
-            d->mark[s->tri[3 * d->vt[a][k] + c]] = M - 1;
-    int common = 0;
-    for (int k = 0; k < d->vtn[b]; k++)
-        for (int c = 0; c < 3; c++) {
-            int w = s->tri[3 * d->vt[b][k] + c];
-            if (w != a && w != b && d->mark[w] == M - 1) {
-                d->mark[w] = M;
-                common++;
-            }
-        }
-    if (common != 2)
-        return 0;
-    /* Keep every vertex at valence >= 4 (valence = live triangles here): a
-     * valence-3 vertex makes tetgen use the tet of it and its neighbours,
-     * a sliver where the surface is nearly flat. */
-    if (d->vtn[opp[0]] <= 4 || d->vtn[opp[1]] <= 4 || d->vtn[a] + d->vtn[b] - 4 < 4)
-        return 0;
-    if (!collapse_ok(d, a, b, p))
-        return 0;
-    /* Apply. */
-    memcpy(&s->v[3 * a], p, sizeof p);
-    for (int k = 0; k < 10; k++)
-        d->Q[a].q[k] += d->Q[b].q[k];
-    for (int k = 0; k < d->vtn[b]; k++) {
-        int t = d->vt[b][k];
-        int *T = &s->tri[3 * t];
-        if (T[0] == a || T[1] == a || T[2] == a) {
-            d->tdead[t] = 1;
-            continue;
-        }
-        for (int c = 0; c < 3; c++)
-            if (T[c] == b)
-                T[c] = a;
-        if (vt_add(d, a, t))
-            return -1;
-    }
-    int n = 0;
-    for (int k = 0; k < d->vtn[a]; k++)
-        if (!d->tdead[d->vt[a][k]])
-            d->vt[a][n++] = d->vt[a][k];
-    d->vtn[a] = n;
-    for (int w = 0; w < 2; w++) {
-        int o = opp[w], m = 0;
-        for (int k = 0; k < d->vtn[o]; k++)
-            if (!d->tdead[d->vt[o][k]])
-                d->vt[o][m++] = d->vt[o][k];
-        d->vtn[o] = m;
-    }
-    free(d->vt[b]);
-    d->vt[b] = NULL, d->vtn[b] = d->vtcap[b] = 0;
-    d->vdead[b] = 1;
-    d->stamp[a]++, d->stamp[b]++;
-    /* New costs for the edges around a (each neighbour once). */
-    d->mark_id++;
-    for (int k = 0; k < d->vtn[a]; k++)
-        for (int c = 0; c < 3; c++) {
-            int w = s->tri[3 * d->vt[a][k] + c];
-            if (w != a && d->mark[w] != d->mark_id) {
-                d->mark[w] = d->mark_id;
-                if (push_edge(d, a, w))
-                    return -1;
-            }
-        }
-    return 1;
-}
 
 int cf_surface_decimate(cf_surface *s, int target_tris)
 {
-    int nv = s->n_verts, nt = s->n_tris;
-    if (target_tris >= nt)
-        return nt;
-    decim d = {0};
-    d.s = s;
-    d.Q = calloc((size_t)nv, sizeof *d.Q);
-    d.stamp = calloc((size_t)nv, sizeof *d.stamp);
-    d.vdead = calloc((size_t)nv, 1);
-    d.tdead = calloc((size_t)nt, 1);
-    d.vt = calloc((size_t)nv, sizeof *d.vt);
-    d.vtn = calloc((size_t)nv, sizeof *d.vtn);
-    d.vtcap = calloc((size_t)nv, sizeof *d.vtcap);
-    d.mark = calloc((size_t)nv, sizeof *d.mark);
+    size_t nv = (size_t)s->n_verts, nt = (size_t)s->n_tris;
+    if (target_tris >= s->n_tris)
+        return s->n_tris;
+    /* meshoptimizer takes float positions: about the centroid, so float's
+     * 7 digits resolve the shape; the kept vertices keep their doubles. */
+    float *xyz = malloc(nv * 3 * sizeof *xyz);
+    unsigned *in = malloc(nt * 3 * sizeof *in), *out = malloc(nt * 3 * sizeof *out);
     int result = -1;
-    if (!d.Q || !d.stamp || !d.vdead || !d.tdead || !d.vt || !d.vtn || !d.vtcap || !d.mark)
+    if (!xyz || !in || !out)
         goto done;
-    /* Area-weighted plane quadrics of the original triangles. */
-    for (int t = 0; t < nt; t++) {
-        const int *T = &s->tri[3 * t];
-        const double *a = &s->v[3 * T[0]], *b = &s->v[3 * T[1]], *c = &s->v[3 * T[2]];
-        double u[3], v[3], n[3];
-        sub3(b, a, u);
-        sub3(c, a, v);
-        cross3(u, v, n);
-        double l = sqrt(dot3(n, n));
-        if (l > 0) {
-            double w = 0.5 * l; /* area */
-            for (int k = 0; k < 3; k++)
-                n[k] /= l;
-            double pl[4] = {n[0], n[1], n[2], -dot3(n, a)};
-            quad K;
-            int m = 0;
-            for (int i = 0; i < 4; i++)
-                for (int j = i; j < 4; j++)
-                    K.q[m++] = w * pl[i] * pl[j];
-            for (int c2 = 0; c2 < 3; c2++)
-                for (int k = 0; k < 10; k++)
-                    d.Q[T[c2]].q[k] += K.q[k];
-        }
-        for (int c2 = 0; c2 < 3; c2++)
-            if (vt_add(&d, T[c2], t))
-                goto done;
-    }
-    for (int t = 0; t < nt; t++)
-        for (int k = 0; k < 3; k++) {
-            int a = s->tri[3 * t + k], b = s->tri[3 * t + (k + 1) % 3];
-            if (a < b && push_edge(&d, a, b)) /* each edge once (its a<b side) */
-                goto done;
-        }
-    int live = nt;
-    while (live > target_tris && d.heap.n > 0) {
-        dec_entry e = heap_pop(&d.heap);
-        if (d.vdead[e.a] || d.vdead[e.b] || e.sa != d.stamp[e.a] || e.sb != d.stamp[e.b])
-            continue; /* stale */
-        int r = try_collapse(&d, e.a, e.b);
-        if (r < 0)
-            goto done;
-        if (r > 0)
-            live -= 2;
-    }
-    for (int t = 0; t < nt; t++)
-        d.tdead[t] = !d.tdead[t]; /* now "alive" flags */
-    compact_tris(s, d.tdead);
-    if (cf_surface_remove_unused(s) >= 0)
+    double c[3] = {0, 0, 0};
+    for (size_t i = 0; i < nv; i++)
+        for (int k = 0; k < 3; k++)
+            c[k] += s->v[3 * i + k] / (double)nv;
+    for (size_t i = 0; i < nv; i++)
+        for (int k = 0; k < 3; k++)
+            xyz[3 * i + k] = (float)(s->v[3 * i + k] - c[k]);
+    for (size_t i = 0; i < 3 * nt; i++)
+        in[i] = (unsigned)s->tri[i];
+    /* Error bound 1 (the whole extent): the triangle count decides. */
+    size_t n = meshopt_simplify(out, in, 3 * nt, xyz, nv, 3 * sizeof(float),
+                                3 * (size_t)target_tris, 1.0f, 0, NULL);
+    for (size_t i = 0; i < n; i++)
+        s->tri[i] = (int)out[i];
+    s->n_tris = (int)(n / 3);
+    if (cf_surface_remove_unused(s) >= 0 && cf_surface_repair_valence3(s) >= 0)
         result = s->n_tris;
 done:
-    for (int v = 0; v < nv && d.vt; v++)
-        free(d.vt[v]);
-    free(d.Q);
-    free(d.stamp);
-    free(d.vdead);
-    free(d.tdead);
-    free(d.vt);
-    free(d.vtn);
-    free(d.vtcap);
-    free(d.mark);
-    free(d.heap.e);
+    free(xyz);
+    free(in);
+    free(out);
     return result;
 }
-
