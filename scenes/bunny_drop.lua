@@ -8,9 +8,9 @@
 -- The source gives no size or drop height: here the mesh's own units are
 -- metres (the bunny is 2 m tall) and it falls 1 m (its lowest point starts
 -- at z = 1 m; from 0.5 m the small bunny does not crack).
--- Default mesh: the coarse `bunny_small` (14,940 tets; `make run`), about
--- 20 s here.  Source scale (the source's bunny has 208,353 tets; ours
--- 203,053): --set 'bodies[1].mesh="bunny"', about 6 minutes on 2 threads
+-- Default mesh: the coarse `bunny_small` (14,390 tets; `make run`), about
+-- 10 s here.  Source scale (the source's bunny has 208,353 tets; ours
+-- 202,404): --set 'bodies[1].mesh="bunny"', about 6 minutes on 2 threads
 -- (see the README and docs/performance.md).
 -- Expected: the bunny rebounds at the impact (fracture mode is PBD with
 -- k = 0.9 and 3 iterations, an almost rigid elastic body: the compression

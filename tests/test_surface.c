@@ -658,7 +658,7 @@ static void test_prepare_cube(void **state)
     /* the output directory does not exist yet */
     char out[512];
     snprintf(out, sizeof out, "%s/made/here/cube", tmpdir);
-    cf_mesh_prep_opts o = {tpath("pcube.off"), out, 0, 0};
+    cf_mesh_prep_opts o = {.input = tpath("pcube.off"), .output = out, .target_tets = 0};
     assert_int_equal(cf_mesh_prepare(&o, &err), CF_OK);
     cf_mesh m;
     assert_int_equal(cf_mesh_load_tetgen(out, &m, &err), CF_OK); /* checks orientation */
@@ -687,14 +687,14 @@ static void test_prepare_cube(void **state)
     char out2[512], out3[512];
     snprintf(out2, sizeof out2, "%s/cube3000", tmpdir);
     snprintf(out3, sizeof out3, "%s/cube3000b", tmpdir);
-    cf_mesh_prep_opts o2 = {tpath("pcube.off"), out2, 3000, 0};
+    cf_mesh_prep_opts o2 = {.input = tpath("pcube.off"), .output = out2, .target_tets = 3000};
     assert_int_equal(cf_mesh_prepare(&o2, &err), CF_OK);
     assert_int_equal(cf_mesh_load_tetgen(out2, &m, &err), CF_OK);
     assert_true(m.n_tets > 2700 && m.n_tets < 3300);
     assert_true(fabs(cf_mesh_volume(&m) - 1.0) < 1e-12);
     cf_mesh_free(&m);
     /* reproducible: a second output from the same input is identical */
-    cf_mesh_prep_opts o3 = {tpath("pcube.off"), out3, 3000, 0};
+    cf_mesh_prep_opts o3 = {.input = tpath("pcube.off"), .output = out3, .target_tets = 3000};
     assert_int_equal(cf_mesh_prepare(&o3, &err), CF_OK);
     char p2[600], p3[600];
     for (int e = 0; e < 2; e++) {
@@ -720,7 +720,7 @@ static void test_prepare_repairs_and_rejects(void **state)
     defect_octahedron(&s);
     assert_int_equal(cf_surface_write_off(&s, tpath("oct.off"), &err), CF_OK);
     cf_surface_free(&s);
-    cf_mesh_prep_opts o = {tpath("oct.off"), tpath("oct"), 0, 0};
+    cf_mesh_prep_opts o = {.input = tpath("oct.off"), .output = tpath("oct"), .target_tets = 0};
     assert_int_equal(cf_mesh_prepare(&o, &err), CF_OK);
     cf_mesh m;
     assert_int_equal(cf_mesh_load_tetgen(tpath("oct"), &m, &err), CF_OK);
@@ -733,7 +733,7 @@ static void test_prepare_repairs_and_rejects(void **state)
     s.n_tris = 11;
     assert_int_equal(cf_surface_write_off(&s, tpath("open.off"), &err), CF_OK);
     cf_surface_free(&s);
-    cf_mesh_prep_opts o2 = {tpath("open.off"), tpath("open"), 0, 0};
+    cf_mesh_prep_opts o2 = {.input = tpath("open.off"), .output = tpath("open"), .target_tets = 0};
     assert_int_equal(cf_mesh_prepare(&o2, &err), CF_ERR_MESH_PARSE);
     assert_non_null(strstr(err.msg, "not a closed"));
 
@@ -748,7 +748,7 @@ static void test_prepare_repairs_and_rejects(void **state)
     for (int i = 0; i < 36; i++)
         u.tri[36 + i] = b.tri[i] + 8;
     assert_int_equal(cf_surface_write_off(&u, tpath("two.off"), &err), CF_OK);
-    cf_mesh_prep_opts o3 = {tpath("two.off"), tpath("two"), 0, 0};
+    cf_mesh_prep_opts o3 = {.input = tpath("two.off"), .output = tpath("two"), .target_tets = 0};
     assert_int_equal(cf_mesh_prepare(&o3, &err), CF_ERR_SURFACE_INTERSECT);
     assert_non_null(strstr(err.msg, "faces "));
     assert_null(fopen(tpath("two.node"), "r")); /* nothing written */
@@ -758,7 +758,7 @@ static void test_prepare_repairs_and_rejects(void **state)
 
     /* tetgen missing */
     setenv("COHFRAC_TETGEN", "/nonexistent/tetgen", 1);
-    cf_mesh_prep_opts o4 = {tpath("pcube.off"), tpath("notet"), 0, 0};
+    cf_mesh_prep_opts o4 = {.input = tpath("pcube.off"), .output = tpath("notet"), .target_tets = 0};
     cube_surface(&s, one, zero);
     assert_int_equal(cf_surface_write_off(&s, tpath("pcube.off"), &err), CF_OK);
     cf_surface_free(&s);

@@ -11,6 +11,8 @@
 #include "cohfrac/error.h"
 #include "cohfrac/mesh.h"
 
+#include <signal.h>
+
 typedef struct cf_surface {
     int n_verts;
     int n_tris;
@@ -92,18 +94,25 @@ int cf_surface_decimate(cf_surface *s, int target_tris);
 
 void cf_surface_free(cf_surface *s);
 
+/* Seconds one tetgen run may take before it is stopped (CF_ERR_EXTERNAL). */
+#define CF_TETGEN_TIME_LIMIT 300.0
+
 /* Options for `cohfrac mesh`. */
 typedef struct cf_mesh_prep_opts {
-    const char *input;    /* surface file (.obj/.off/.stl) */
+    const char *input;    /* surface file (any format cf_surface_load reads) */
     const char *output;   /* output base: writes <output>.node/.ele */
     int target_tets;      /* approximate number of tets wanted (0: tetgen -pq default) */
     int verbose;          /* print what is done to stderr */
+    double time_limit;    /* s per tetgen run; 0: CF_TETGEN_TIME_LIMIT */
+    const volatile sig_atomic_t *stop; /* NULL, or a flag a signal handler raises: tetgen
+                                          is stopped, the temporary files removed, and
+                                          CF_ERR_INTERRUPTED returned */
 } cf_mesh_prep_opts;
 
 /* Load, report self-intersections (face indices) and repair them, check the
  * surface is a closed manifold, coarsen it if `target_tets` needs it, run
  * tetgen, orient every tet positively, check the tets' total volume against
- * the surface's enclosed volume (1e-6 relative), and write
+ * the surface's enclosed volume (1e-5 relative), and write
  * <output>.node/.ele (0-based, %.17g; coordinates in the surface's file
  * units and axes: no scaling or rotation).  The output directory is created
  * if missing.  Skips all work (printing "cached" when verbose) when the
@@ -115,6 +124,8 @@ typedef struct cf_mesh_prep_opts {
  * surface; a surface too fine for N is decimated first (about 2.4 tets per
  * surface triangle) and a maximum tet volume -a fills up to N.  N = 0 runs
  * plain tetgen -pq on the full surface.  The stamp lists the options used.
+ * Bounded: with a target, tetgen may add at most N points (-S N: about 4 N
+ * tets), and every tetgen run is stopped after opts->time_limit.
  * The program is `tetgen` from PATH, or $COHFRAC_TETGEN; temporary files go
  * to $TMPDIR (default /tmp) and are removed.
  * Errors: as cf_surface_load, CF_ERR_USAGE (missing paths, N < 0),
@@ -123,7 +134,8 @@ typedef struct cf_mesh_prep_opts {
  * or made by decimation: lists face pairs), CF_ERR_EXTERNAL (tetgen missing
  * or failed: its output is quoted; or its tets do not fill the surface),
  * CF_ERR_MESH_INVERTED (degenerate tet in tetgen's output), CF_ERR_OUTPUT,
- * CF_ERR_NOMEM. */
+ * CF_ERR_NOMEM, CF_ERR_INTERRUPTED (opts->stop raised).  Temporary files are
+ * removed on every return. */
 cf_status cf_mesh_prepare(const cf_mesh_prep_opts *opts, cf_error *err);
 
 /* The meshes a world definition names, made by mesh preparation: each

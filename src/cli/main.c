@@ -65,7 +65,9 @@ static const struct {
      "                                      glTF, 3DS, FBX... read with assimp), run tetgen,\n"
      "                                      write OUT.node/OUT.ele (cached)\n"
      "      -o, --output OUT                the TetGen base to write (OUT.node, OUT.ele)\n"
-     "          --target-tets N             about this many tets (default: tetgen's own)\n"
+     "          --target-tets N             about this many tets (default: tetgen's own);\n"
+     "                                      tetgen then adds at most N points (-S N)\n"
+     "          --time-limit S              stop a tetgen run after S seconds (default 300)\n"
      "      -q, --quiet                     no progress lines\n"},
     {"study",
      "  cohfrac study SCENE.lua --vary KEY.PATH=V1,V2,... [options]\n"
@@ -177,10 +179,37 @@ static int real_arg(const char *opt, const char *text, double lo, double *out)
     return 0;
 }
 
+/* The signal that asked a run or a mesh preparation to stop (0: none). */
+static volatile sig_atomic_t stop_signal = 0;
+
+static void on_stop_signal(int sig) { stop_signal = sig; }
+
+/* SIGINT, SIGTERM raise stop_signal; the work stops cleanly (a second one
+ * kills at once). */
+static void catch_stop_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sa.sa_flags = SA_RESETHAND;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+/* The exit code and one-line note of work stopped by a signal. */
+static int stopped(const cf_error *err)
+{
+    fprintf(stderr, "cohfrac: %s: %s\n", stop_signal == SIGTERM ? "SIGTERM" : "SIGINT",
+            err->msg);
+    return 128 + (stop_signal ? stop_signal : SIGINT);
+}
+
 static int cmd_mesh(int argc, char **argv)
 {
     static const struct option lo[] = {{"output", required_argument, 0, 'o'},
                                        {"target-tets", required_argument, 0, 't'},
+                                       {"time-limit", required_argument, 0, 'L'},
                                        {"quiet", no_argument, 0, 'q'},
                                        {0, 0, 0, 0}};
     cf_mesh_prep_opts o = {0};
@@ -193,6 +222,12 @@ static int cmd_mesh(int argc, char **argv)
             if ((o.target_tets = count_arg("--target-tets", optarg, 4)) < 0)
                 return cf_status_exit_code(CF_ERR_USAGE);
             break;
+        case 'L':
+            if (real_arg("--time-limit", optarg, 0, &o.time_limit))
+                return cf_status_exit_code(CF_ERR_USAGE);
+            if (!(o.time_limit > 0))
+                return usage_error("--time-limit needs a number of seconds > 0");
+            break;
         case 'q': o.verbose = 0; break;
         default: return usage_error("bad option for 'mesh'");
         }
@@ -200,10 +235,13 @@ static int cmd_mesh(int argc, char **argv)
     if (optind != argc - 1 || !o.output)
         return usage_error("'mesh' needs one surface file and -o OUT");
     o.input = argv[optind];
+    o.stop = &stop_signal;
+    catch_stop_signals(); /* tetgen stopped, temporary files removed */
     cf_error err = {0};
-    if (cf_mesh_prepare(&o, &err) != CF_OK)
-        return fail(&err);
-    return 0;
+    cf_status st = cf_mesh_prepare(&o, &err);
+    if (st == CF_ERR_INTERRUPTED)
+        return stopped(&err);
+    return st == CF_OK ? 0 : fail(&err);
 }
 
 static char *command_line(const char *prefix, int argc, char **argv);
@@ -297,11 +335,6 @@ static int parse_scene_args(int argc, char **argv, const char *cmd, scene_args *
     return 0;
 }
 
-/* The signal that asked a run to stop (0: none). */
-static volatile sig_atomic_t stop_signal = 0;
-
-static void on_stop_signal(int sig) { stop_signal = sig; }
-
 static int cmd_run(int argc, char **argv)
 {
     scene_args a;
@@ -328,14 +361,7 @@ static int cmd_run(int argc, char **argv)
     cf_sim *sim = NULL;
     cf_run_options opt = {.progress = a.progress, .threads = a.threads, .mesh_dir = a.mesh_dir,
                           .force = a.force, .stop = &stop_signal};
-    /* SIGINT, SIGTERM: finish the step, close the file (a second one kills). */
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_stop_signal;
-    sa.sa_flags = SA_RESETHAND;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    catch_stop_signals(); /* finish the step, close the file */
     if (cf_scene_load(a.scene, a.sets, a.n_sets, a.mesh_dir, &scene, &err) != CF_OK) {
         rc = fail(&err);
     } else {
@@ -345,9 +371,7 @@ static int cmd_run(int argc, char **argv)
         if (sim)
             cf_sim_print_summary(sim, stdout);
         if (st == CF_ERR_INTERRUPTED) {
-            fprintf(stderr, "cohfrac: %s: %s\n", stop_signal == SIGTERM ? "SIGTERM" : "SIGINT",
-                    err.msg);
-            rc = 128 + (stop_signal ? stop_signal : SIGINT);
+            rc = stopped(&err);
         } else if (st != CF_OK) {
             rc = fail(&err);
         }

@@ -283,21 +283,25 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
             memcpy(w.obstacles, def->obstacles, no * sizeof *w.obstacles);
         if (opt->threads > 0)
             w.solver.threads = opt->threads;
-        st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
     }
-    if (st == CF_OK)
-        st = cf_world_create(&w, &sim->world, err);
-    free(w.bodies), free(w.obstacles);
+    /* The file first, with the scene in it: a run stopped during mesh
+     * preparation or convex decomposition (minutes on a large mesh) still
+     * leaves a readable file that says what was run. */
     if (st == CF_OK && def->output.file[0] && !opt->force &&
         access(def->output.file, F_OK) == 0 && !cf_h5_is_output(def->output.file))
         st = cf_error_set(err, CF_ERR_OUTPUT,
                           "refusing to overwrite %s: it is not a cohfrac output file (give "
                           "another output file, or --force to overwrite it)",
                           def->output.file);
-    if (st == CF_OK && def->output.file[0]) {
+    if (st == CF_OK && def->output.file[0])
         st = cf_h5_open(def->output.file, def->name, def->resolved, &sim->h5, err);
-        if (st == CF_OK)
-            st = write_initial_bounds(sim, err);
+    if (st == CF_OK)
+        st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
+    if (st == CF_OK)
+        st = cf_world_create(&w, &sim->world, err);
+    free(w.bodies), free(w.obstacles);
+    if (st == CF_OK && sim->h5) {
+        st = write_initial_bounds(sim, err);
         double t0 = cf_wall_time();
         if (st == CF_OK)
             st = write_rest_mesh(sim, err);
