@@ -94,8 +94,9 @@ int cf_surface_decimate(cf_surface *s, int target_tris);
 
 void cf_surface_free(cf_surface *s);
 
-/* Seconds one tetgen run may take before it is stopped (CF_ERR_EXTERNAL). */
-#define CF_TETGEN_TIME_LIMIT 300.0
+/* Seconds `cohfrac mesh` may take (all its tetgen runs) before the tetgen
+ * run going on is stopped (CF_ERR_EXTERNAL). */
+#define CF_MESH_TIME_LIMIT 300.0
 
 /* Options for `cohfrac mesh`. */
 typedef struct cf_mesh_prep_opts {
@@ -103,7 +104,7 @@ typedef struct cf_mesh_prep_opts {
     const char *output;   /* output base: writes <output>.node/.ele */
     int target_tets;      /* approximate number of tets wanted (0: tetgen -pq default) */
     int verbose;          /* print what is done to stderr */
-    double time_limit;    /* s per tetgen run; 0: CF_TETGEN_TIME_LIMIT */
+    double time_limit;    /* s for the whole preparation; 0: CF_MESH_TIME_LIMIT */
     const volatile sig_atomic_t *stop; /* NULL, or a flag a signal handler raises: tetgen
                                           is stopped, the temporary files removed, and
                                           CF_ERR_INTERRUPTED returned */
@@ -125,7 +126,8 @@ typedef struct cf_mesh_prep_opts {
  * surface triangle) and a maximum tet volume -a fills up to N.  N = 0 runs
  * plain tetgen -pq on the full surface.  The stamp lists the options used.
  * Bounded: with a target, tetgen may add at most N points (-S N: about 4 N
- * tets), and every tetgen run is stopped after opts->time_limit.
+ * tets), and the tetgen run going on when opts->time_limit runs out is
+ * stopped.
  * The program is `tetgen` from PATH, or $COHFRAC_TETGEN; temporary files go
  * to $TMPDIR (default /tmp) and are removed.
  * Errors: as cf_surface_load, CF_ERR_USAGE (missing paths, N < 0),

@@ -67,7 +67,7 @@ static const struct {
      "      -o, --output OUT                the TetGen base to write (OUT.node, OUT.ele)\n"
      "          --target-tets N             about this many tets (default: tetgen's own);\n"
      "                                      tetgen then adds at most N points (-S N)\n"
-     "          --time-limit S              stop a tetgen run after S seconds (default 300)\n"
+     "          --time-limit S              give up after S seconds (default 300)\n"
      "      -q, --quiet                     no progress lines\n"},
     {"study",
      "  cohfrac study SCENE.lua --vary KEY.PATH=V1,V2,... [options]\n"

@@ -147,18 +147,24 @@ static int cache_valid(const cf_mesh_prep_opts *o, const char *key)
 /* ---- running tetgen ---------------------------------------------------- */
 
 
+/* One preparation: its options, temporary directory and deadline. */
+typedef struct prep {
+    const cf_mesh_prep_opts *o;
+    const char *dir;
+    double limit, deadline; /* s: the time limit, and when it runs out (wall clock) */
+} prep;
+
 /* Wait for tetgen, polling: stop it when the caller's stop flag is raised
- * (a signal) or after `limit` seconds.  Returns 0 with *status set, or
- * the reason it was stopped: 1 the stop flag, 2 the time limit. */
-static int wait_tetgen(pid_t pid, const cf_mesh_prep_opts *o, double limit, int *status)
+ * (a signal) or at the deadline.  Returns 0 with *status set, or the reason
+ * it was stopped: 1 the stop flag, 2 the deadline. */
+static int wait_tetgen(pid_t pid, const prep *p, int *status)
 {
     const struct timespec nap = {0, 20000000}; /* 20 ms */
-    double t0 = cf_wall_time();
     for (;;) {
         pid_t got = waitpid(pid, status, WNOHANG);
         if (got == pid || (got < 0 && errno != EINTR))
             return 0;
-        int why = o->stop && *o->stop ? 1 : cf_wall_time() - t0 > limit ? 2 : 0;
+        int why = p->o->stop && *p->o->stop ? 1 : cf_wall_time() > p->deadline ? 2 : 0;
         if (why) {
             kill(pid, SIGKILL);
             while (waitpid(pid, status, 0) < 0 && errno == EINTR)
@@ -170,9 +176,10 @@ static int wait_tetgen(pid_t pid, const cf_mesh_prep_opts *o, double limit, int 
 }
 
 /* Run `tetgen -<opts> <dir>/surf.off`, output to <dir>/surf.1.*; load it. */
-static cf_status run_tetgen(const char *dir, const char *opts, const cf_mesh_prep_opts *o,
-                            cf_mesh *m, double *secs, cf_error *err)
+static cf_status run_tetgen(const prep *p, const char *opts, cf_mesh *m, double *secs,
+                            cf_error *err)
 {
+    const char *dir = p->dir;
     char in[PATH_MAX], logp[PATH_MAX], base[PATH_MAX], flag[128];
     snprintf(in, sizeof in, "%s/surf.off", dir);
     snprintf(logp, sizeof logp, "%s/tetgen.log", dir);
@@ -191,18 +198,18 @@ static cf_status run_tetgen(const char *dir, const char *opts, const cf_mesh_pre
                             "or point COHFRAC_TETGEN at the program",
                             prog, strerror(rc));
     int status = 0;
-    double limit = o->time_limit > 0 ? o->time_limit : CF_TETGEN_TIME_LIMIT;
-    int stopped = wait_tetgen(pid, o, limit, &status);
+    int stopped = wait_tetgen(pid, p, &status);
     *secs = cf_wall_time() - t0;
     if (stopped == 1)
         return cf_error_set(err, CF_ERR_INTERRUPTED, "tetgen %s stopped by a signal after %.1f s",
                             flag, *secs);
     if (stopped == 2)
         return cf_error_set(err, CF_ERR_EXTERNAL,
-                            "tetgen %s did not finish within %g s: the surface is probably "
-                            "much finer than --target-tets allows or has slivers tetgen keeps "
-                            "refining; ask for fewer tets, or simplify the surface first",
-                            flag, limit);
+                            "cohfrac mesh did not finish within %g s (tetgen %s stopped): the "
+                            "surface is probably much finer than --target-tets allows or has "
+                            "slivers tetgen keeps refining; ask for fewer tets, simplify the "
+                            "surface first, or allow more time (--time-limit)",
+                            p->limit, flag);
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         char tail[600];
         cf_file_log_tail(logp, tail, sizeof tail);
@@ -395,16 +402,16 @@ typedef struct trial {
  * surface it keeps refining cannot run to millions of tets. */
 #define STEINER_PER_TARGET_TET 1.0
 
-static cf_status tetgen_trial(const char *dir, const char *opts, trial *t,
-                              const cf_mesh_prep_opts *o, cf_error *err)
+static cf_status tetgen_trial(const prep *p, const char *opts, trial *t, cf_error *err)
 {
+    const cf_mesh_prep_opts *o = p->o;
     if (o->target_tets > 0)
         snprintf(t->opts, sizeof t->opts, "%sS%.0f", opts,
                  ceil(STEINER_PER_TARGET_TET * o->target_tets));
     else
         snprintf(t->opts, sizeof t->opts, "%s", opts);
     double secs = 0;
-    cf_status st = run_tetgen(dir, t->opts, o, &t->m, &secs, err);
+    cf_status st = run_tetgen(p, t->opts, &t->m, &secs, err);
     if (st == CF_OK && o->verbose)
         fprintf(stderr, "  tetgen -%s: %d nodes, %d tets (%.2f s)\n", t->opts, t->m.n_nodes,
                 t->m.n_tets, secs);
@@ -416,10 +423,11 @@ static double miss(int n, int target) { return fabs(log((double)n / (double)targ
 /* Surface choice and tetgen runs for target_tets > 0; see the top comment.
  * `s` is the clean full surface; on success `best` holds the mesh and
  * `used` the surface it was made from (a decimated copy or `s` itself). */
-static cf_status fit_size(const cf_surface *s, const char *dir, const cf_mesh_prep_opts *o,
-                          trial *best, cf_surface *dec, const cf_surface **used, cf_error *err)
+static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_surface *dec,
+                          const cf_surface **used, cf_error *err)
 {
-    int target = o->target_tets, verbose = o->verbose;
+    const char *dir = p->dir;
+    int target = p->o->target_tets, verbose = p->o->verbose;
     char off[PATH_MAX];
     snprintf(off, sizeof off, "%s/surf.off", dir);
     const cf_surface *cur = s;
@@ -443,7 +451,7 @@ static cf_status fit_size(const cf_surface *s, const char *dir, const cf_mesh_pr
             cur = s;
         }
         if ((st = cf_surface_write_off(cur, off, err)) != CF_OK ||
-            (st = tetgen_trial(dir, BASE_OPTS "F", &t, o, err)) != CF_OK)
+            (st = tetgen_trial(p, BASE_OPTS "F", &t, err)) != CF_OK)
             return st;
         n = t.m.n_tets;
         if (n <= (1 + TOL) * target || cur->n_tris <= 8)
@@ -467,7 +475,7 @@ static cf_status fit_size(const cf_surface *s, const char *dir, const cf_mesh_pr
         snprintf(opts, sizeof opts, "%sa%.3gF", base_opts, a);
         a = strtod(strchr(opts, 'a') + 1, NULL); /* exactly the value tetgen gets */
         trial u = {{0}, {0}};
-        if ((st = tetgen_trial(dir, opts, &u, o, err)) != CF_OK) {
+        if ((st = tetgen_trial(p, opts, &u, err)) != CF_OK) {
             cf_mesh_free(&best->m);
             return st;
         }
@@ -568,14 +576,15 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
         dir[0] = '\0';
         goto out;
     }
+    double limit = o->time_limit > 0 ? o->time_limit : CF_MESH_TIME_LIMIT;
+    prep pr = {o, dir, limit, t_start + limit};
     if (o->target_tets == 0) {
         char off[PATH_MAX];
         snprintf(off, sizeof off, "%s/surf.off", dir);
         if ((st = cf_surface_write_off(&s, off, err)) != CF_OK ||
-            (st = tetgen_trial(dir, "pqF", &best, o, err)) != CF_OK)
+            (st = tetgen_trial(&pr, "pqF", &best, err)) != CF_OK)
             goto out;
-    } else if ((st = fit_size(&s, dir, o, &best, &dec, &used, err)) !=
-               CF_OK) {
+    } else if ((st = fit_size(&s, &pr, &best, &dec, &used, err)) != CF_OK) {
         goto out;
     }
 
