@@ -15,7 +15,7 @@
 -- Expected: the bunny rebounds at the impact (fracture mode is PBD with
 -- k = 0.9 and 3 iterations, an almost rigid elastic body: the compression
 -- wave comes back) and loses small pieces where it meets the ground:
--- bunny_small ~110 pieces of 1-2 tets, the body keeping 99.7% of its mass,
+-- bunny_small ~260 pieces of one to a few tets, the body keeping 99.5% of its mass,
 -- the fastest piece ~3-4 m/s (the fall gives 4.4 m/s).  It chips; it does
 -- not break into large pieces (the source's Fig 6.3 shows several): with
 -- the source's parameters, Weibull strength scatter, the traction rule,
