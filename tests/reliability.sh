@@ -74,6 +74,15 @@ expect 5 "cohfrac mesh: tetgen past --time-limit is stopped" env TMPDIR="$tmp/mt
 cp "$tmp/log" "$tmp/tl.log"
 expect 0 "... with advice, and no temporary files left" sh -c "grep -q 'ask for fewer tets' '$tmp/tl.log' &&
     [ -z \"\$(ls -A '$tmp/mtmp')\" ]"
+# A 1 m x 1 m x 2 mm plate cannot be meshed to 20 tets at tetgen's quality
+# bound: exit 1 naming the count reached, nothing written; 1,000 tets it
+# reaches by subdividing its 12 triangles.
+printf 'OFF\n8 6 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 0.002\n1 0 0.002\n0 1 0.002\n1 1 0.002\n4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n' >"$tmp/plate.off"
+expect 1 "cohfrac mesh: a target out of reach is an error naming what is reachable" \
+    sh -c "'$exe' mesh '$tmp/plate.off' -o '$tmp/plate20' --target-tets 20 2>&1 | tee /dev/stderr | grep -q 'cannot be met within 25%.*Ask for about' && [ ! -e '$tmp/plate20.ele' ] && exit 1"
+expect 0 "cohfrac mesh: a surface too coarse for the target is subdivided" \
+    "$exe" mesh "$tmp/plate.off" -o "$tmp/plate1k" --target-tets 1000
+expect 0 "... to within 25% of 1,000 tets" sh -c "n=\$(sed -n 's/^tets //p' '$tmp/plate1k.stamp'); [ \$n -ge 750 ] && [ \$n -le 1250 ]"
 env TMPDIR="$tmp/mtmp" "$exe" mesh "$bunny" -o "$tmp/st" --target-tets 800000 -q 2>"$tmp/mesh.err" &
 pid=$!
 i=0

@@ -592,6 +592,35 @@ static void test_decimate(void **state)
     cf_surface_free(&t);
 }
 
+/* Midpoint subdivision: the unit cube's 12 triangles become 48 over
+ * 8 + 18 vertices (one per edge), the same closed surface: volume and
+ * every vertex on the cube's faces exactly. */
+static void test_subdivide(void **state)
+{
+    (void)state;
+    cf_surface s;
+    double one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
+    cube_surface(&s, one, zero);
+    double v0 = cf_surface_volume(&s);
+    assert_int_equal(cf_surface_subdivide(&s), 0);
+    assert_int_equal(s.n_tris, 48);
+    assert_int_equal(s.n_verts, 26);
+    assert_true(cf_surface_volume(&s) == v0);
+    char why[256];
+    assert_int_equal(cf_surface_check_closed(&s, why, sizeof why), 1);
+    assert_int_equal(cf_surface_self_intersections(&s, NULL, 0), 0);
+    for (int i = 0; i < s.n_verts; i++) {
+        int on_face = 0;
+        for (int k = 0; k < 3; k++)
+            on_face |= s.v[3 * i + k] == 0 || s.v[3 * i + k] == 1;
+        assert_true(on_face);
+    }
+    assert_int_equal(cf_surface_subdivide(&s), 0); /* and again */
+    assert_int_equal(s.n_tris, 192);
+    assert_true(fabs(cf_surface_volume(&s) - v0) < 1e-15);
+    cf_surface_free(&s);
+}
+
 /* The real input (docs/scenes.md): the bunny of glmark2-data has exactly the
  * two intersecting pairs tetgen -d reports (its facets 22950/69662 and
  * 69660/69662, 1-based), both made by one valence-3 vertex. */
@@ -780,6 +809,7 @@ int main(void)
         cmocka_unit_test(test_intersections_grid_vs_brute_force),
         cmocka_unit_test(test_repair_valence3),
         cmocka_unit_test(test_decimate),
+        cmocka_unit_test(test_subdivide),
         cmocka_unit_test(test_real_bunny_defect),
         cmocka_unit_test(test_prepare_cube),
         cmocka_unit_test(test_prepare_repairs_and_rejects),

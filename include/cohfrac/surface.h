@@ -92,6 +92,13 @@ int cf_surface_check_closed(const cf_surface *s, char *why, size_t why_len);
  * memory.  It does not test for self-intersections: check afterwards. */
 int cf_surface_decimate(cf_surface *s, int target_tris);
 
+/* Split every triangle in four at its edge midpoints (one new vertex per
+ * edge, shared by the triangles on both sides): the same surface, four
+ * times the triangles, orientation kept.  For a surface too coarse for the
+ * tet count asked.  0, or -1 when out of memory or past INT_MAX (then `s`
+ * is unchanged apart from spare vertex capacity). */
+int cf_surface_subdivide(cf_surface *s);
+
 void cf_surface_free(cf_surface *s);
 
 /* Seconds `cohfrac mesh` may take (all its tetgen runs) before the tetgen
@@ -130,7 +137,11 @@ typedef struct cf_mesh_prep_opts {
  * stopped.
  * The program is `tetgen` from PATH, or $COHFRAC_TETGEN; temporary files go
  * to $TMPDIR (default /tmp) and are removed.
- * Errors: as cf_surface_load, CF_ERR_USAGE (missing paths, N < 0),
+ * A surface too coarse for N is subdivided (cf_surface_subdivide) before
+ * the fill.  When the closest mesh is more than 25 % from N, nothing is
+ * written: CF_ERR_USAGE names the count reached and what to ask for.
+ * Errors: as cf_surface_load, CF_ERR_USAGE (missing paths, N < 0, N not
+ * reachable within 25 %),
  * CF_ERR_MESH_PARSE (surface not closed or encloses no volume: names the
  * edge/vertex), CF_ERR_SURFACE_INTERSECT (intersections left after repair,
  * or made by decimation: lists face pairs), CF_ERR_EXTERNAL (tetgen missing

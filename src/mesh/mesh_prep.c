@@ -53,6 +53,8 @@
 #define BASE_OPTS "pYq2.0"
 #define TOL 0.05
 #define MAX_A_RUNS 8
+#define MAX_SUBDIVISIONS 3 /* 64 x the triangles at most */
+#define MISS_ALLOWED 0.25  /* the target met within 25 %, or an error */
 
 static char *str_cat(const char *a, const char *b)
 {
@@ -463,6 +465,44 @@ static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_su
     }
     *used = cur;
     *best = t;
+    /* Too coarse for the target even with -Y: split every triangle in four
+     * (the same surface, so the same enclosed volume) while the tets stay
+     * short of it and do not overshoot. */
+    for (int k = 0; k < MAX_SUBDIVISIONS && n < (1 - TOL) * target; k++) {
+        cf_surface fine = {0};
+        trial f = {{0}, {0}};
+        if ((st = copy_surface(cur, &fine, err)) != CF_OK)
+            return st;
+        if (cf_surface_subdivide(&fine) != 0) {
+            cf_surface_free(&fine);
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory subdividing the surface");
+        }
+        if ((st = cf_surface_write_off(&fine, off, err)) != CF_OK ||
+            (st = tetgen_trial(p, BASE_OPTS "F", &f, err)) != CF_OK) {
+            cf_surface_free(&fine);
+            return st;
+        }
+        if (verbose)
+            fprintf(stderr, "  subdivided the surface to %d triangles\n", fine.n_tris);
+        int over = f.m.n_tets > (1 + TOL) * target;
+        if (over && miss(f.m.n_tets, target) >= miss(n, target)) {
+            /* overshoots by more than the coarse one falls short: fill that */
+            cf_mesh_free(&f.m);
+            cf_surface_free(&fine);
+            if ((st = cf_surface_write_off(cur, off, err)) != CF_OK)
+                return st;
+            break;
+        }
+        cf_mesh_free(&best->m);
+        *best = f;
+        n = f.m.n_tets;
+        cf_surface_free(dec);
+        *dec = fine;
+        cur = dec;
+        *used = cur;
+        if (over)
+            return CF_OK; /* the closest there is: filling only adds tets */
+    }
     if (n >= (1 - TOL) * target)
         return CF_OK;
     /* Fill with a maximum volume: N(a) ~ N0 + C / a. */
@@ -585,6 +625,21 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
             (st = tetgen_trial(&pr, "pqF", &best, err)) != CF_OK)
             goto out;
     } else if ((st = fit_size(&s, &pr, &best, &dec, &used, err)) != CF_OK) {
+        goto out;
+    }
+    double off_by = o->target_tets > 0 ? (double)best.m.n_tets / o->target_tets - 1 : 0;
+    if (fabs(off_by) > MISS_ALLOWED) {
+        st = cf_error_set(err, CF_ERR_USAGE,
+                          "--target-tets %d cannot be met within %.0f%% for %s: the closest "
+                          "tetgen came is %d tets (%+.0f%%; %s).  Ask for about %d tets, or 0 "
+                          "for tetgen's own choice",
+                          o->target_tets, 100 * MISS_ALLOWED, o->input, best.m.n_tets,
+                          100 * off_by,
+                          off_by > 0 ? "thin parts need smaller tets than that at tetgen's "
+                                       "quality bound"
+                                     : "refining further needs more points than --target-tets "
+                                       "allows tetgen to add",
+                          best.m.n_tets);
         goto out;
     }
 

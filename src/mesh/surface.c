@@ -245,6 +245,52 @@ int cf_surface_remove_unused(cf_surface *s)
     return removed;
 }
 
+static int edge_cmp(const void *pa, const void *pb)
+{
+    const int *a = pa, *b = pb; /* lo, hi, slot */
+    return a[0] != b[0] ? (a[0] > b[0]) - (a[0] < b[0]) : (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+int cf_surface_subdivide(cf_surface *s)
+{
+    size_t nt = (size_t)s->n_tris, ne = 3 * nt;
+    if ((size_t)s->n_verts + ne > INT_MAX / 3 || 4 * nt > INT_MAX / 3)
+        return -1;
+    int *e = malloc(ne * 3 * sizeof *e), *mid = malloc(ne * sizeof *mid);
+    int *tri = malloc(4 * nt * 3 * sizeof *tri);
+    double *v = realloc(s->v, ((size_t)s->n_verts + ne) * 3 * sizeof *v);
+    if (v)
+        s->v = v;
+    if (!e || !mid || !tri || !v) {
+        free(e), free(mid), free(tri);
+        return -1;
+    }
+    for (size_t k = 0; k < ne; k++) { /* edge k: corner k%3 to the next */
+        int a = s->tri[k], b = s->tri[3 * (k / 3) + (k % 3 + 1) % 3];
+        e[3 * k] = a < b ? a : b, e[3 * k + 1] = a < b ? b : a, e[3 * k + 2] = (int)k;
+    }
+    qsort(e, ne, 3 * sizeof *e, edge_cmp);
+    int nv = s->n_verts;
+    for (size_t k = 0; k < ne; k++) { /* one midpoint per distinct edge */
+        if (k == 0 || edge_cmp(&e[3 * k], &e[3 * (k - 1)]) != 0) {
+            for (int d = 0; d < 3; d++)
+                s->v[3 * (size_t)nv + d] = 0.5 * (s->v[3 * e[3 * k] + d] + s->v[3 * e[3 * k + 1] + d]);
+            nv++;
+        }
+        mid[e[3 * k + 2]] = nv - 1;
+    }
+    for (size_t t = 0; t < nt; t++) {
+        const int *c = &s->tri[3 * t], *m = &mid[3 * t]; /* m[i]: edge c[i] c[i+1] */
+        int q[4][3] = {{c[0], m[0], m[2]}, {m[0], c[1], m[1]}, {m[2], m[1], c[2]},
+                       {m[0], m[1], m[2]}};
+        memcpy(&tri[12 * t], q, sizeof q);
+    }
+    free(s->tri);
+    s->tri = tri, s->n_tris = (int)(4 * nt), s->n_verts = nv;
+    free(e), free(mid);
+    return 0;
+}
+
 /* A directed edge from -> to of triangle `tri`. */
 typedef struct hedge {
     int from, to, tri;
