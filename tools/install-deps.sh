@@ -7,7 +7,7 @@ PKGS="gcc g++ make cmake pkg-config libbullet-dev libbullet-extras-dev libccd-de
       python3-numpy python3-matplotlib ffmpeg libtinygltf-dev nlohmann-json3-dev
       blender python3-meshio paraview python3-paraview xvfb
       clang libomp-dev libassimp-dev libmeshoptimizer-dev
-      libopenmpi-dev openmpi-bin"
+      libopenmpi-dev openmpi-bin metis"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||
