@@ -467,11 +467,15 @@ extern "C" {
  * the count right for blocks allocated before the hook was set. */
 static long long bullet_bytes;
 
+// Bullet does not check its allocations (btPoolAllocator memsets what it
+// got): a failed one throws instead, and the entry points that allocate
+// turn that into an error (cfb_last_error: "out of memory").
 static void *counted_alloc(size_t n)
 {
     void *p = malloc(n);
-    if (p)
-        __atomic_add_fetch(&bullet_bytes, (long long)malloc_usable_size(p), __ATOMIC_RELAXED);
+    if (!p)
+        throw std::bad_alloc();
+    __atomic_add_fetch(&bullet_bytes, (long long)malloc_usable_size(p), __ATOMIC_RELAXED);
     return p;
 }
 
@@ -503,11 +507,16 @@ cfb_world *cfb_world_create(const double gravity[3])
         set_error("out of memory");
         return NULL;
     }
-    w->config = new btDefaultCollisionConfiguration();
-    w->dispatcher = new FamilyDispatcher(w->config);
-    w->broadphase = new btDbvtBroadphase();
-    w->solver = new btSequentialImpulseConstraintSolver();
-    w->dyn = new StepWorld(w->dispatcher, w->broadphase, w->solver, w->config);
+    try {
+        w->config = new btDefaultCollisionConfiguration();
+        w->dispatcher = new FamilyDispatcher(w->config);
+        w->broadphase = new btDbvtBroadphase();
+        w->solver = new btSequentialImpulseConstraintSolver();
+        w->dyn = new StepWorld(w->dispatcher, w->broadphase, w->solver, w->config);
+    } catch (const std::bad_alloc &) {
+        set_error("out of memory building the Bullet world (its pools need a few MB)");
+        return NULL; // what was built is lost: the run ends here
+    }
     w->dyn->setGravity(btVector3(gravity[0], gravity[1], gravity[2]));
     // Motion states show the state at the end of the last sub-step, not one
     // sub-step behind.
@@ -545,7 +554,7 @@ void cfb_world_destroy(cfb_world *w)
     delete w;
 }
 
-int cfb_add_plane(cfb_world *w, const double point[3], const double normal[3], double friction,
+static int add_plane_unguarded(cfb_world *w, const double point[3], const double normal[3], double friction,
                   double restitution)
 {
     if (!obstacle_args_valid(w, point, NULL, friction, restitution)) return -1;
@@ -562,7 +571,7 @@ int cfb_add_plane(cfb_world *w, const double point[3], const double normal[3], d
                     btVector3(0, 0, 0), friction, restitution);
 }
 
-int cfb_add_sphere(cfb_world *w, const double center[3], double radius,
+static int add_sphere_unguarded(cfb_world *w, const double center[3], double radius,
                    const double velocity[3], double friction, double restitution)
 {
     if (!obstacle_args_valid(w, center, velocity, friction, restitution)) return -1;
@@ -573,7 +582,7 @@ int cfb_add_sphere(cfb_world *w, const double center[3], double radius,
     return add_obstacle(w, new btSphereShape(radius), center, velocity, friction, restitution);
 }
 
-int cfb_add_box(cfb_world *w, const double center[3], const double half_extents[3],
+static int add_box_unguarded(cfb_world *w, const double center[3], const double half_extents[3],
                 const double velocity[3], double friction, double restitution)
 {
     if (!obstacle_args_valid(w, center, velocity, friction, restitution)) return -1;
@@ -590,7 +599,7 @@ int cfb_add_box(cfb_world *w, const double center[3], const double half_extents[
     return add_obstacle(w, box, center, velocity, friction, restitution);
 }
 
-int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
+static int add_hull_body_unguarded(cfb_world *w, double mass, const double inertia[3], const double *pts,
                       int n, double margin, const cfb_state *s, double friction,
                       double restitution)
 {
@@ -602,7 +611,7 @@ int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const 
     return cfb_add_compound_body(w, mass, inertia, pts, start, 1, margin, s, friction, restitution);
 }
 
-int cfb_convex_hull(const double *pts, int n, double *out, double *volume)
+static int convex_hull_unguarded(const double *pts, int n, double *out, double *volume)
 {
     if (!pts || n < 1) {
         set_error("convex hull needs at least 1 point (got %d)", pts ? n : 0);
@@ -654,7 +663,7 @@ int cfb_convex_hull(const double *pts, int n, double *out, double *volume)
     return nv;
 }
 
-int cfb_add_compound_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
+static int add_compound_body_unguarded(cfb_world *w, double mass, const double inertia[3], const double *pts,
                           const int *start, int n_hulls, double margin, const cfb_state *s,
                           double friction, double restitution)
 {
@@ -718,7 +727,7 @@ int cfb_add_compound_body(cfb_world *w, double mass, const double inertia[3], co
     return id;
 }
 
-int cfb_add_trimesh(cfb_world *w, const double *verts, int nv, const int *tris, int nt,
+static int add_trimesh_unguarded(cfb_world *w, const double *verts, int nv, const int *tris, int nt,
                     double friction, double restitution)
 {
     if (!w) {
@@ -783,7 +792,7 @@ int cfb_add_trimesh(cfb_world *w, const double *verts, int nv, const int *tris, 
     return id;
 }
 
-int cfb_set_ccd(cfb_world *w, int id, double motion_threshold, double swept_radius)
+static int set_ccd_unguarded(cfb_world *w, int id, double motion_threshold, double swept_radius)
 {
     Body *b = lookup(w, id);
     if (!b) return -1;
@@ -1035,7 +1044,7 @@ void cfb_ignore_pair(cfb_world *w, int a, int b)
     drop_contacts(w, ba, bb);
 }
 
-int cfb_set_family(cfb_world *w, int id, int family)
+static int set_family_unguarded(cfb_world *w, int id, int family)
 {
     Body *b = lookup(w, id);
     if (!b) return -1;
@@ -1052,7 +1061,7 @@ int cfb_set_family(cfb_world *w, int id, int family)
     return 0;
 }
 
-int cfb_step(cfb_world *w, double dt, int substeps)
+static int step_unguarded(cfb_world *w, double dt, int substeps)
 {
     if (!w) {
         set_error("world is NULL");
@@ -1101,3 +1110,74 @@ int cfb_body_count(const cfb_world *w)
 const char *cfb_last_error(void) { return g_error; }
 
 }  // extern "C"
+
+// The entry points that make Bullet allocate: out of memory (counted_alloc
+// throws) is an error return (-1, cfb_last_error), not a crash.  A call cut
+// short leaves the world unusable; the caller ends the run.
+template <typename F> static int guarded(F f)
+{
+    try {
+        return f();
+    } catch (const std::bad_alloc &) {
+        set_error("out of memory inside Bullet");
+        return -1;
+    }
+}
+
+int cfb_add_plane(cfb_world *w, const double point[3], const double normal[3], double friction,
+                  double restitution)
+{
+    return guarded([&] { return add_plane_unguarded(w, point, normal, friction, restitution); });
+}
+
+int cfb_add_sphere(cfb_world *w, const double center[3], double radius,
+                   const double velocity[3], double friction, double restitution)
+{
+    return guarded([&] { return add_sphere_unguarded(w, center, radius, velocity, friction, restitution); });
+}
+
+int cfb_add_box(cfb_world *w, const double center[3], const double half_extents[3],
+                const double velocity[3], double friction, double restitution)
+{
+    return guarded([&] { return add_box_unguarded(w, center, half_extents, velocity, friction, restitution); });
+}
+
+int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
+                      int n, double margin, const cfb_state *s, double friction,
+                      double restitution)
+{
+    return guarded([&] { return add_hull_body_unguarded(w, mass, inertia, pts, n, margin, s, friction, restitution); });
+}
+
+int cfb_convex_hull(const double *pts, int n, double *out, double *volume)
+{
+    return guarded([&] { return convex_hull_unguarded(pts, n, out, volume); });
+}
+
+int cfb_add_compound_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
+                          const int *start, int n_hulls, double margin, const cfb_state *s,
+                          double friction, double restitution)
+{
+    return guarded([&] { return add_compound_body_unguarded(w, mass, inertia, pts, start, n_hulls, margin, s, friction, restitution); });
+}
+
+int cfb_add_trimesh(cfb_world *w, const double *verts, int nv, const int *tris, int nt,
+                    double friction, double restitution)
+{
+    return guarded([&] { return add_trimesh_unguarded(w, verts, nv, tris, nt, friction, restitution); });
+}
+
+int cfb_step(cfb_world *w, double dt, int substeps)
+{
+    return guarded([&] { return step_unguarded(w, dt, substeps); });
+}
+
+int cfb_set_family(cfb_world *w, int id, int family)
+{
+    return guarded([&] { return set_family_unguarded(w, id, family); });
+}
+
+int cfb_set_ccd(cfb_world *w, int id, double motion_threshold, double swept_radius)
+{
+    return guarded([&] { return set_ccd_unguarded(w, id, motion_threshold, swept_radius); });
+}

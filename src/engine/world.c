@@ -12,6 +12,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -442,6 +443,23 @@ static cf_status copy_def(cf_world *sim, const cf_world_def *def, cf_error *err)
                 : CF_OK;
 }
 
+static void *probe_thread(void *arg) { return arg; }
+
+/* How many of `n` threads can run at once (the caller's included): libgomp
+ * ends the process with status 1 when it cannot start a thread, so the
+ * threads are tried here first and a shortage becomes an error. */
+static int threads_startable(int n)
+{
+    pthread_t t[256];
+    int started = 0;
+    n = n > 256 ? 256 : n;
+    while (started < n - 1 && pthread_create(&t[started], NULL, probe_thread, NULL) == 0)
+        started++;
+    for (int i = 0; i < started; i++)
+        pthread_join(t[i], NULL);
+    return started + 1;
+}
+
 cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err)
 {
     *out = NULL;
@@ -457,6 +475,13 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
     sim->bullet_base = cfb_allocated_bytes();
     if (scene->solver.threads > 0)
         omp_set_num_threads(scene->solver.threads);
+    int threads = omp_get_max_threads(), startable = threads_startable(threads);
+    if (st == CF_OK && startable < threads)
+        st = cf_error_set(err, CF_ERR_NOMEM,
+                          "cannot start %d threads for the element loops (only %d): the memory "
+                          "or process limits (ulimit -v, ulimit -u) leave no room for their "
+                          "stacks; run with fewer threads (-t %d, solver.threads)",
+                          threads, startable, startable > 0 ? startable : 1);
     sim->law = &cf_law_ppr;
     sim->law->init(sim->law_params, &scene->material);
 
