@@ -140,6 +140,8 @@ static int cluster_hull(const cf_solid *s, cluster *c, int *stamp, int mark, dou
     if (!c->pts)
         return -1;
     int nv = n >= 4 ? cfb_convex_hull(*buf, n, c->pts, &c->hull_volume) : 0;
+    if (nv < 0)
+        return -1; /* the points are valid: Bullet ran out of memory */
     if (nv < 4 || !(c->hull_volume > 0)) { /* flat or empty: no hull */
         nv = 0;
         c->hull_volume = 0;
