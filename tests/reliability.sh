@@ -74,6 +74,11 @@ expect 5 "cohfrac mesh: tetgen past --time-limit is stopped" env TMPDIR="$tmp/mt
 cp "$tmp/log" "$tmp/tl.log"
 expect 0 "... with advice, and no temporary files left" sh -c "grep -q 'ask for fewer tets' '$tmp/tl.log' &&
     [ -z \"\$(ls -A '$tmp/mtmp')\" ]"
+# A tetgen that crashes (here a stand-in that aborts itself) is exit 5 with
+# what usually causes it and what to try, not just "signal 6".
+printf '#!/bin/sh\nkill -ABRT $$\n' >"$tmp/crash_tetgen"
+chmod +x "$tmp/crash_tetgen"
+expect 5 "cohfrac mesh: a tetgen crash comes with advice" sh -c "COHFRAC_TETGEN='$tmp/crash_tetgen' TMPDIR='$tmp/mtmp' '$exe' mesh '$bunny' -o '$tmp/cr' --target-tets 15000 2>&1 | tee /dev/stderr | grep -q 'crashed (signal 6).*try another --target-tets' && exit 5"
 # A 1 m x 1 m x 2 mm plate cannot be meshed to 20 tets at tetgen's quality
 # bound: exit 1 naming the count reached, nothing written; 1,000 tets it
 # reaches by subdividing its 12 triangles.

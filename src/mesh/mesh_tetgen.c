@@ -361,8 +361,9 @@ cf_status cf_mesh_check(const cf_mesh *m, const char *what, cf_error *err)
         /* Scale-free threshold: the tet's own mean edge sets the size. */
         if (!(v > 1e-12 * le * le * le)) {
             return cf_error_set(err, CF_ERR_MESH_INVERTED,
-                                "%s: tet %d (0-based; nodes %d %d %d %d) has volume %.3g m^3 "
-                                "(%s): re-run tetgen or fix the node order",
+                                "%s: tet %d (0-based; nodes %d %d %d %d) has volume %.3g "
+                                "(the file's length unit cubed; %s): re-run tetgen or fix the "
+                                "node order",
                                 what, t, T[0], T[1], T[2], T[3], v,
                                 v < 0 ? "inverted" : "degenerate");
         }
