@@ -103,6 +103,9 @@ struct cfb_world {
     int ticks;  // sub-steps run by the current cfb_step
     // Sleeping thresholds (m/s, rad/s) for dynamic bodies; 0, 0 = never.
     double sleep_linear, sleep_angular;
+    // Bullet ran out of memory in a call that cannot return an error (a
+    // void one): the next cfb_step fails with it.
+    bool out_of_memory;
 };
 
 namespace {
@@ -538,6 +541,7 @@ cfb_world *cfb_world_create(const double gravity[3])
     w->ticks = 0;
     w->sleep_linear = 0.0;
     w->sleep_angular = 0.0;
+    w->out_of_memory = false;
     return w;
 }
 
@@ -554,8 +558,8 @@ void cfb_world_destroy(cfb_world *w)
     delete w;
 }
 
-static int add_plane_unguarded(cfb_world *w, const double point[3], const double normal[3], double friction,
-                  double restitution)
+static int add_plane_unguarded(cfb_world *w, const double point[3], const double normal[3],
+                               double friction, double restitution)
 {
     if (!obstacle_args_valid(w, point, NULL, friction, restitution)) return -1;
     if (!normal || !finite3(normal) || !nonzero3(normal)) {
@@ -572,7 +576,7 @@ static int add_plane_unguarded(cfb_world *w, const double point[3], const double
 }
 
 static int add_sphere_unguarded(cfb_world *w, const double center[3], double radius,
-                   const double velocity[3], double friction, double restitution)
+                                const double velocity[3], double friction, double restitution)
 {
     if (!obstacle_args_valid(w, center, velocity, friction, restitution)) return -1;
     if (!std::isfinite(radius) || !(radius > 0.0)) {
@@ -583,7 +587,7 @@ static int add_sphere_unguarded(cfb_world *w, const double center[3], double rad
 }
 
 static int add_box_unguarded(cfb_world *w, const double center[3], const double half_extents[3],
-                const double velocity[3], double friction, double restitution)
+                             const double velocity[3], double friction, double restitution)
 {
     if (!obstacle_args_valid(w, center, velocity, friction, restitution)) return -1;
     if (!half_extents || !finite3(half_extents) || !(half_extents[0] > 0.0) ||
@@ -599,9 +603,9 @@ static int add_box_unguarded(cfb_world *w, const double center[3], const double 
     return add_obstacle(w, box, center, velocity, friction, restitution);
 }
 
-static int add_hull_body_unguarded(cfb_world *w, double mass, const double inertia[3], const double *pts,
-                      int n, double margin, const cfb_state *s, double friction,
-                      double restitution)
+static int add_hull_body_unguarded(cfb_world *w, double mass, const double inertia[3],
+                                   const double *pts, int n, double margin, const cfb_state *s,
+                                   double friction, double restitution)
 {
     if (!pts || n < 4) {
         set_error("a hull needs at least 4 points (got %d)", pts ? n : 0);
@@ -663,9 +667,10 @@ static int convex_hull_unguarded(const double *pts, int n, double *out, double *
     return nv;
 }
 
-static int add_compound_body_unguarded(cfb_world *w, double mass, const double inertia[3], const double *pts,
-                          const int *start, int n_hulls, double margin, const cfb_state *s,
-                          double friction, double restitution)
+static int add_compound_body_unguarded(cfb_world *w, double mass, const double inertia[3],
+                                       const double *pts, const int *start, int n_hulls,
+                                       double margin, const cfb_state *s, double friction,
+                                       double restitution)
 {
     if (!w) {
         set_error("world is NULL");
@@ -728,7 +733,7 @@ static int add_compound_body_unguarded(cfb_world *w, double mass, const double i
 }
 
 static int add_trimesh_unguarded(cfb_world *w, const double *verts, int nv, const int *tris, int nt,
-                    double friction, double restitution)
+                                 double friction, double restitution)
 {
     if (!w) {
         set_error("world is NULL");
@@ -882,7 +887,7 @@ int cfb_get_aabb(const cfb_world *w, int id, double lo[3], double hi[3])
     return 0;
 }
 
-double cfb_pair_penetration(cfb_world *w, int a, int b)
+static double pair_penetration_unguarded(cfb_world *w, int a, int b)
 {
     Body *ba = lookup(w, a);
     if (!ba) return -1.0;
@@ -900,7 +905,7 @@ double cfb_pair_penetration(cfb_world *w, int a, int b)
     return cb.min_distance < 0.0 ? -cb.min_distance : 0.0;
 }
 
-void cfb_unignore_pair(cfb_world *w, int a, int b)
+static void unignore_pair_unguarded(cfb_world *w, int a, int b)
 {
     Body *ba = lookup(w, a);
     if (!ba) return;
@@ -933,7 +938,7 @@ void cfb_unignore_pair(cfb_world *w, int a, int b)
     if (bb->kind == BODY_DYNAMIC) bb->rb->activate(true);
 }
 
-void cfb_remove_body(cfb_world *w, int id)
+static void remove_body_unguarded(cfb_world *w, int id)
 {
     Body *b = lookup(w, id);
     if (!b) return;
@@ -1025,7 +1030,7 @@ void cfb_set_state(cfb_world *w, int id, const cfb_state *s)
     remember_quat(b, q);
 }
 
-void cfb_ignore_pair(cfb_world *w, int a, int b)
+static void ignore_pair_unguarded(cfb_world *w, int a, int b)
 {
     Body *ba = lookup(w, a);
     if (!ba) return;
@@ -1065,6 +1070,10 @@ static int step_unguarded(cfb_world *w, double dt, int substeps)
 {
     if (!w) {
         set_error("world is NULL");
+        return -1;
+    }
+    if (w->out_of_memory) {
+        set_error("out of memory inside Bullet (in an earlier call)");
         return -1;
     }
     if (!std::isfinite(dt) || !(dt > 0.0) || substeps < 1) {
@@ -1112,72 +1121,109 @@ const char *cfb_last_error(void) { return g_error; }
 }  // extern "C"
 
 // The entry points that make Bullet allocate: out of memory (counted_alloc
-// throws) is an error return (-1, cfb_last_error), not a crash.  A call cut
-// short leaves the world unusable; the caller ends the run.
-template <typename F> static int guarded(F f)
+// throws) is an error return (cfb_last_error: "out of memory inside
+// Bullet"), not a crash, and marks the world so that the next cfb_step
+// fails too (a call cut short leaves the world unusable; the caller ends
+// the run).  The void ones have only that mark.
+template <typename R, typename F> static R marked(cfb_world *w, R fail, F f)
 {
     try {
         return f();
     } catch (const std::bad_alloc &) {
         set_error("out of memory inside Bullet");
-        return -1;
+        if (w)
+            w->out_of_memory = true;
+        return fail;
     }
 }
 
 int cfb_add_plane(cfb_world *w, const double point[3], const double normal[3], double friction,
                   double restitution)
 {
-    return guarded([&] { return add_plane_unguarded(w, point, normal, friction, restitution); });
+    return marked(w, -1, [&] {
+        return add_plane_unguarded(w, point, normal, friction, restitution);
+    });
 }
 
 int cfb_add_sphere(cfb_world *w, const double center[3], double radius,
                    const double velocity[3], double friction, double restitution)
 {
-    return guarded([&] { return add_sphere_unguarded(w, center, radius, velocity, friction, restitution); });
+    return marked(w, -1, [&] {
+        return add_sphere_unguarded(w, center, radius, velocity, friction, restitution);
+    });
 }
 
 int cfb_add_box(cfb_world *w, const double center[3], const double half_extents[3],
                 const double velocity[3], double friction, double restitution)
 {
-    return guarded([&] { return add_box_unguarded(w, center, half_extents, velocity, friction, restitution); });
+    return marked(w, -1, [&] {
+        return add_box_unguarded(w, center, half_extents, velocity, friction, restitution);
+    });
 }
 
 int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
                       int n, double margin, const cfb_state *s, double friction,
                       double restitution)
 {
-    return guarded([&] { return add_hull_body_unguarded(w, mass, inertia, pts, n, margin, s, friction, restitution); });
+    return marked(w, -1, [&] {
+        return add_hull_body_unguarded(w, mass, inertia, pts, n, margin, s, friction, restitution);
+    });
 }
 
 int cfb_convex_hull(const double *pts, int n, double *out, double *volume)
 {
-    return guarded([&] { return convex_hull_unguarded(pts, n, out, volume); });
+    return marked(nullptr, -1, [&] { return convex_hull_unguarded(pts, n, out, volume); });
 }
 
 int cfb_add_compound_body(cfb_world *w, double mass, const double inertia[3], const double *pts,
                           const int *start, int n_hulls, double margin, const cfb_state *s,
                           double friction, double restitution)
 {
-    return guarded([&] { return add_compound_body_unguarded(w, mass, inertia, pts, start, n_hulls, margin, s, friction, restitution); });
+    return marked(w, -1, [&] {
+        return add_compound_body_unguarded(w, mass, inertia, pts, start, n_hulls, margin, s,
+                                           friction, restitution);
+    });
 }
 
 int cfb_add_trimesh(cfb_world *w, const double *verts, int nv, const int *tris, int nt,
                     double friction, double restitution)
 {
-    return guarded([&] { return add_trimesh_unguarded(w, verts, nv, tris, nt, friction, restitution); });
+    return marked(w, -1, [&] {
+        return add_trimesh_unguarded(w, verts, nv, tris, nt, friction, restitution);
+    });
 }
 
 int cfb_step(cfb_world *w, double dt, int substeps)
 {
-    return guarded([&] { return step_unguarded(w, dt, substeps); });
+    return marked(w, -1, [&] { return step_unguarded(w, dt, substeps); });
 }
 
 int cfb_set_family(cfb_world *w, int id, int family)
 {
-    return guarded([&] { return set_family_unguarded(w, id, family); });
+    return marked(w, -1, [&] { return set_family_unguarded(w, id, family); });
 }
 
 int cfb_set_ccd(cfb_world *w, int id, double motion_threshold, double swept_radius)
 {
-    return guarded([&] { return set_ccd_unguarded(w, id, motion_threshold, swept_radius); });
+    return marked(w, -1, [&] { return set_ccd_unguarded(w, id, motion_threshold, swept_radius); });
+}
+
+double cfb_pair_penetration(cfb_world *w, int a, int b)
+{
+    return marked(w, -1.0, [&] { return pair_penetration_unguarded(w, a, b); });
+}
+
+void cfb_unignore_pair(cfb_world *w, int a, int b)
+{
+    marked(w, 0, [&] { return unignore_pair_unguarded(w, a, b), 0; });
+}
+
+void cfb_remove_body(cfb_world *w, int id)
+{
+    marked(w, 0, [&] { return remove_body_unguarded(w, id), 0; });
+}
+
+void cfb_ignore_pair(cfb_world *w, int a, int b)
+{
+    marked(w, 0, [&] { return ignore_pair_unguarded(w, a, b), 0; });
 }
