@@ -137,6 +137,14 @@ static double wave_speed(const cf_material *mat)
     return sqrt(mat->E * (1 - mat->nu) / (mat->rho * (1 + mat->nu) * (1 - 2 * mat->nu)));
 }
 
+/* Dm = [x1 - x0, x2 - x0, x3 - x0] (columns), row-major. */
+static void edge_matrix(const double *x0, const double *x1, const double *x2, const double *x3,
+                        double Dm[9])
+{
+    for (int r = 0; r < 3; r++)
+        Dm[3 * r] = x1[r] - x0[r], Dm[3 * r + 1] = x2[r] - x0[r], Dm[3 * r + 2] = x3[r] - x0[r];
+}
+
 /* Twice the inradius of a tet of volume `vol`: 6 V / (total face area). */
 static double tet_h(double vol, const double *x0, const double *x1, const double *x2,
                     const double *x3)
@@ -154,8 +162,7 @@ double cf_mesh_dt_cfl(const cf_mesh *m, double scale, const cf_material *mat)
         const double *x0 = &m->x[3 * T[0]], *x1 = &m->x[3 * T[1]], *x2 = &m->x[3 * T[2]],
                      *x3 = &m->x[3 * T[3]];
         double Dm[9];
-        for (int r = 0; r < 3; r++)
-            Dm[3 * r] = x1[r] - x0[r], Dm[3 * r + 1] = x2[r] - x0[r], Dm[3 * r + 2] = x3[r] - x0[r];
+        edge_matrix(x0, x1, x2, x3, Dm);
         double h = tet_h(fabs(m3_det(Dm)) / 6.0, x0, x1, x2, x3);
         if (!(h > 0))
             return NAN;
@@ -261,8 +268,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
         const double *x0 = &s->X[3 * T[0]], *x1 = &s->X[3 * T[1]], *x2 = &s->X[3 * T[2]],
                      *x3 = &s->X[3 * T[3]];
         double Dm[9];
-        for (int r = 0; r < 3; r++)
-            Dm[3 * r] = x1[r] - x0[r], Dm[3 * r + 1] = x2[r] - x0[r], Dm[3 * r + 2] = x3[r] - x0[r];
+        edge_matrix(x0, x1, x2, x3, Dm);
         double det = m3_inv(Dm, &s->Dm_inv[9 * t]);
         s->vol[t] = det / 6.0;
         if (!(s->vol[t] > 0)) {
