@@ -17,7 +17,7 @@
 #include <string.h>
 
 #define STORED_HASH 0xc36ecb17cb257b60ull
-#define STORED_HASH_COLOURED 0xc5e7eb3ca711fb4eull
+#define STORED_HASH_COLOURED 0x47acaec4acd4f6dcull
 
 static char dir[256];
 

@@ -10,6 +10,7 @@
 #include "fragments.h"
 #include "insertion.h"
 #include "linalg.h"
+#include "pbd.h"
 #include "tet4.h"
 
 #include <math.h>
@@ -65,8 +66,8 @@ static void test_two_tets_split_into_two_fragments(void **state)
         if (s.facet[4 * i + 2] >= 0)
             f = i;
     assert_true(f >= 0);
-    cf_int_list nodes = {0};
-    assert_int_equal(cf_crack_facet(&s, f, &nodes), 0);
+    cf_int_list nodes = {0}, touched = {0};
+    assert_int_equal(cf_crack_facet(&s, f, &nodes, &touched), 0);
     assert_int_equal(s.n_nodes, 8);
     assert_int_equal(nodes.n, 3);
     assert_int_equal(s.n_coh, 1);
@@ -85,7 +86,7 @@ static void test_two_tets_split_into_two_fragments(void **state)
         assert_int_not_equal(a, b);
         assert_int_equal(s.origin[a], s.origin[b]);
     }
-    free(nodes.v);
+    free(nodes.v), free(touched.v);
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
@@ -100,7 +101,7 @@ static void test_box_split_along_a_plane(void **state)
     init(&s, &m);
     double P0[3], M0, P1[3], M1;
     momentum(&s, P0, &M0);
-    cf_int_list nodes = {0};
+    cf_int_list nodes = {0}, touched = {0};
     int first = -1, cracked = 0;
     for (int f = 0; f < s.n_facets; f++) {
         const int *F = &s.facet[4 * f];
@@ -111,7 +112,7 @@ static void test_box_split_along_a_plane(void **state)
             on_plane &= fabs(s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][i]]] - 0.2) < 1e-12;
         if (!on_plane)
             continue;
-        assert_int_equal(cf_crack_facet(&s, f, &nodes), 0);
+        assert_int_equal(cf_crack_facet(&s, f, &nodes, &touched), 0);
         if (first < 0) {
             first = f;
             assert_int_equal(components(&s), 1);
@@ -125,7 +126,7 @@ static void test_box_split_along_a_plane(void **state)
     assert_near(M1, M0, 1e-14 * M0);
     for (int k = 0; k < 3; k++)
         assert_near(P1[k], P0[k], 1e-14 * (fabs(P0[k]) + M0));
-    free(nodes.v);
+    free(nodes.v), free(touched.v);
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
@@ -214,11 +215,125 @@ static void test_bound_never_misses_a_facet(void **state)
     cf_mesh_free(&m);
 }
 
+/* Bars sorted by their ends, for comparing bar sets. */
+typedef struct {
+    int a, b;
+    double rest, compliance;
+} bar_row;
+
+static int by_ends(const void *x, const void *y)
+{
+    const bar_row *p = x, *q = y;
+    return p->a != q->a ? (p->a > q->a) - (p->a < q->a) : (p->b > q->b) - (p->b < q->b);
+}
+
+static bar_row *rows(const cf_bars *b)
+{
+    bar_row *r = malloc((size_t)(b->n ? b->n : 1) * sizeof *r);
+    for (int i = 0; i < b->n; i++)
+        r[i] = (bar_row){b->ends[2 * i], b->ends[2 * i + 1], b->rest[i], b->compliance[i]};
+    qsort(r, (size_t)b->n, sizeof *r, by_ends);
+    return r;
+}
+
+/* Same bars (ends, rest length, compliance to the bit) and every colour
+ * group a matching: no node twice in one colour. */
+static void assert_same_bars_validly_coloured(const cf_bars *got, const cf_bars *want, int nodes)
+{
+    assert_int_equal(got->n, want->n);
+    assert_int_equal(got->color_start[CF_BARS_COLORS + 1], got->n);
+    bar_row *g = rows(got), *w = rows(want);
+    for (int i = 0; i < got->n; i++) {
+        assert_int_equal(g[i].a, w[i].a);
+        assert_int_equal(g[i].b, w[i].b);
+        assert_true(g[i].rest == w[i].rest && g[i].compliance == w[i].compliance);
+    }
+    free(g), free(w);
+    int *seen = malloc((size_t)nodes * sizeof(int));
+    for (int i = 0; i < nodes; i++)
+        seen[i] = -1;
+    for (int c = 0; c < CF_BARS_COLORS; c++)
+        for (int i = got->color_start[c]; i < got->color_start[c + 1]; i++)
+            for (int e = 0; e < 2; e++) {
+                int a = got->ends[2 * i + e];
+                assert_int_not_equal(seen[a], c);
+                seen[a] = c;
+            }
+    for (int c = 0; c <= CF_BARS_COLORS; c++)
+        assert_true(c < got->n_colors || got->color_start[c + 1] == got->color_start[c]);
+    free(seen);
+}
+
+/* Bars patched at the duplicated nodes after each round of insertions
+ * equal the bars built anew from all tets; when the box falls apart, the
+ * pieces' split bars equal the bars built on each piece's tets. */
+static void test_bars_patched_after_insertion_equal_a_rebuild(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 4, 3, 3, 0.4, 0.3, 0.3);
+    cf_solid s;
+    init(&s, &m);
+    int *all = malloc((size_t)s.n_tets * sizeof(int));
+    for (int t = 0; t < s.n_tets; t++)
+        all[t] = t;
+    cf_bars bars = {0}, fresh = {0};
+    cf_bars_scratch w = {0};
+    assert_int_equal(cf_bars_build(&bars, &s, all, s.n_tets), 0);
+    cf_int_list nodes = {0}, touched = {0};
+    /* Rounds: scattered facets, then the whole plane x = 0.2. */
+    for (int round = 0; round < 4; round++) {
+        touched.n = 0;
+        for (int f = 0; f < s.n_facets; f++) {
+            const int *F = &s.facet[4 * f];
+            if (F[2] < 0 || s.cracked[f])
+                continue;
+            int on_plane = 1;
+            for (int i = 0; i < 3; i++)
+                on_plane &= fabs(s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][i]]] - 0.2) < 1e-12;
+            int pick = round < 3 ? (f * 7 + round) % 11 == 0 : on_plane;
+            if (pick)
+                assert_int_equal(cf_crack_facet(&s, f, &nodes, &touched), 0);
+        }
+        assert_int_equal(cf_bars_patch(&bars, &s, touched.v, touched.n, &w), 0);
+        assert_int_equal(cf_bars_build(&fresh, &s, all, s.n_tets), 0);
+        assert_same_bars_validly_coloured(&bars, &fresh, s.n_nodes);
+    }
+    for (int i = 0; i < s.n_nodes; i++)
+        assert_int_equal(w.flag[i], 0); /* the scratch is left clean */
+    /* Split by pieces. */
+    int *comp = malloc((size_t)s.n_tets * sizeof(int));
+    int k = cf_label_components(&s, all, s.n_tets, comp);
+    assert_true(k >= 2);
+    int *piece = malloc((size_t)s.n_nodes * sizeof(int));
+    for (int t = 0; t < s.n_tets; t++)
+        for (int j = 0; j < 4; j++)
+            piece[s.tet[4 * t + j]] = comp[t];
+    cf_bars *parts = calloc((size_t)k, sizeof *parts), **dst = malloc((size_t)k * sizeof *dst);
+    for (int p = 0; p < k; p++)
+        dst[p] = &parts[p];
+    assert_int_equal(cf_bars_split(&bars, piece, k, dst), 0);
+    for (int p = 0; p < k; p++) {
+        int nt = 0;
+        for (int t = 0; t < s.n_tets; t++)
+            if (comp[t] == p)
+                all[nt++] = t;
+        assert_int_equal(cf_bars_build(&fresh, &s, all, nt), 0);
+        assert_same_bars_validly_coloured(&parts[p], &fresh, s.n_nodes);
+        cf_bars_free(&parts[p]);
+    }
+    free(parts), free(dst), free(piece), free(comp), free(all);
+    free(nodes.v), free(touched.v);
+    cf_bars_free(&bars), cf_bars_free(&fresh), cf_bars_scratch_free(&w);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_two_tets_split_into_two_fragments),
         cmocka_unit_test(test_box_split_along_a_plane),
+        cmocka_unit_test(test_bars_patched_after_insertion_equal_a_rebuild),
         cmocka_unit_test(test_criterion_selects_facets_normal_to_tension),
         cmocka_unit_test(test_bound_never_misses_a_facet),
     };

@@ -52,6 +52,7 @@ typedef struct cf_bench_timing {
 
 typedef struct cf_bench_result {
     int tets, nodes, bars;
+    int colours, serial_bars; /* bar colours, bars in the one-thread group (cf_step_stats) */
     double bytes;           /* traffic model, bytes per step */
     double bw_1t, bw_nt;    /* triad bandwidth, bytes/s, 1 and N threads */
     int threads;

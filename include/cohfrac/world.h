@@ -238,6 +238,9 @@ typedef struct cf_step_stats {
     int iterations;                        /* constraint iterations per step */
     int check;                             /* 1: the insertion criterion is checked */
     int xpbd;                              /* 1: XPBD bars (compliance, multipliers) */
+    int colours;                           /* most bar colours in one fragment (a sweep
+                                              waits once per colour) */
+    int serial_bars;                       /* bars no colour could take (swept on one thread) */
 } cf_step_stats;
 
 void cf_world_step_stats(const cf_world *sim, cf_step_stats *out);

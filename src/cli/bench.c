@@ -74,7 +74,7 @@ static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_crit
         "              friction = 0.5, restitution = 0},\n"
         "  bodies = {{mesh = [==[%s]==], orientation = {0.7071067811865476, 0.7071067811865476, 0, "
         "0},\n"
-        "             position = {0, 0, 0}, velocity = {0, 0, -3.1}}},\n"
+        "             position = {0, 0, 0}, velocity = {0, 0, -4.43}}},\n"
         "  obstacles = {{type = 'plane', point = {0, 0, %.17g}, normal = {0, 0, 1}}},\n"
         "  solver = {mode = 'fracture', dt_rigid = 5e-6, dt_fracture = 5e-6, criterion = '%s',\n"
         "            pbd = {k_stiffness = 0.9, iterations = 3, k_damping = 1}},\n"
@@ -246,6 +246,7 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
     }
     cf_step_stats *z = &sn[0].stats;
     r->tets = z->tets, r->nodes = z->nodes, r->bars = z->bars;
+    r->colours = z->colours, r->serial_bars = z->serial_bars;
     r->bytes = cf_step_traffic(z);
     summarize(s1, reps, &r->t1);
     summarize(sn, reps, &r->tn);
@@ -260,11 +261,11 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
     }
     if (log) {
         fprintf(log,
-                "solid: %d tets, %d nodes, %d bars in fracture mode at the end; engine memory %.0f "
-                "B per tet\n"
+                "solid: %d tets, %d nodes, %d bars (%d colours, %d bars on one thread) in fracture "
+                "mode at the end; engine memory %.0f B per tet\n"
                 "traffic model: %.1f MB per step -> floor %.3f ms at %.1f GB/s (docs/performance.md)\n"
                 "  %-10s %8s %9s %8s %9s %8s %9s %7s %7s %10s\n",
-                r->tets, r->nodes, r->bars, r->memory_per_tet, r->bytes / 1e6, r->floor_ms,
+                r->tets, r->nodes, r->bars, r->colours, r->serial_bars, r->memory_per_tet, r->bytes / 1e6, r->floor_ms,
                 r->bw_nt / 1e9, "threads", "min ms", "median ms", "CPU ms", "ns/tet", "stress",
                 "insertion", "forces", "PBD", "insertions");
         char what[32];

@@ -42,10 +42,12 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, int n_hot, int 
                                      &sim->cand);
     if (nc < 0)
         return CF_ERR_NOMEM;
+    sim->touched.n = 0;
     for (int i = 0; i < nc; i++)
-        if (cf_crack_facet(s, sim->cand.v[i], &f->nodes) || cf_int_list_push(&f->coh, s->n_coh - 1))
+        if (cf_crack_facet(s, sim->cand.v[i], &f->nodes, &sim->touched) ||
+            cf_int_list_push(&f->coh, s->n_coh - 1))
             return CF_ERR_NOMEM;
-    if (nc > 0 && cf_bars_build(&f->bars, s, f->tets, f->nt))
+    if (cf_bars_patch(&f->bars, s, sim->touched.v, sim->touched.n, &sim->bar_scratch))
         return CF_ERR_NOMEM;
     *inserted = nc;
     f->cracked += nc;

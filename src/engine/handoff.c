@@ -304,22 +304,45 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     return record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, err);
 }
 
-/* Give the new fragment `ci` the tets of component `c` and their nodes. */
-static int take_component(cf_world *sim, int ci, const int *tets, const int *comp, int nt, int c,
-                          unsigned char *seen)
+/* The tets grouped by component, in list order within each: component c
+ * is out[start[c]] .. out[start[c + 1] - 1] (one pass: a split into many
+ * pieces does not scan the whole list once per piece).  NULL when out of
+ * memory; free both. */
+static int *group_by_component(const int *tets, const int *comp, int nt, int k, int **start)
+{
+    int *out = malloc((size_t)(nt ? nt : 1) * sizeof(int));
+    int *at = calloc((size_t)k + 1, sizeof(int));
+    if (!out || !at) {
+        free(out), free(at);
+        return NULL;
+    }
+    for (int i = 0; i < nt; i++)
+        at[comp[i] + 1]++;
+    for (int c = 0; c < k; c++)
+        at[c + 1] += at[c];
+    int *next = malloc((size_t)k * sizeof(int));
+    if (!next) {
+        free(out), free(at);
+        return NULL;
+    }
+    memcpy(next, at, (size_t)k * sizeof(int));
+    for (int i = 0; i < nt; i++)
+        out[next[comp[i]]++] = tets[i];
+    free(next);
+    *start = at;
+    return out;
+}
+
+/* Give the new fragment `ci` the `count` tets at `tets` and their nodes. */
+static int take_component(cf_world *sim, int ci, const int *tets, int count, unsigned char *seen)
 {
     cf_fragment *f = &sim->frag[ci];
     cf_solid *s = &sim->solid;
-    int count = 0;
-    for (int i = 0; i < nt; i++)
-        count += comp[i] == c;
-    f->tets = malloc((size_t)count * sizeof(int));
+    f->tets = malloc((size_t)(count ? count : 1) * sizeof(int));
     if (!f->tets)
         return -1;
     f->nt = 0;
-    for (int i = 0; i < nt; i++) {
-        if (comp[i] != c)
-            continue;
+    for (int i = 0; i < count; i++) {
         int t = tets[i];
         f->tets[f->nt++] = t;
         s->tet_frag[t] = ci;
@@ -352,7 +375,8 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
     /* The parent's per-node leapfrog kinetic energy terms, by node id. */
     int *index = malloc((size_t)s->n_nodes * sizeof(int));
     unsigned char *seen = calloc((size_t)s->n_nodes, 1);
-    int rc = -(!index || !seen);
+    int *cstart = NULL, *grouped = group_by_component(tets, comp, nt, k, &cstart);
+    int rc = -(!index || !seen || !grouped);
     for (int i = 0; rc == 0 && i < f->nodes.n; i++)
         index[f->nodes.v[i]] = i;
     *first = sim->n_frag;
@@ -361,7 +385,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
             rc = -1;
     for (int c = 0; rc == 0 && c < k; c++) {
         int ci = *first + c;
-        if (take_component(sim, ci, tets, comp, nt, c, seen)) {
+        if (take_component(sim, ci, grouped + cstart[c], cstart[c + 1] - cstart[c], seen)) {
             rc = -1;
             break;
         }
@@ -376,9 +400,21 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
             g->e_kin += 0.5 * s->m[a] * v3_dot(&p->v_old[3 * index[a]], &s->v[3 * a]);
             v3_axpy(s->m[a], &s->x[3 * a], g->mx);
         }
-        if (collect_cohesive(sim, g) || cf_bars_build(&g->bars, s, g->tets, g->nt))
+        if (collect_cohesive(sim, g))
             rc = -1;
     }
+    /* The parent's bars go to the pieces (index now gives a node's piece). */
+    cf_bars **dst = rc ? NULL : malloc((size_t)k * sizeof *dst);
+    rc |= -(!dst);
+    for (int c = 0; rc == 0 && c < k; c++) {
+        cf_fragment *g = &sim->frag[*first + c];
+        dst[c] = &g->bars;
+        for (int i = 0; i < g->nodes.n; i++)
+            index[g->nodes.v[i]] = c;
+    }
+    if (rc == 0 && cf_bars_split(&sim->frag[fi].bars, index, k, dst))
+        rc = -1;
+    free(dst);
     if (rc == 0) {
         f = &sim->frag[fi];
         f->mode = CF_MODE_DEAD;
@@ -386,7 +422,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         cf_bars_free(&f->bars);
         free(tets);
     }
-    free(comp), free(index), free(seen);
+    free(comp), free(index), free(seen), free(grouped), free(cstart);
     return rc ? -1 : k;
 }
 
@@ -408,6 +444,12 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
     }
     int k = cf_label_components(s, tets, nt, comp);
+    int *cstart = NULL, *grouped = group_by_component(tets, comp, nt, k, &cstart);
+    free(comp);
+    if (!grouped) {
+        free(seen);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
+    }
     /* A rigid fragment keeps no strain or cohesive energy. */
     sim->flow.handoff += f->e_strain + cf_cohesive_release(s, f->coh.v, f->coh.n);
     f->e_strain = 0;
@@ -423,7 +465,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         first = sim->n_frag;
         for (int c = 0; c < k; c++)
             if (cf_fragment_new(sim, fi, sim->t) < 0) {
-                free(comp), free(seen);
+                free(grouped), free(cstart), free(seen);
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
             }
         f = &sim->frag[fi]; /* the array may have moved */
@@ -433,8 +475,8 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
     f->nodes.n = 0;
     for (int c = 0; c < k; c++) {
         int ci = first + c;
-        if (take_component(sim, ci, tets, comp, nt, c, seen)) {
-            free(comp), free(seen);
+        if (take_component(sim, ci, grouped + cstart[c], cstart[c + 1] - cstart[c], seen)) {
+            free(grouped), free(cstart), free(seen);
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
         }
         cf_fragment *g = &sim->frag[ci];
@@ -449,12 +491,12 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         if (sim->bullet) {
             cf_status st = cf_fragment_add_body(sim, ci, ns.com, ns.R, ns.v, w, err);
             if (st != CF_OK) {
-                free(comp), free(seen);
+                free(grouped), free(cstart), free(seen);
                 return st;
             }
         } else {
             if (cf_bars_build(&g->bars, s, g->tets, g->nt)) {
-                free(comp), free(seen);
+                free(grouped), free(cstart), free(seen);
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
             }
             g->steps = 0;
@@ -474,7 +516,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         cf_bars_free(&sim->frag[fi].bars);
     cf_hull_set_free(&sim->frag[fi].near);
     cf_frag_surface_free(&sim->frag[fi].surface);
-    free(tets), free(comp), free(seen);
+    free(tets), free(grouped), free(cstart), free(seen);
     for (int c = 0; c < k; c++) {
         double P[3], L[3];
         cf_fragment_momenta(sim, first + c, P, L);

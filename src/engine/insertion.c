@@ -163,7 +163,7 @@ static int uf_find(int *parent, int i)
 /* Split the star of node copy `n` of original vertex `o` into its
  * components (tets joined through uncracked facets containing o); every
  * component but the one with the lowest tet gets a new copy of the node. */
-static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
+static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes, cf_int_list *touched)
 {
     int lo = s->vt_start[o], hi = s->vt_start[o + 1];
     int local[3 * 256]; /* stars of up to 256 tets without the heap */
@@ -205,7 +205,8 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
             continue;
         if (copy_of_root[r] < 0) {
             int c = cf_solid_copy_node(s, n);
-            if (c < 0 || cf_int_list_push(nodes, c)) {
+            if (c < 0 || cf_int_list_push(nodes, c) || cf_int_list_push(touched, c) ||
+                cf_int_list_push(touched, n)) {
                 rc = -1;
                 break;
             }
@@ -223,7 +224,7 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes)
     return rc;
 }
 
-int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes)
+int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched)
 {
     const int *F = &s->facet[4 * f];
     int ta = F[0], fa = F[1], tb = F[2];
@@ -239,9 +240,9 @@ int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes)
         ce.slot[1][i] = slot_of(s, tb, o);
         int na = s->tet[4 * ta + sa];
         int nb = s->tet[4 * tb + ce.slot[1][i]];
-        if (split_star(s, o, na, nodes))
+        if (split_star(s, o, na, nodes, touched))
             return -1;
-        if (nb != na && split_star(s, o, nb, nodes))
+        if (nb != na && split_star(s, o, nb, nodes, touched))
             return -1;
     }
     if (s->n_coh == s->cap_coh) {

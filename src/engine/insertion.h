@@ -39,8 +39,9 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
                             cf_int_list *out);
 
 /* Crack facet f: mark it, duplicate the nodes whose star it disconnects
- * (new copies are appended to `nodes`), re-lump the masses of the affected
- * nodes, and add a cohesive element.  Returns 0, or -1 when out of memory. */
-int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes);
+ * (new copies are appended to `nodes`; each split node and its copies to
+ * `touched`, for cf_bars_patch), re-lump the masses of the affected nodes,
+ * and add a cohesive element.  Returns 0, or -1 when out of memory. */
+int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched);
 
 #endif

@@ -11,11 +11,12 @@ typedef struct {
     double vol;     /* m^3, tributary volume */
 } nbr;
 
-/* The bars (a, b > a) of node a: every other node of the tets that hold a,
- * merged per node with their tets' sixths of volume added in ascending tet
- * order.  Writes them ascending in b into out (room for 3 x the star) and
- * returns how many. */
-static int node_bars(const cf_solid *s, int a, nbr *out)
+/* The bars of node a: every other node b of the tets that hold a, merged
+ * per node with their tets' sixths of volume added in ascending tet order.
+ * Only b > a, except that with `lower` (a flag per node, or NULL) also the
+ * b < a with lower[b] == 0.  Writes them ascending in b into out (room for
+ * 3 x the star) and returns how many. */
+static int node_bars(const cf_solid *s, int a, const unsigned char *lower, nbr *out)
 {
     int o = s->origin[a], n = 0;
     for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
@@ -24,7 +25,7 @@ static int node_bars(const cf_solid *s, int a, nbr *out)
             continue;
         for (int k = 0; k < 4; k++) {
             int b = s->tet[4 * t + k];
-            if (b <= a)
+            if (b == a || (b < a && (!lower || lower[b])))
                 continue;
             /* insertion, stable: equal ends keep ascending tet order */
             int i = n++;
@@ -48,20 +49,21 @@ static int star_size(const cf_solid *s, int a)
     return s->vt_start[s->origin[a] + 1] - s->vt_start[s->origin[a]];
 }
 
-/* Bars of node a into the arrays at position at; returns 0, -1 out of memory. */
-static int fill_node(const cf_solid *s, int a, int *ends, double *rest, double *compliance,
-                     int at, int *count)
+/* Bars of node a (node_bars) into the arrays at position at, each pair in
+ * ascending order; returns 0, -1 out of memory. */
+static int fill_node(const cf_solid *s, int a, const unsigned char *lower, int *ends, double *rest,
+                     double *compliance, int at, int *count)
 {
     nbr local[3 * 128];
     int need = 3 * star_size(s, a);
     nbr *e = need <= 3 * 128 ? local : malloc((size_t)need * sizeof *e);
     if (!e)
         return -1;
-    int m = node_bars(s, a, e);
+    int m = node_bars(s, a, lower, e);
     for (int i = 0; ends && i < m; i++) {
         double d[3];
         int b = e[i].b;
-        ends[2 * (at + i)] = a, ends[2 * (at + i) + 1] = b;
+        ends[2 * (at + i)] = a < b ? a : b, ends[2 * (at + i) + 1] = a < b ? b : a;
         v3_sub(&s->X[3 * a], &s->X[3 * b], d);
         rest[at + i] = v3_norm(d);
         /* A bar of section V/L and length L: stiffness E V / L^2. */
@@ -71,6 +73,19 @@ static int fill_node(const cf_solid *s, int a, int *ends, double *rest, double *
     if (e != local)
         free(e);
     return 0;
+}
+
+/* The lowest colour free at both masks, marked used in both; CF_BARS_COLORS
+ * when none is. */
+static int take_colour(uint64_t *ma, uint64_t *mb)
+{
+    uint64_t lo = ~(ma[0] | mb[0]), hi = ~(ma[1] | mb[1]);
+    int c = lo ? __builtin_ctzll(lo) : hi ? 64 + __builtin_ctzll(hi) : CF_BARS_COLORS;
+    if (c < CF_BARS_COLORS) {
+        ma[c / 64] |= 1ull << (c % 64);
+        mb[c / 64] |= 1ull << (c % 64);
+    }
+    return c;
 }
 
 /* Greedy colouring in bar order: the lowest colour that no bar at either
@@ -83,13 +98,7 @@ static int colour(const int *ends, int n, int nodes, unsigned char *colour_of)
         return -1;
     int used = 0;
     for (int i = 0; i < n; i++) {
-        uint64_t *ma = mask[ends[2 * i]], *mb = mask[ends[2 * i + 1]];
-        uint64_t lo = ~(ma[0] | mb[0]), hi = ~(ma[1] | mb[1]);
-        int c = lo ? __builtin_ctzll(lo) : hi ? 64 + __builtin_ctzll(hi) : CF_BARS_COLORS;
-        if (c < CF_BARS_COLORS) {
-            ma[c / 64] |= 1ull << (c % 64);
-            mb[c / 64] |= 1ull << (c % 64);
-        }
+        int c = take_colour(mask[ends[2 * i]], mask[ends[2 * i + 1]]);
         colour_of[i] = (unsigned char)c;
         used = c + 1 > used ? c + 1 : used;
     }
@@ -114,7 +123,7 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
     int big = nn >= CF_NODES_PARALLEL_MIN;
 #pragma omp parallel for schedule(static) reduction(| : rc) if (big)
     for (int i = 0; i < nn; i++)
-        rc |= fill_node(s, nodes[i], NULL, NULL, NULL, 0, &start[i + 1]);
+        rc |= fill_node(s, nodes[i], NULL, NULL, NULL, NULL, 0, &start[i + 1]);
     int n = 0;
     if (rc == 0) {
         start[0] = 0;
@@ -135,7 +144,7 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
     for (int i = 0; i < nn; i++) {
         int m;
         if (rc == 0)
-            rc |= fill_node(s, nodes[i], ends, rest, compliance, start[i], &m);
+            rc |= fill_node(s, nodes[i], NULL, ends, rest, compliance, start[i], &m);
     }
     int groups = rc ? -1 : colour(ends, n, s->n_nodes, col);
     if (groups < 0)
@@ -159,8 +168,218 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
         return -1;
     }
     cf_bars_free(b);
-    b->n = n, b->ends = e2, b->rest = r2, b->compliance = c2, b->lambda = lambda;
+    b->n = n, b->cap = n, b->ends = e2, b->rest = r2, b->compliance = c2, b->lambda = lambda;
     b->n_colors = groups, b->color_start = color_start;
+    return 0;
+}
+
+/* Room for `nodes` node flags and masks and `bars` new bars; 0 or -1. */
+static int scratch_reserve(cf_bars_scratch *w, int nodes, int bars)
+{
+    if (nodes > w->node_cap) {
+        int cap = nodes + nodes / 2 + 16;
+        unsigned char *f = realloc(w->flag, (size_t)cap);
+        if (!f)
+            return -1;
+        memset(f + w->node_cap, 0, (size_t)(cap - w->node_cap));
+        w->flag = f;
+        uint64_t(*m)[2] = realloc(w->mask, (size_t)cap * sizeof *m);
+        int *l = realloc(w->list, (size_t)cap * sizeof(int));
+        if (m)
+            w->mask = m;
+        if (l)
+            w->list = l;
+        if (!m || !l)
+            return -1;
+        w->node_cap = cap;
+    }
+    if (bars > w->bar_cap) {
+        int cap = bars + bars / 2 + 64;
+        int *e = realloc(w->ends, (size_t)cap * 2 * sizeof(int));
+        if (e)
+            w->ends = e;
+        double *r = realloc(w->rest, (size_t)cap * sizeof(double));
+        if (r)
+            w->rest = r;
+        double *c = realloc(w->compliance, (size_t)cap * sizeof(double));
+        if (c)
+            w->compliance = c;
+        unsigned char *k = realloc(w->colour, (size_t)cap);
+        if (k)
+            w->colour = k;
+        if (!e || !r || !c || !k)
+            return -1;
+        w->bar_cap = cap;
+    }
+    return 0;
+}
+
+void cf_bars_scratch_free(cf_bars_scratch *w)
+{
+    free(w->flag), free(w->mask), free(w->list);
+    free(w->ends), free(w->rest), free(w->compliance), free(w->colour);
+    memset(w, 0, sizeof *w);
+}
+
+static int by_int(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return (a > b) - (a < b);
+}
+
+/* Room for n bars in b (amortised); 0 or -1. */
+static int bars_reserve(cf_bars *b, int n)
+{
+    if (n <= b->cap)
+        return 0;
+    int cap = n + n / 8 + 64;
+    int *e = realloc(b->ends, (size_t)cap * 2 * sizeof(int));
+    if (e)
+        b->ends = e;
+    double *r = realloc(b->rest, (size_t)cap * sizeof(double));
+    if (r)
+        b->rest = r;
+    double *c = realloc(b->compliance, (size_t)cap * sizeof(double));
+    if (c)
+        b->compliance = c;
+    double *l = realloc(b->lambda, (size_t)cap * sizeof(double));
+    if (l)
+        b->lambda = l;
+    if (!e || !r || !c || !l)
+        return -1;
+    b->cap = cap;
+    return 0;
+}
+
+/* Flag values in cf_bars_scratch: a node whose star changed, and a node
+ * that shares a new bar with one. */
+enum { TOUCHED = 1, NEIGHBOUR = 2 };
+
+int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touched,
+                  cf_bars_scratch *w)
+{
+    if (n_touched == 0)
+        return 0;
+    if (scratch_reserve(w, s->n_nodes, 0))
+        return -1;
+    /* The touched nodes, once each, ascending: the order the new bars are
+     * made and coloured in, so that the result does not depend on the order
+     * the facets cracked in beyond their list order. */
+    int nd = 0;
+    for (int i = 0; i < n_touched; i++)
+        if (!w->flag[touched[i]])
+            w->flag[touched[i]] = TOUCHED, w->list[nd++] = touched[i];
+    qsort(w->list, (size_t)nd, sizeof(int), by_int);
+    /* Their bars: every bar at a touched node, a pair of touched nodes once. */
+    int n_new = 0, m;
+    for (int i = 0; i < nd; i++) {
+        if (fill_node(s, w->list[i], w->flag, NULL, NULL, NULL, 0, &m))
+            return -1;
+        n_new += m;
+    }
+    if (scratch_reserve(w, s->n_nodes, n_new))
+        return -1;
+    for (int i = 0, at = 0; i < nd; i++, at += m)
+        fill_node(s, w->list[i], w->flag, w->ends, w->rest, w->compliance, at, &m);
+    /* The colours the kept bars use at the new bars' untouched ends. */
+    int nn = nd;
+    for (int i = 0; i < 2 * n_new; i++) {
+        int a = w->ends[i];
+        if (w->flag[a] == 0)
+            w->flag[a] = NEIGHBOUR, w->list[nn++] = a;
+    }
+    for (int i = 0; i < nn; i++)
+        w->mask[w->list[i]][0] = w->mask[w->list[i]][1] = 0;
+    /* Drop the bars at touched nodes, in place and in order. */
+    int kept[CF_BARS_COLORS + 2], cnt[CF_BARS_COLORS + 1] = {0}, at = 0;
+    for (int c = 0; c <= CF_BARS_COLORS; c++) {
+        kept[c] = at;
+        for (int i = b->color_start[c]; i < b->color_start[c + 1]; i++) {
+            int e0 = b->ends[2 * i], e1 = b->ends[2 * i + 1];
+            if (w->flag[e0] == TOUCHED || w->flag[e1] == TOUCHED)
+                continue;
+            if (c < CF_BARS_COLORS && w->flag[e0] == NEIGHBOUR)
+                w->mask[e0][c / 64] |= 1ull << (c % 64);
+            if (c < CF_BARS_COLORS && w->flag[e1] == NEIGHBOUR)
+                w->mask[e1][c / 64] |= 1ull << (c % 64);
+            b->ends[2 * at] = e0, b->ends[2 * at + 1] = e1;
+            b->rest[at] = b->rest[i], b->compliance[at] = b->compliance[i];
+            at++;
+        }
+    }
+    kept[CF_BARS_COLORS + 1] = at;
+    /* The new bars coloured greedily around them. */
+    for (int j = 0; j < n_new; j++) {
+        int c = take_colour(w->mask[w->ends[2 * j]], w->mask[w->ends[2 * j + 1]]);
+        w->colour[j] = (unsigned char)c;
+        cnt[c]++;
+    }
+    for (int i = 0; i < nn; i++)
+        w->flag[w->list[i]] = 0;
+    /* Regroup: each colour's kept bars, then its new ones.  Groups move
+     * right (from the last), so nothing is overwritten before it moves. */
+    int start[CF_BARS_COLORS + 2];
+    start[0] = 0;
+    for (int c = 0; c <= CF_BARS_COLORS; c++)
+        start[c + 1] = start[c] + (kept[c + 1] - kept[c]) + cnt[c];
+    int n = start[CF_BARS_COLORS + 1];
+    if (bars_reserve(b, n))
+        return -1;
+    for (int c = CF_BARS_COLORS; c >= 0; c--) {
+        size_t len = (size_t)(kept[c + 1] - kept[c]);
+        memmove(&b->ends[2 * start[c]], &b->ends[2 * kept[c]], 2 * len * sizeof(int));
+        memmove(&b->rest[start[c]], &b->rest[kept[c]], len * sizeof(double));
+        memmove(&b->compliance[start[c]], &b->compliance[kept[c]], len * sizeof(double));
+        cnt[c] = start[c] + (int)len; /* now: the next free slot of colour c */
+    }
+    for (int j = 0; j < n_new; j++) {
+        int k = cnt[w->colour[j]]++;
+        b->ends[2 * k] = w->ends[2 * j], b->ends[2 * k + 1] = w->ends[2 * j + 1];
+        b->rest[k] = w->rest[j], b->compliance[k] = w->compliance[j];
+    }
+    memset(b->lambda, 0, (size_t)n * sizeof(double));
+    memcpy(b->color_start, start, sizeof start);
+    b->n = n, b->n_colors = 0;
+    for (int c = 0; c <= CF_BARS_COLORS; c++)
+        if (start[c + 1] > start[c])
+            b->n_colors = c + 1;
+    return 0;
+}
+
+int cf_bars_split(const cf_bars *src, const int *piece_of_node, int k, cf_bars *const *dst)
+{
+    int rc = 0;
+    for (int p = 0; p < k; p++) {
+        cf_bars *d = dst[p];
+        cf_bars_free(d);
+        d->color_start = calloc(CF_BARS_COLORS + 2, sizeof(int));
+        rc |= !d->color_start;
+    }
+    if (rc)
+        return -1;
+    /* Counts per piece and colour, then each piece's bars in source order:
+     * a subset of a colouring is a colouring. */
+    for (int c = 0; c <= CF_BARS_COLORS; c++)
+        for (int i = src->color_start[c]; i < src->color_start[c + 1]; i++)
+            dst[piece_of_node[src->ends[2 * i]]]->color_start[c + 1]++;
+    for (int p = 0; p < k; p++) {
+        cf_bars *d = dst[p];
+        for (int c = 0; c <= CF_BARS_COLORS; c++) {
+            if (d->color_start[c + 1] > 0)
+                d->n_colors = c + 1;
+            d->color_start[c + 1] += d->color_start[c];
+        }
+        if (bars_reserve(d, d->color_start[CF_BARS_COLORS + 1]))
+            return -1;
+        d->n = 0;
+    }
+    for (int i = 0; i < src->n; i++) {
+        cf_bars *d = dst[piece_of_node[src->ends[2 * i]]];
+        int j = d->n++;
+        d->ends[2 * j] = src->ends[2 * i], d->ends[2 * j + 1] = src->ends[2 * i + 1];
+        d->rest[j] = src->rest[i], d->compliance[j] = src->compliance[i];
+        d->lambda[j] = 0;
+    }
     return 0;
 }
 

@@ -6,6 +6,8 @@
 #include "cohfrac/types.h"
 #include "solid.h"
 
+#include <stdint.h>
+
 /* One bar per unique edge of the current tets, rest length from s->X.
  * XPBD compliance of a bar: L^2 / (E V_trib) (m/N), V_trib the sum of a
  * sixth of the volume of every tet that has the edge, so that a bar is a rod
@@ -14,7 +16,7 @@
 #define CF_BARS_PARALLEL_MIN 4096 /* fewer bars: the sweep runs on one thread */
 
 typedef struct cf_bars {
-    int n;
+    int n, cap;         /* bars, and room for them */
     int n_colors;       /* colour groups used */
     int *color_start;   /* [CF_BARS_COLORS + 2]: bars of colour c are color_start[c] ..
                            color_start[c+1] - 1; the serial group from
@@ -31,6 +33,35 @@ typedef struct cf_bars {
  * when out of memory. */
 int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt);
 void cf_bars_free(cf_bars *b);
+
+/* Scratch of cf_bars_patch, kept between calls so that an inserting step
+ * does not allocate (grown when the solid's nodes or the new bars need it). */
+typedef struct cf_bars_scratch {
+    int node_cap, bar_cap;
+    unsigned char *flag;      /* [node_cap] 0 between calls */
+    uint64_t (*mask)[2];      /* [node_cap] colours used at a node */
+    int *list;                /* [node_cap] the nodes flagged */
+    int *ends;                /* [bar_cap][2] the new bars */
+    double *rest, *compliance;
+    unsigned char *colour;
+} cf_bars_scratch;
+void cf_bars_scratch_free(cf_bars_scratch *w);
+
+/* The bars after node duplication, patched where the mesh changed instead
+ * of rebuilt: the bars at the `touched` nodes (the nodes whose star of tets
+ * changed: each split node and its new copies; repeats allowed) are dropped
+ * and made anew from their stars; every other bar keeps its rest length,
+ * compliance and colour, and the new ones take the lowest colour free at
+ * both ends (in ascending node order).  The bar set equals
+ * cf_bars_build's; the colouring is a valid one, not the same.  Returns 0,
+ * or -1 when out of memory. */
+int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touched,
+                  cf_bars_scratch *w);
+
+/* Split the bars of a fragment among the k pieces it fell into (no bar
+ * joins two pieces): bar i goes to dst[piece_of_node[its first end]], in
+ * order and with its colour.  Returns 0, or -1 when out of memory. */
+int cf_bars_split(const cf_bars *src, const int *piece_of_node, int k, cf_bars *const *dst);
 
 /* One Gauss-Seidel sweep over the bars on s->p, colour after colour (in
  * parallel within a colour; the same bits for any thread count):

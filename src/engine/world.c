@@ -566,6 +566,8 @@ void cf_world_destroy(cf_world *sim)
     cf_obstacles_free(&sim->obs);
     free(sim->obstacle_body), free(sim->obstacle_moving);
     free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
+    free(sim->touched.v);
+    cf_bars_scratch_free(&sim->bar_scratch);
     free(sim->def.obstacles), free(sim->def.boundaries);
     if (sim->bullet)
         cfb_world_destroy(sim->bullet);
@@ -1208,6 +1210,10 @@ void cf_world_step_stats(const cf_world *sim, cf_step_stats *o)
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         o->tets += f->nt, o->nodes += f->nodes.n, o->bars += f->bars.n, o->cohesive += f->coh.n;
+        if (f->bars.color_start) {
+            o->colours = f->bars.n_colors > o->colours ? f->bars.n_colors : o->colours;
+            o->serial_bars += f->bars.n - f->bars.color_start[CF_BARS_COLORS];
+        }
     }
     o->iterations = set->constraints == CF_CONSTRAINTS_NONE ? 0 : set->iterations;
     o->check = set->criterion != CF_CRITERION_NONE;

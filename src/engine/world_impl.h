@@ -111,6 +111,8 @@ struct cf_world {
     int *tet_of_user;        /* [n_tets] the solid's tet of each input tet (the solid is
                                 renumbered for locality at load: renumber.h) */
     cf_int_list cand;        /* facets that qualify at a check (scratch of the step) */
+    cf_int_list touched;     /* nodes whose star the step's insertions changed (scratch) */
+    cf_bars_scratch bar_scratch; /* of cf_bars_patch */
     cf_initial_bounds bounds;/* taken at create */
     cf_event *ev;            /* events since the caller last drained them */
     int n_ev, cap_ev;
