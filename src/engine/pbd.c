@@ -173,41 +173,32 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
     return 0;
 }
 
+/* *p resized to cap elements of `size` bytes; on failure *p stays as it
+ * was (still owned by the caller).  0 or -1. */
+static int resize(void *p, size_t size, int cap)
+{
+    void *q = realloc(*(void **)p, (size_t)cap * size);
+    if (!q)
+        return -1;
+    *(void **)p = q;
+    return 0;
+}
+
 /* Room for `nodes` node flags and masks and `bars` new bars; 0 or -1. */
 static int scratch_reserve(cf_bars_scratch *w, int nodes, int bars)
 {
     if (nodes > w->node_cap) {
         int cap = nodes + nodes / 2 + 16;
-        unsigned char *f = realloc(w->flag, (size_t)cap);
-        if (!f)
+        if (resize(&w->flag, 1, cap) || resize(&w->mask, sizeof *w->mask, cap) ||
+            resize(&w->list, sizeof(int), cap))
             return -1;
-        memset(f + w->node_cap, 0, (size_t)(cap - w->node_cap));
-        w->flag = f;
-        uint64_t(*m)[2] = realloc(w->mask, (size_t)cap * sizeof *m);
-        int *l = realloc(w->list, (size_t)cap * sizeof(int));
-        if (m)
-            w->mask = m;
-        if (l)
-            w->list = l;
-        if (!m || !l)
-            return -1;
+        memset(w->flag + w->node_cap, 0, (size_t)(cap - w->node_cap));
         w->node_cap = cap;
     }
     if (bars > w->bar_cap) {
         int cap = bars + bars / 2 + 64;
-        int *e = realloc(w->ends, (size_t)cap * 2 * sizeof(int));
-        if (e)
-            w->ends = e;
-        double *r = realloc(w->rest, (size_t)cap * sizeof(double));
-        if (r)
-            w->rest = r;
-        double *c = realloc(w->compliance, (size_t)cap * sizeof(double));
-        if (c)
-            w->compliance = c;
-        unsigned char *k = realloc(w->colour, (size_t)cap);
-        if (k)
-            w->colour = k;
-        if (!e || !r || !c || !k)
+        if (resize(&w->ends, 2 * sizeof(int), cap) || resize(&w->rest, sizeof(double), cap) ||
+            resize(&w->compliance, sizeof(double), cap) || resize(&w->colour, 1, cap))
             return -1;
         w->bar_cap = cap;
     }
@@ -233,19 +224,8 @@ static int bars_reserve(cf_bars *b, int n)
     if (n <= b->cap)
         return 0;
     int cap = n + n / 8 + 64;
-    int *e = realloc(b->ends, (size_t)cap * 2 * sizeof(int));
-    if (e)
-        b->ends = e;
-    double *r = realloc(b->rest, (size_t)cap * sizeof(double));
-    if (r)
-        b->rest = r;
-    double *c = realloc(b->compliance, (size_t)cap * sizeof(double));
-    if (c)
-        b->compliance = c;
-    double *l = realloc(b->lambda, (size_t)cap * sizeof(double));
-    if (l)
-        b->lambda = l;
-    if (!e || !r || !c || !l)
+    if (resize(&b->ends, 2 * sizeof(int), cap) || resize(&b->rest, sizeof(double), cap) ||
+        resize(&b->compliance, sizeof(double), cap) || resize(&b->lambda, sizeof(double), cap))
         return -1;
     b->cap = cap;
     return 0;
