@@ -408,6 +408,10 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
     }
     int k = cf_label_components(s, tets, nt, comp);
+    if (k < 0) { /* (-1: out of memory; 0 components would empty the fragment) */
+        free(comp), free(seen);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
+    }
     /* A rigid fragment keeps no strain or cohesive energy. */
     sim->flow.handoff += f->e_strain + cf_cohesive_release(s, f->coh.v, f->coh.n);
     f->e_strain = 0;
