@@ -17,6 +17,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A failed bridge call as an error: out of memory inside Bullet is
+ * CF_ERR_NOMEM, anything else CF_ERR_EXTERNAL. */
+static cf_status bullet_error(cf_error *err, const char *what)
+{
+    const char *why = cfb_last_error();
+    return cf_error_set(err, strstr(why, "out of memory") ? CF_ERR_NOMEM : CF_ERR_EXTERNAL,
+                        "Bullet, %s: %s", what, why);
+}
+
 /* Place a body's mesh: x' = position + scale R (x - bbox centre). */
 static void place_mesh(cf_mesh *m, const cf_body_def *b)
 {
@@ -521,7 +530,7 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
         scene->solver.mode == CF_RUN_HYBRID) {
         sim->bullet = cfb_world_create(scene->gravity);
         if (!sim->bullet)
-            st = cf_error_set(err, CF_ERR_EXTERNAL, "Bullet world: %s", cfb_last_error());
+            st = bullet_error(err, "creating the world");
         else
             cfb_set_sleeping(sim->bullet, scene->solver.sleep_linear, scene->solver.sleep_angular);
     }
@@ -811,7 +820,12 @@ static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
     cf_status st = CF_OK;
     for (int pass = 0; st == CF_OK; pass++) {
         double t0 = cf_wall_time();
-        cfb_step(sim->bullet, dt, set->rigid_substeps);
+        /* Fails when Bullet ran out of memory, in this step or in an
+         * earlier call that could not say so (the world is then unusable). */
+        if (cfb_step(sim->bullet, dt, set->rigid_substeps) < 0) {
+            st = bullet_error(err, "the rigid step");
+            break;
+        }
         sim->prof.rigid += cf_wall_time() - t0;
         int hit = 0;
         for (int fi = 0; fi < n && st == CF_OK; fi++) {
