@@ -229,23 +229,28 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
     for (int t = 0; t < nt; t++)
         all[t] = t;
     int k = cf_label_components(s, all, nt, comp);
-    for (int c = 0; c < k; c++)
-        cf_fragment_new(sim, -1, 0.0);
-    for (int t = 0; t < nt; t++) {
+    int ok = k >= 0;
+    for (int c = 0; ok && c < k; c++)
+        ok = cf_fragment_new(sim, -1, 0.0) >= 0;
+    for (int t = 0; ok && t < nt; t++) {
         cf_fragment *f = &sim->frag[comp[t]];
-        if (!f->tets)
-            f->tets = malloc((size_t)nt * sizeof(int)); /* trimmed below */
+        if (!f->tets && !(f->tets = malloc((size_t)nt * sizeof(int)))) { /* trimmed below */
+            ok = 0;
+            break;
+        }
         f->tets[f->nt++] = t;
         s->tet_frag[t] = comp[t];
-        for (int j = 0; j < 4; j++) {
+        for (int j = 0; ok && j < 4; j++) {
             int a = s->tet[4 * t + j];
             if (!seen[a]) {
                 seen[a] = 1;
-                cf_int_list_push(&f->nodes, a);
+                ok = cf_int_list_push(&f->nodes, a) == 0;
             }
         }
     }
     free(all), free(comp), free(seen);
+    if (!ok) /* the fragments made so far are freed with the world */
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory finding the bodies' fragments");
 
     /* Initial velocity field: v = v_b + w_b x (x - x_com) + rate (.) (x - x_e). */
     for (int b = 0; b < def->n_bodies; b++) {
