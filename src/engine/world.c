@@ -971,7 +971,10 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
         cf_fragment *f = &sim->frag[fi];
         if (f->mode != CF_MODE_FRACTURE)
             continue;
-        sim->flow.contact -= cf_node_impulses_flush(sim, &f->push, f->nodes.v);
+        double gained;
+        if (cf_node_impulses_flush(sim, &f->push, f->nodes.v, &gained))
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory pushing rigid fragments");
+        sim->flow.contact -= gained;
         f->near.n = 0;
         char what[160];
         if (!nodes_sane(&sim->solid, f)) {
