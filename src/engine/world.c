@@ -1165,17 +1165,22 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->rigid = p->rigid, o->stress = p->stress, o->insertion = p->insertion;
     o->forces = p->forces, o->pbd = p->pbd, o->bodies = p->bodies, o->handoff = p->handoff;
     o->decompose = p->decompose;
-    /* Convex decomposition of the rigid fragments alive now: median and worst error. */
+    /* Convex decomposition of the rigid fragments alive now: median and worst
+     * error (NaN when there is no memory to sort them: unknown, not 0). */
     double *e = malloc((size_t)(sim->n_frag + 1) * sizeof(double));
     int n = 0;
-    for (int fi = 0; e && fi < sim->n_frag; fi++) {
+    for (int fi = 0; fi < sim->n_frag; fi++) {
         const cf_fragment *f = &sim->frag[fi];
         if (f->mode == CF_MODE_RIGID && f->body >= 0) {
-            e[n++] = cf_hulls_error(&f->hulls);
+            if (e)
+                e[n] = cf_hulls_error(&f->hulls);
+            n++;
             o->hulls += f->hulls.n_hulls;
         }
     }
-    if (n > 0) {
+    if (n > 0 && !e) {
+        o->hull_error_median = o->hull_error_worst = NAN;
+    } else if (n > 0) {
         qsort(e, (size_t)n, sizeof *e, by_value);
         o->hull_error_median = n % 2 ? e[n / 2] : 0.5 * (e[n / 2 - 1] + e[n / 2]);
         o->hull_error_worst = e[n - 1];
