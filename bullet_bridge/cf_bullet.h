@@ -57,7 +57,8 @@ int cfb_add_hull_body(cfb_world *w, double mass, const double inertia[3], const 
  * The vertices are input points, copied bit for bit.  Points within
  * round-off of a face may or may not count as vertices.
  * Returns the number of hull vertices, or -1 on bad arguments (n < 1,
- * NULL or non-finite points). */
+ * NULL or non-finite points) or when Bullet runs out of memory
+ * (cfb_last_error says which). */
 int cfb_convex_hull(const double *pts, int n, double *out, double *volume);
 
 /* Dynamic body whose collision shape is a compound of convex hulls (a
@@ -141,7 +142,9 @@ void cfb_ignore_pair(cfb_world *w, int a, int b);
 int cfb_set_family(cfb_world *w, int id, int family);
 
 /* Advance by dt seconds in `substeps` equal fixed sub-steps (Bullet's
- * semi-implicit Euler).  Returns 0, or -1 on bad arguments. */
+ * semi-implicit Euler).  Returns 0, or -1 on bad arguments or when Bullet
+ * ran out of memory, in this call or in an earlier one that could not
+ * return an error (cfb_last_error says which; the world is then unusable). */
 int cfb_step(cfb_world *w, double dt, int substeps);
 
 /* Sum of normal contact impulses (N s) applied to body `id` during the last

@@ -306,7 +306,8 @@ typedef struct cf_world_stats {
     int handoffs;
     double max_momentum_error, handoff_loss; /* relative; J */
     int rigid_with_hulls, hulls;        /* Bullet bodies alive and their hulls */
-    double hull_error_median, hull_error_worst; /* hull volume / tet volume - 1 */
+    double hull_error_median, hull_error_worst; /* hull volume / tet volume - 1 (NaN:
+                                                 * no memory to sort them) */
     double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s */
 } cf_world_stats;
 

@@ -142,6 +142,14 @@ static int fail(const cf_error *e)
     return cf_status_exit_code(e->code);
 }
 
+/* The front end's own allocations (argument lists) failing. */
+static int out_of_memory(const char *what)
+{
+    cf_error e;
+    cf_error_set(&e, CF_ERR_NOMEM, "out of memory %s", what);
+    return fail(&e);
+}
+
 /* The subcommand being parsed, for usage errors. */
 static const char *current = NULL;
 
@@ -308,6 +316,8 @@ static int parse_scene_args(int argc, char **argv, const char *cmd, scene_args *
     char msg[64];
     memset(a, 0, sizeof *a);
     a->sets = calloc((size_t)argc + 2, sizeof *a->sets);
+    if (!a->sets)
+        return out_of_memory("reading the command line");
     a->mesh_dir = cf_default_mesh_dir();
     a->progress = 1;
     int c;
@@ -346,6 +356,10 @@ static int cmd_run(int argc, char **argv)
         if (a.output[0] && a.output[0] != '/' && !getcwd(cwd, sizeof cwd))
             cwd[0] = '\0';
         out_set = malloc(strlen(cwd) + strlen(a.output) + 32);
+        if (!out_set) {
+            free(a.sets);
+            return out_of_memory("reading the command line");
+        }
         sprintf(out_set, "output.file=[==[%s%s%s]==]", cwd, cwd[0] ? "/" : "", a.output);
         memmove(&a.sets[a.output_at + 1], &a.sets[a.output_at],
                 (size_t)(a.n_sets - a.output_at) * sizeof *a.sets);
@@ -441,6 +455,10 @@ static int cmd_study(int argc, char **argv)
     const char **vary = calloc((size_t)argc, sizeof *vary);
     const char **ref = calloc((size_t)argc, sizeof *ref);
     const char **sets = calloc((size_t)argc, sizeof *sets);
+    if (!vary || !ref || !sets) {
+        free(vary), free(ref), free(sets);
+        return out_of_memory("reading the command line");
+    }
     cf_study_options o = {.progress = 1, .plot = 1, .jobs = 1};
     o.mesh_dir = cf_default_mesh_dir();
     int c, rc = 0;
@@ -553,6 +571,8 @@ static int cmd_bench(int argc, char **argv)
     cf_error err = {0};
     if (scaling) {
         char *list = strdup(scaling), *save = NULL;
+        if (!list)
+            return out_of_memory("reading the command line");
         const char *meshes[32];
         int n = 0;
         for (char *t = strtok_r(list, ",", &save); t && n < 32; t = strtok_r(NULL, ",", &save))
@@ -662,7 +682,41 @@ static int asks(int argc, char **argv, const char *a, const char *b)
     return 0;
 }
 
+/* Set once main returns: an exit() before then is a library's. */
+static volatile sig_atomic_t main_returned = 0;
+
+/* Some libraries end the process themselves when an allocation fails,
+ * instead of returning an error: libgomp (gomp_malloc: "out of memory
+ * allocating N bytes", or a thread it cannot start) with exit(1), and
+ * HDF5 1.10 (its identifier table) with exit(-1), silently.  Status 1
+ * means a bad command line here and 255 means nothing.  Registered first,
+ * this runs first of the exit handlers: it says what happened and ends
+ * with exit code 5 at once (_exit: other threads are still running, and
+ * destructors run under them could crash).  The output file is then as
+ * after SIGKILL: every frame written is whole. */
+static void library_exit(void)
+{
+    static const char msg[] =
+        "cohfrac: error [CF_ERR_EXTERNAL]: a library ended the process itself (libgomp and "
+        "HDF5 do so when out of memory; libgomp also when it cannot start a thread; its "
+        "message, if it gave one, is above)\n";
+    if (main_returned)
+        return;
+    if (write(2, msg, sizeof msg - 1) < 0) { /* nothing more to say it with */ }
+    _exit(cf_status_exit_code(CF_ERR_EXTERNAL));
+}
+
+static int dispatch(int argc, char **argv);
+
 int main(int argc, char **argv)
+{
+    atexit(library_exit);
+    int rc = dispatch(argc, argv);
+    main_returned = 1;
+    return rc;
+}
+
+static int dispatch(int argc, char **argv)
 {
     static const struct {
         const char *name;

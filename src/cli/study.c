@@ -87,7 +87,9 @@ static cf_status parse_axis(const char *spec, axis *a, cf_error *err)
         else if ((*c == ',' && depth == 0) || !*c) {
             if (c == start)
                 return cf_error_set(err, CF_ERR_USAGE, "--vary '%s': empty value", spec);
-            a->values[a->n++] = strndup(start, (size_t)(c - start));
+            if (!(a->values[a->n] = strndup(start, (size_t)(c - start))))
+                return cf_error_set(err, CF_ERR_NOMEM, "--vary '%s': out of memory", spec);
+            a->n++;
             start = c + 1;
             if (!*c)
                 break;

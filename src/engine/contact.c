@@ -250,12 +250,16 @@ typedef struct {
     int hit;
 } push_sum;
 
-double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes)
+int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes, double *energy)
 {
     int n = sim->n_frag;
-    push_sum *sum = calloc((size_t)n, sizeof *sum);
+    /* Without the sums the pushes could not be bounded: an error, not
+     * unbounded impulses. */
+    push_sum *sum = calloc((size_t)n + 1, sizeof *sum);
+    if (!sum)
+        return -1;
     double gained = 0, bounce = 1.0 + sim->solid.mat.restitution;
-    for (int i = 0; sum && i < ni->n; i++) {
+    for (int i = 0; i < ni->n; i++) {
         int g = ni->frag[i];
         if (g < 0 || sim->frag[g].body < 0)
             continue;
@@ -264,7 +268,7 @@ double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *no
         sum[g].hit = 1;
     }
     for (int g = 0; g < n; g++) {
-        if (!sum || !sum[g].hit)
+        if (!sum[g].hit)
             continue;
         cfb_state st;
         cfb_get_state(sim->bullet, sim->frag[g].body, &st);
@@ -279,7 +283,7 @@ double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *no
         if (g < 0)
             continue;
         cf_fragment *o = &sim->frag[g];
-        double beta = sum ? sum[g].beta : 1.0;
+        double beta = sum[g].beta;
         double J[3] = {-beta * ni->J[3 * i], -beta * ni->J[3 * i + 1], -beta * ni->J[3 * i + 2]};
         if (o->body >= 0) {
             cfb_apply_impulse(sim->bullet, o->body, J, &ni->point[3 * i]);
@@ -296,7 +300,7 @@ double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *no
         memset(&ni->J[3 * i], 0, 3 * sizeof(double));
     }
     for (int g = 0; g < n; g++) { /* the spin the pushes gave, bounded likewise */
-        if (!sum || !sum[g].hit)
+        if (!sum[g].hit)
             continue;
         const cf_fragment *o = &sim->frag[g];
         cfb_state st;
@@ -317,5 +321,6 @@ double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *no
         gained += cf_body_kinetic_energy(sim, g);
     }
     free(sum);
-    return gained;
+    *energy = gained;
+    return 0;
 }

@@ -68,8 +68,7 @@ void cf_node_impulses_free(cf_node_impulses *ni);
 
 /* Apply minus each node's accumulated impulse to the body it pushed, at its
  * contact point, add its size to the body fragment's `pushed`, and clear the
- * record (nodes[i]: the node id of record i).  Returns the kinetic energy
- * the bodies gained, J.
+ * record (nodes[i]: the node id of record i).
  * A body's hull stays where the rigid step left it while the fracture-mode
  * nodes push it for the whole rigid step, as if it were a wall; a light
  * body would take the push of a heavy fragment for the whole step (measured:
@@ -80,8 +79,10 @@ void cf_node_impulses_free(cf_node_impulses *ni);
  * the spin they give it holds at most 1/2 M ((1 + e) V)^2 of energy.  The
  * part of a node's impulse its body does not take is taken back from the
  * node's velocity, so that linear momentum is kept; the spin's bound is not
- * given back (angular momentum is not kept where it acts). */
-double cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes);
+ * given back (angular momentum is not kept where it acts).  The energy the
+ * bodies gained goes to *energy (J).  Returns 0, or -1 out of memory
+ * (nothing applied). */
+int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes, double *energy);
 
 /* The boundary of a fracture-mode fragment as a deforming triangle mesh:
  * the faces of its tets used by one of its tets only (crack faces opened by

@@ -45,7 +45,8 @@ static double side(const double *pl, const double x[3]) { return v3_dot(pl, x) -
 /* Clip the convex point set q[k] by the half-space pl: keep the points
  * inside, add where each segment between an inside and an outside point
  * crosses the plane (the vertices of the cut are among these).  Returns the
- * new count, reduced to the hull's vertices when it grows large. */
+ * new count, reduced to the hull's vertices when it grows large, or -1 when
+ * Bullet runs out of memory for that hull (the points are finite). */
 static int clip(double *q, int k, const double *pl, double *tmp)
 {
     double s[CLIP_MAX];
@@ -65,8 +66,7 @@ static int clip(double *q, int k, const double *pl, double *tmp)
             }
     if (m > 16) {
         double v;
-        int nv = cfb_convex_hull(tmp, m, q, &v);
-        return nv > 0 ? nv : 0;
+        return cfb_convex_hull(tmp, m, q, &v);
     }
     memcpy(q, tmp, (size_t)m * 3 * sizeof(double));
     return m;
@@ -74,7 +74,9 @@ static int clip(double *q, int k, const double *pl, double *tmp)
 
 /* The points and volume of tet t inside the cell: its 4 nodes when it lies
  * inside every plane; otherwise its clipped vertices.  Returns the count
- * written to q (CLIP_MAX capacity), 0 when nothing is inside. */
+ * written to q (CLIP_MAX capacity), 0 when nothing is inside, -1 when
+ * Bullet runs out of memory (a part dropped or a volume unset would
+ * silently make a wrong hull). */
 static int tet_in_cell(const cf_solid *s, int t, const cluster *c, double *q, double *tmp,
                        double *volume, int *whole)
 {
@@ -90,12 +92,15 @@ static int tet_in_cell(const cf_solid *s, int t, const cluster *c, double *q, do
         if (out) {
             *whole = 0;
             k = clip(q, k, pl, tmp);
+            if (k < 0)
+                return -1;
         }
     }
     if (*whole) {
         *volume = s->vol[t];
     } else if (k >= 4) {
-        cfb_convex_hull(q, k, NULL, volume);
+        if (cfb_convex_hull(q, k, NULL, volume) < 0)
+            return -1;
     } else {
         *volume = 0;
     }
@@ -114,6 +119,8 @@ static int cluster_hull(const cf_solid *s, cluster *c, int *stamp, int mark, dou
         int t = c->tets[i], whole;
         double v;
         int k = tet_in_cell(s, t, c, q, tmp, &v, &whole);
+        if (k < 0)
+            return -1;
         c->tet_volume += v;
         if (n + k > *cap) {
             int nc = 2 * (n + k);
@@ -169,6 +176,10 @@ static int split(const cf_solid *s, cluster *c, cluster *d)
     for (int i = 0; i < n; i++) {
         double v;
         int whole, m = tet_in_cell(s, c->tets[i], c, q, tmp, &v, &whole);
+        if (m < 0) {
+            free(k), free(cen), free(lo), free(hi), free(pc), free(pd);
+            return -1;
+        }
         cen[3 * i] = cen[3 * i + 1] = cen[3 * i + 2] = 0;
         for (int j = 0; j < m; j++)
             v3_axpy(1.0 / m, &q[3 * j], &cen[3 * i]);

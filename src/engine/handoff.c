@@ -444,9 +444,9 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
     }
     int k = cf_label_components(s, tets, nt, comp);
-    int *cstart = NULL, *grouped = group_by_component(tets, comp, nt, k, &cstart);
+    int *cstart = NULL, *grouped = k < 1 ? NULL : group_by_component(tets, comp, nt, k, &cstart);
     free(comp);
-    if (!grouped) {
+    if (!grouped) { /* k -1: out of memory; 0 components would empty the fragment */
         free(seen);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
     }

@@ -121,9 +121,14 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
         }
     free(seen);
     int big = nn >= CF_NODES_PARALLEL_MIN;
+    /* Each loop runs only when everything before it worked: inside it rc
+     * is each thread's copy for the reduction, which starts at 0, so a
+     * test of rc there cannot see an earlier failure. */
+    if (rc == 0) {
 #pragma omp parallel for schedule(static) reduction(| : rc) if (big)
-    for (int i = 0; i < nn; i++)
-        rc |= fill_node(s, nodes[i], NULL, NULL, NULL, NULL, 0, &start[i + 1]);
+        for (int i = 0; i < nn; i++)
+            rc |= fill_node(s, nodes[i], NULL, NULL, NULL, NULL, 0, &start[i + 1]);
+    }
     int n = 0;
     if (rc == 0) {
         start[0] = 0;
@@ -140,11 +145,12 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
     int *color_start = calloc(CF_BARS_COLORS + 2, sizeof(int));
     if (rc || !ends || !e2 || !rest || !r2 || !compliance || !c2 || !lambda || !col || !color_start)
         rc = -1;
+    if (rc == 0) {
 #pragma omp parallel for schedule(static) reduction(| : rc) if (big)
-    for (int i = 0; i < nn; i++) {
-        int m;
-        if (rc == 0)
+        for (int i = 0; i < nn; i++) {
+            int m;
             rc |= fill_node(s, nodes[i], NULL, ends, rest, compliance, start[i], &m);
+        }
     }
     int groups = rc ? -1 : colour(ends, n, s->n_nodes, col);
     if (groups < 0)

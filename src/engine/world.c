@@ -17,6 +17,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A failed bridge call as an error: out of memory inside Bullet is
+ * CF_ERR_NOMEM, anything else CF_ERR_EXTERNAL. */
+static cf_status bullet_error(cf_error *err, const char *what)
+{
+    const char *why = cfb_last_error();
+    return cf_error_set(err, strstr(why, "out of memory") ? CF_ERR_NOMEM : CF_ERR_EXTERNAL,
+                        "Bullet, %s: %s", what, why);
+}
+
 /* Place a body's mesh: x' = position + scale R (x - bbox centre). */
 static void place_mesh(cf_mesh *m, const cf_body_def *b)
 {
@@ -220,23 +229,28 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
     for (int t = 0; t < nt; t++)
         all[t] = t;
     int k = cf_label_components(s, all, nt, comp);
-    for (int c = 0; c < k; c++)
-        cf_fragment_new(sim, -1, 0.0);
-    for (int t = 0; t < nt; t++) {
+    int ok = k >= 0;
+    for (int c = 0; ok && c < k; c++)
+        ok = cf_fragment_new(sim, -1, 0.0) >= 0;
+    for (int t = 0; ok && t < nt; t++) {
         cf_fragment *f = &sim->frag[comp[t]];
-        if (!f->tets)
-            f->tets = malloc((size_t)nt * sizeof(int)); /* trimmed below */
+        if (!f->tets && !(f->tets = malloc((size_t)nt * sizeof(int)))) { /* trimmed below */
+            ok = 0;
+            break;
+        }
         f->tets[f->nt++] = t;
         s->tet_frag[t] = comp[t];
-        for (int j = 0; j < 4; j++) {
+        for (int j = 0; ok && j < 4; j++) {
             int a = s->tet[4 * t + j];
             if (!seen[a]) {
                 seen[a] = 1;
-                cf_int_list_push(&f->nodes, a);
+                ok = cf_int_list_push(&f->nodes, a) == 0;
             }
         }
     }
     free(all), free(comp), free(seen);
+    if (!ok) /* the fragments made so far are freed with the world */
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory finding the bodies' fragments");
 
     /* Initial velocity field: v = v_b + w_b x (x - x_com) + rate (.) (x - x_e). */
     for (int b = 0; b < def->n_bodies; b++) {
@@ -521,7 +535,7 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
         scene->solver.mode == CF_RUN_HYBRID) {
         sim->bullet = cfb_world_create(scene->gravity);
         if (!sim->bullet)
-            st = cf_error_set(err, CF_ERR_EXTERNAL, "Bullet world: %s", cfb_last_error());
+            st = bullet_error(err, "creating the world");
         else
             cfb_set_sleeping(sim->bullet, scene->solver.sleep_linear, scene->solver.sleep_angular);
     }
@@ -813,7 +827,12 @@ static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
     cf_status st = CF_OK;
     for (int pass = 0; st == CF_OK; pass++) {
         double t0 = cf_wall_time();
-        cfb_step(sim->bullet, dt, set->rigid_substeps);
+        /* Fails when Bullet ran out of memory, in this step or in an
+         * earlier call that could not say so (the world is then unusable). */
+        if (cfb_step(sim->bullet, dt, set->rigid_substeps) < 0) {
+            st = bullet_error(err, "the rigid step");
+            break;
+        }
         sim->prof.rigid += cf_wall_time() - t0;
         int hit = 0;
         for (int fi = 0; fi < n && st == CF_OK; fi++) {
@@ -954,7 +973,10 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
         cf_fragment *f = &sim->frag[fi];
         if (f->mode != CF_MODE_FRACTURE)
             continue;
-        sim->flow.contact -= cf_node_impulses_flush(sim, &f->push, f->nodes.v);
+        double gained;
+        if (cf_node_impulses_flush(sim, &f->push, f->nodes.v, &gained))
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory pushing rigid fragments");
+        sim->flow.contact -= gained;
         f->near.n = 0;
         char what[160];
         if (!nodes_sane(&sim->solid, f)) {
@@ -1145,17 +1167,22 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->rigid = p->rigid, o->stress = p->stress, o->insertion = p->insertion;
     o->forces = p->forces, o->pbd = p->pbd, o->bodies = p->bodies, o->handoff = p->handoff;
     o->decompose = p->decompose;
-    /* Convex decomposition of the rigid fragments alive now: median and worst error. */
+    /* Convex decomposition of the rigid fragments alive now: median and worst
+     * error (NaN when there is no memory to sort them: unknown, not 0). */
     double *e = malloc((size_t)(sim->n_frag + 1) * sizeof(double));
     int n = 0;
-    for (int fi = 0; e && fi < sim->n_frag; fi++) {
+    for (int fi = 0; fi < sim->n_frag; fi++) {
         const cf_fragment *f = &sim->frag[fi];
         if (f->mode == CF_MODE_RIGID && f->body >= 0) {
-            e[n++] = cf_hulls_error(&f->hulls);
+            if (e)
+                e[n] = cf_hulls_error(&f->hulls);
+            n++;
             o->hulls += f->hulls.n_hulls;
         }
     }
-    if (n > 0) {
+    if (n > 0 && !e) {
+        o->hull_error_median = o->hull_error_worst = NAN;
+    } else if (n > 0) {
         qsort(e, (size_t)n, sizeof *e, by_value);
         o->hull_error_median = n % 2 ? e[n / 2] : 0.5 * (e[n / 2 - 1] + e[n / 2]);
         o->hull_error_worst = e[n - 1];

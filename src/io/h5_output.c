@@ -15,7 +15,13 @@
  *     monitoring script) can open the file read-only while the run goes on.
  *   - HDF5's automatic error printing is switched off for the duration of
  *     each call (and restored after); failures become CF_ERR_OUTPUT with a
- *     message naming the file, the step that failed and HDF5's own reason.
+ *     message naming the file, the step that failed and HDF5's own reason,
+ *     or CF_ERR_NOMEM when that reason is a failed allocation.
+ *   - The layout is written under a temporary name and renamed into place
+ *     once flushed, so the output's name never holds a half-made file.
+ *   - After a failed write the close first cuts every table back to what
+ *     the last successful flush left, so a run that ends on an error leaves
+ *     the same whole frames a SIGKILL at that flush would have.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -123,6 +129,7 @@ typedef struct observable {
     char *name;
     hid_t step, time, value;
     hsize_t n;
+    hsize_t flushed; /* samples on disk at the last flush */
 } observable;
 
 /* What the XDMF sidecar needs to know about one written frame. */
@@ -146,6 +153,11 @@ struct cf_h5 {
     hsize_t nsurface;
     hid_t map_step, map_time, map_value; /* /mesh/tet_fragment, created on first use */
     hsize_t nmaps;
+    /* Rows on disk at the last flush (frames, fragments and hand-offs are
+     * counted only once flushed); `failed`: a write failed since then, and
+     * the close puts every table back to these (see rollback). */
+    hsize_t ncracks_flushed, nsurface_flushed, nmaps_flushed;
+    int failed;
     hid_t obs_group;
 
     hsize_t nframes, ncols, nfragments, nhandoffs;
@@ -169,16 +181,34 @@ struct cf_h5 {
 
 #define REASON_LEN 400
 
+typedef struct h5_reason {
+    char text[REASON_LEN];
+    int memory; /* an allocation failed somewhere down the stack */
+} h5_reason;
+
 /* Walking upward, entry 0 is the innermost and most specific error (for a
- * failed create it carries errno's text). */
-static herr_t innermost_error(unsigned n, const H5E_error2_t *e, void *data)
+ * failed create it carries errno's text).  HDF5 files a failed memory
+ * allocation under minor H5E_NOSPACE ("no space available for
+ * allocation"), or under H5E_CANTALLOC with a description that says memory
+ * ("memory allocation failed for on disk image buffer"; H5E_CANTALLOC
+ * alone also covers file space); a full disk comes as a write error with
+ * errno's text instead. */
+static herr_t walk_error(unsigned n, const H5E_error2_t *e, void *data)
 {
-    if (n == 0 && e && e->desc)
-        snprintf((char *)data, REASON_LEN, "%s", e->desc);
+    h5_reason *r = data;
+    if (!e)
+        return 0;
+    if (n == 0 && e->desc)
+        snprintf(r->text, REASON_LEN, "%s", e->desc);
+    if (e->min_num == H5E_NOSPACE ||
+        (e->min_num == H5E_CANTALLOC && e->desc && strstr(e->desc, "memory")))
+        r->memory = 1;
     return 0;
 }
 
-/* Turn the current HDF5 error stack into a CF_ERR_OUTPUT message. */
+/* Turn the current HDF5 error stack into a message: CF_ERR_NOMEM when an
+ * allocation failed (HDF5 says so, or, when it could not even record its
+ * error, errno says ENOMEM), CF_ERR_OUTPUT otherwise. */
 static cf_status h5_fail(cf_error *err, const char *path, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
@@ -187,18 +217,46 @@ static cf_status h5_fail(cf_error *err, const char *path, const char *fmt, ...)
 
 static cf_status h5_fail(cf_error *err, const char *path, const char *fmt, ...)
 {
+    int saved_errno = errno;
     char what[256];
-    char reason[REASON_LEN] = "";
+    h5_reason r = {"", 0};
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(what, sizeof what, fmt, ap);
     va_end(ap);
-    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost_error, reason);
+    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, walk_error, &r);
     H5Eclear2(H5E_DEFAULT);
-    if (reason[0])
+    if (r.memory || (!r.text[0] && saved_errno == ENOMEM))
+        return cf_error_set(err, CF_ERR_NOMEM, "output file '%s': out of memory %s%s%s%s", path,
+                            what, r.text[0] ? " (HDF5: " : "", r.text, r.text[0] ? ")" : "");
+    if (r.text[0])
         return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': %s failed (HDF5: %s)", path,
-                            what, reason);
+                            what, r.text);
     return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': %s failed", path, what);
+}
+
+/* H5Fflush, or its error.  HDF5 writes its metadata entry by entry: one
+ * that runs out of memory part way may have written some and not the rest
+ * (the superblock's end of file among them), and the file may then not
+ * open; the message says so. */
+static cf_status flush_file(cf_h5 *h, cf_error *err, const char *what)
+{
+    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) >= 0) {
+        for (size_t i = 0; i < h->nobs; ++i)
+            h->obs[i].flushed = h->obs[i].n;
+        h->ncracks_flushed = h->ncracks;
+        h->nsurface_flushed = h->nsurface;
+        h->nmaps_flushed = h->nmaps;
+        h->failed = 0;
+        return CF_OK;
+    }
+    cf_status st = h5_fail(err, h->path, "%s", what);
+    if (st == CF_ERR_NOMEM && err) {
+        size_t n = strlen(err->msg);
+        snprintf(err->msg + n, sizeof err->msg - n,
+                 "; HDF5 may have written part of its metadata, and the file may not open");
+    }
+    return st;
 }
 
 static cf_status no_memory(cf_error *err, const char *path)
@@ -644,8 +702,9 @@ static cf_status write_row_group(cf_h5 *h, const char *name, const column_def *c
     return ok ? CF_OK : h5_fail(err, h->path, "creating /%s", name);
 }
 
-static cf_status build_layout(cf_h5 *h, const char *scene_name, const char *scene_text,
-                              cf_error *err)
+/* The file's layout, created as `file_name` (the output's temporary name). */
+static cf_status build_layout(cf_h5 *h, const char *file_name, const char *scene_name,
+                              const char *scene_text, cf_error *err)
 {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     if (fapl < 0)
@@ -655,7 +714,7 @@ static cf_status build_layout(cf_h5 *h, const char *scene_name, const char *scen
      * run goes on (to watch progress); it sees the state of the last flush. */
     H5Pset_file_locking(fapl, 0, 1);
 #endif
-    h->file = H5Fcreate(h->path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    h->file = H5Fcreate(file_name, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
     H5Pclose(fapl);
     if (h->file < 0)
         return h5_fail(err, h->path, "creating the file");
@@ -694,12 +753,10 @@ static cf_status build_layout(cf_h5 *h, const char *scene_name, const char *scen
     h->obs_group = make_group(h->file, "observables");
     if (h->obs_group < 0)
         return h5_fail(err, h->path, "creating /observables");
-    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
-        return h5_fail(err, h->path, "flushing the new file");
-    return CF_OK;
+    return flush_file(h, err, "flushing the new file");
 }
 
-static void h5_init_once(void);
+static int h5_init_once(void);
 
 static cf_status open_impl(const char *path, const char *scene_name, const char *scene_text,
                            cf_h5 **out, cf_error *err)
@@ -721,27 +778,47 @@ static cf_status open_impl(const char *path, const char *scene_name, const char 
     if (stat(path, &sb) == 0 && access(path, W_OK) != 0)
         return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s' cannot be written: %s", path,
                             strerror(errno));
-    int fd = open(path, O_WRONLY | O_CREAT, 0644); /* HDF5 truncates it next */
-    if (fd < 0)
-        return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s' cannot be created: %s", path,
-                            strerror(errno));
-    close(fd);
+    /* The layout is written under a temporary name beside the output and
+     * moved into place once flushed: a process ended while HDF5 writes it
+     * (SIGKILL; HDF5 itself calling exit() when out of memory) leaves no
+     * half-written file under the output's name, and an earlier output
+     * stays until the new one is whole.  A layout that fails (out of
+     * memory, a full disk) leaves nothing. */
     cf_h5 *h = calloc(1, sizeof *h);
     if (!h)
         return no_memory(err, path);
     init_handles(h);
     h->path = strdup(path);
-    if (!h->path) {
-        free(h);
+    size_t tmp_len = strlen(path) + 32;
+    char *tmp = malloc(tmp_len);
+    if (!h->path || !tmp) {
+        free(tmp);
+        free_handle(h);
         return no_memory(err, path);
     }
-    st = build_layout(h, scene_name, scene_text, err);
-    if (st != CF_OK) {
-        close_handles(h);
-        H5Eclear2(H5E_DEFAULT);
+    snprintf(tmp, tmp_len, "%s.%ld.tmp", path, (long)getpid());
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) {
+        st = cf_error_set(err, CF_ERR_OUTPUT, "output file '%s' cannot be created: %s", path,
+                          strerror(errno));
+        free(tmp);
         free_handle(h);
         return st;
     }
+    close(fd);
+    st = build_layout(h, tmp, scene_name, scene_text, err);
+    if (st == CF_OK && rename(tmp, path) != 0)
+        st = cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': cannot move '%s' to it: %s",
+                          path, tmp, strerror(errno));
+    if (st != CF_OK) {
+        close_handles(h);
+        H5Eclear2(H5E_DEFAULT);
+        unlink(tmp);
+        free(tmp);
+        free_handle(h);
+        return st;
+    }
+    free(tmp);
     *out = h;
     return CF_OK;
 }
@@ -749,8 +826,14 @@ static cf_status open_impl(const char *path, const char *scene_name, const char 
 cf_status cf_h5_open(const char *path, const char *scene_name, const char *scene_text,
                      cf_h5 **out, cf_error *err)
 {
-    h5_init_once(); /* before any HDF5 call, quiet_begin's included */
     quiet_state q;
+    /* before any HDF5 call, quiet_begin's included */
+    if (h5_init_once() < 0) {
+        quiet_begin(&q);
+        cf_status st = h5_fail(err, path, "starting HDF5");
+        quiet_end(&q);
+        return st;
+    }
     quiet_begin(&q);
     cf_status st = open_impl(path, scene_name, scene_text, out, err);
     quiet_end(&q);
@@ -858,8 +941,11 @@ static cf_status write_frame_impl(cf_h5 *h, long step, double time, const cf_fra
         return h5_fail(err, h->path, "appending to /particles/fragments/id/time");
     if (append_rows(h->step, T, 1, H5T_NATIVE_INT64, &step64) < 0)
         return h5_fail(err, h->path, "appending to /particles/fragments/id/step");
-    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
-        return h5_fail(err, h->path, "flushing frame %llu", (unsigned long long)T);
+    char what[64];
+    snprintf(what, sizeof what, "flushing frame %llu", (unsigned long long)T);
+    cf_status st = flush_file(h, err, what);
+    if (st != CF_OK)
+        return st;
 
     frame_record *r = &h->frames[T];
     r->time = time;
@@ -880,6 +966,8 @@ cf_status cf_h5_write_frame(cf_h5 *h, long step, double time, const cf_frag_fram
     quiet_state q;
     quiet_begin(&q);
     cf_status st = write_frame_impl(h, step, time, frags, n, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
     quiet_end(&q);
     return st;
 }
@@ -942,8 +1030,9 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
         if (append_rows(h->fragment[c], h->nfragments, un, mem_type(&FRAGMENT_COLUMNS[c]),
                         bufs[c]) < 0)
             return h5_fail(err, h->path, "appending to /fragments/%s", FRAGMENT_COLUMNS[c].name);
-    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
-        return h5_fail(err, h->path, "flushing /fragments");
+    cf_status st = flush_file(h, err, "flushing /fragments");
+    if (st != CF_OK)
+        return st;
     h->nfragments += un;
     return CF_OK;
 }
@@ -953,6 +1042,8 @@ cf_status cf_h5_add_fragments(cf_h5 *h, const cf_frag_info *info, int n, cf_erro
     quiet_state q;
     quiet_begin(&q);
     cf_status st = add_fragments_impl(h, info, n, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
     quiet_end(&q);
     return st;
 }
@@ -985,7 +1076,7 @@ static cf_status create_observable(cf_h5 *h, const char *name, const char *unit,
     if (!o->name)
         return no_memory(err, h->path);
     o->step = o->time = o->value = H5I_INVALID_HID;
-    o->n = 0;
+    o->n = o->flushed = 0;
     hid_t g = make_group(h->obs_group, name);
     if (g >= 0) {
         o->step = create_rows(g, "step", H5T_STD_I64LE, 1);
@@ -1000,7 +1091,12 @@ static cf_status create_observable(cf_h5 *h, const char *name, const char *unit,
         close_dataset(&o->time, &ignored);
         close_dataset(&o->value, &ignored);
         free(o->name);
-        return h5_fail(err, h->path, "creating /observables/%s", name);
+        cf_status st = h5_fail(err, h->path, "creating /observables/%s", name);
+        /* No half-made series left in the file (a group without its value). */
+        if (g >= 0)
+            H5Ldelete(h->obs_group, name, H5P_DEFAULT);
+        H5Eclear2(H5E_DEFAULT);
+        return st;
     }
     h->obs_last = h->nobs++;
     *out = o;
@@ -1041,6 +1137,8 @@ cf_status cf_h5_write_observable(cf_h5 *h, const char *name, const char *unit, l
     quiet_state q;
     quiet_begin(&q);
     cf_status st = write_observable_impl(h, name, unit, step, time, value, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
     quiet_end(&q);
     return st;
 }
@@ -1107,8 +1205,9 @@ static cf_status add_handoff_impl(cf_h5 *h, const cf_handoff_record *r, cf_error
         if (append_rows(h->handoff[c], h->nhandoffs, 1, mem_type(&HANDOFF_COLUMNS[c]), bufs[c]) <
             0)
             return h5_fail(err, h->path, "appending to /handoffs/%s", HANDOFF_COLUMNS[c].name);
-    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
-        return h5_fail(err, h->path, "flushing /handoffs");
+    cf_status st = flush_file(h, err, "flushing /handoffs");
+    if (st != CF_OK)
+        return st;
     h->nhandoffs++;
     return CF_OK;
 }
@@ -1161,6 +1260,8 @@ cf_status cf_h5_add_cracks(cf_h5 *h, const cf_crack_row *rows, int n, cf_error *
     quiet_state q;
     quiet_begin(&q);
     cf_status st = add_cracks_impl(h, rows, n, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
     quiet_end(&q);
     return st;
 }
@@ -1170,6 +1271,8 @@ cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
     quiet_state q;
     quiet_begin(&q);
     cf_status st = add_handoff_impl(h, r, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
     quiet_end(&q);
     return st;
 }
@@ -1179,19 +1282,25 @@ cf_status cf_h5_add_handoff(cf_h5 *h, const cf_handoff_record *r, cf_error *err)
 /* HDF5 closes what is still open when the process exits; after a failed
  * close (a full disk) that second attempt crashes inside HDF5 (SIGSEGV in
  * H5F__close_cb).  Every file this writer opens is closed by cf_h5_close,
- * so the exit-time clean-up is turned off before HDF5's first use. */
-static void h5_init_once(void)
+ * so the exit-time clean-up is turned off before HDF5's first use.  Then
+ * HDF5 is started (H5open): it allocates its tables on first use, and
+ * when that fails every later call fails with a misleading reason ("not a
+ * property list class").  Returns 0, or -1 when it could not start (its
+ * error stack says why). */
+static int h5_init_once(void)
 {
     static int done = 0;
     if (!done) {
         done = 1;
         H5dont_atexit();
     }
+    return H5open() < 0 ? -1 : 0;
 }
 
 int cf_h5_is_output(const char *path)
 {
-    h5_init_once(); /* before any HDF5 call */
+    if (h5_init_once() < 0) /* before any HDF5 call */
+        return 0;
     quiet_state q;
     quiet_begin(&q);
     int ours = 0;
@@ -1246,6 +1355,8 @@ cf_status cf_h5_add_surfaces(cf_h5 *h, const int *tris, const int *crack, int m,
     quiet_state q;
     quiet_begin(&q);
     cf_status st = add_surfaces_impl(h, tris, crack, m, first, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
     quiet_end(&q);
     return st;
 }
@@ -1269,9 +1380,9 @@ static cf_status write_rest_mesh_impl(cf_h5 *h, const double *X, int n, const in
         H5Gclose(rest);
     if (mesh >= 0)
         H5Gclose(mesh);
-    if (!ok || H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
+    if (!ok)
         return h5_fail(err, h->path, "writing /mesh/rest");
-    return CF_OK;
+    return flush_file(h, err, "flushing /mesh/rest");
 }
 
 cf_status cf_h5_write_rest_mesh(cf_h5 *h, const double *X, int n, const int *tets, int nt,
@@ -1323,6 +1434,8 @@ cf_status cf_h5_write_tet_fragments(cf_h5 *h, long step, double time, const int 
     quiet_state q;
     quiet_begin(&q);
     cf_status st = write_tet_fragments_impl(h, step, time, map, nt, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
     quiet_end(&q);
     return st;
 }
@@ -1530,8 +1643,11 @@ static cf_status write_xdmf(const cf_h5 *h, cf_error *err)
     x.href = href;
     x.fp = fopen(tmp, "w");
     if (!x.fp) {
-        st = cf_error_set(err, CF_ERR_OUTPUT, "XDMF sidecar '%s': cannot create it: %s", tmp,
-                          strerror(errno));
+        /* fopen allocates its FILE: ENOMEM is memory, not the disk. */
+        st = errno == ENOMEM
+                 ? cf_error_set(err, CF_ERR_NOMEM, "XDMF sidecar '%s': out of memory opening it", tmp)
+                 : cf_error_set(err, CF_ERR_OUTPUT, "XDMF sidecar '%s': cannot create it: %s", tmp,
+                                strerror(errno));
         goto done;
     }
     put_xdmf(&x, h);
@@ -1563,17 +1679,82 @@ unsigned long long cf_h5_memory(const cf_h5 *h)
     return cur;
 }
 
+/* Cut dataset `d` back to `rows` rows when it holds more. */
+static void trim_rows(hid_t d, hsize_t rows)
+{
+    if (d < 0)
+        return;
+    hsize_t dims[3] = {0, 0, 0};
+    hid_t s = H5Dget_space(d);
+    int rank = s >= 0 ? H5Sget_simple_extent_ndims(s) : -1;
+    int ok = rank >= 1 && rank <= 3 && H5Sget_simple_extent_dims(s, dims, NULL) >= 0;
+    if (s >= 0)
+        H5Sclose(s);
+    if (ok && dims[0] > rows) {
+        dims[0] = rows;
+        H5Dset_extent(d, dims);
+    }
+}
+
+/* After a failed write (out of memory, a full disk) the tables hold part
+ * of what was being written: the fields of a frame but not its step, the
+ * observables of a frame that never came, some columns of a hand-off.  The
+ * close flushes whatever is in them, so first every table goes back to
+ * what the last successful flush left: the file is then as a SIGKILL at
+ * that moment would have left it, every frame complete or absent. */
+static void rollback(cf_h5 *h)
+{
+    for (int f = 0; f < FLD_COUNT; ++f)
+        trim_rows(h->value[f], h->nframes);
+    trim_rows(h->time, h->nframes);
+    trim_rows(h->step, h->nframes);
+    for (int c = 0; c < FR_COUNT; ++c)
+        trim_rows(h->fragment[c], h->nfragments);
+    for (int c = 0; c < HO_COUNT; ++c)
+        trim_rows(h->handoff[c], h->nhandoffs);
+    for (int c = 0; c < CR_COUNT; ++c)
+        trim_rows(h->crack[c], h->ncracks_flushed);
+    h->ncracks = h->ncracks_flushed;
+    for (int c = 0; c < SF_COUNT; ++c)
+        trim_rows(h->surface[c], h->nsurface_flushed);
+    h->nsurface = h->nsurface_flushed;
+    trim_rows(h->map_step, h->nmaps_flushed);
+    trim_rows(h->map_time, h->nmaps_flushed);
+    trim_rows(h->map_value, h->nmaps_flushed);
+    h->nmaps = h->nmaps_flushed;
+    for (size_t i = 0; i < h->nobs; ++i) {
+        observable *o = &h->obs[i];
+        if (o->flushed == 0) { /* begun after the last flush: not there then */
+            int ignored = 0;
+            close_dataset(&o->step, &ignored);
+            close_dataset(&o->time, &ignored);
+            close_dataset(&o->value, &ignored);
+            H5Ldelete(h->obs_group, o->name, H5P_DEFAULT);
+        } else {
+            trim_rows(o->step, o->flushed);
+            trim_rows(o->time, o->flushed);
+            trim_rows(o->value, o->flushed);
+        }
+        o->n = o->flushed;
+    }
+    H5Eclear2(H5E_DEFAULT);
+}
+
 cf_status cf_h5_close(cf_h5 *h, cf_error *err)
 {
     if (!h)
         return CF_OK;
     quiet_state q;
     quiet_begin(&q);
-    cf_status st = CF_OK;
-    if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0)
-        st = h5_fail(err, h->path, "flushing before close");
+    if (h->failed)
+        rollback(h);
+    cf_status st = flush_file(h, err, "flushing before close");
     if (st == CF_OK)
         st = write_connectivity(h, err);
+    /* Everything on disk before the handles close: a close that runs out
+     * of memory then has nothing left to write half-way. */
+    if (st == CF_OK)
+        st = flush_file(h, err, "flushing /xdmf");
     if (st == CF_OK)
         st = write_xdmf(h, err);
     if (close_handles(h) < 0 && st == CF_OK)

@@ -142,6 +142,20 @@ static const double IDENTITY_QUAT[4] = {1.0, 0.0, 0.0, 0.0};
 
 /* ---------------------------------------------------------------- loader */
 
+/* Limits on a scene script (docs/reliability.md): a script that loops
+ * forever or fills memory stops with an error naming the limit. */
+#define SCENE_MAX_INSTRUCTIONS 200000000L /* about a second of Lua */
+#define SCENE_MAX_BYTES (256L << 20)
+#define SCENE_HOOK_EVERY 100000
+
+typedef struct script_budget {
+    size_t bytes;
+    long instructions;
+    /* Why the last allocation Lua asked for was refused: the limit (1) or
+     * the system's allocator (0).  Lua reports both as LUA_ERRMEM. */
+    int refused_by_limit;
+} script_budget;
+
 typedef struct loader {
     lua_State *L;
     const char *file;     /* scene path as given: every message starts with it */
@@ -172,6 +186,20 @@ static cf_status fail(loader *ld, cf_status code, const char *fmt, ...)
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     return cf_error_set(ld->err, code, "%s: %s", ld->file, msg);
+}
+
+/* A Lua call that ended with LUA_ERRMEM while doing `what`: the script
+ * went over its memory limit (bad input, exit 2), or the process is out of
+ * memory (exit 5). */
+static cf_status memory_failure(loader *ld, const char *what)
+{
+    void *ud;
+    lua_getallocf(ld->L, &ud);
+    if (((script_budget *)ud)->refused_by_limit)
+        return fail(ld, CF_ERR_SCENE_SYNTAX,
+                    "the script used more than %ld MiB of memory: a scene only builds a table",
+                    SCENE_MAX_BYTES >> 20);
+    return fail(ld, CF_ERR_NOMEM, "out of memory %s", what);
 }
 
 /* Full path of `key` inside the current table ("solver.pbd.iterations"). */
@@ -659,9 +687,9 @@ static cf_status absolute_path(loader *ld, const char *key, const char *path, co
         dir[cut - path] = '\0';
     }
     char *real = realpath(dir, NULL);
-    if (!real)
-        return fail(ld, CF_ERR_FILE_OPEN, "%s: cannot resolve directory %s: %s", kp(ld, key), dir,
-                    strerror(errno));
+    if (!real) /* realpath allocates its result: ENOMEM is memory, not the path */
+        return fail(ld, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
+                    "%s: cannot resolve directory %s: %s", kp(ld, key), dir, strerror(errno));
     int w = snprintf(out, size, "%s%s%s", real, ends_with(real, "/") ? "" : "/", cut + 1);
     free(real);
     if (w < 0 || (size_t)w >= size)
@@ -1217,6 +1245,9 @@ static cf_status read_output(loader *ld, int t, const char *name, int fracture_o
                 memcpy(rel, o->file, sizeof rel);
                 w = snprintf(o->file, sizeof o->file, "%s/%s", real, rel);
                 free(real);
+            } else if (errno == ENOMEM) {
+                return fail(ld, CF_ERR_NOMEM, "'%s': out of memory resolving the scene's directory",
+                            kp(ld, "file"));
             }
             if (w < 0 || (size_t)w >= sizeof o->file)
                 return fail(ld, CF_ERR_SCENE_VALUE,
@@ -1406,10 +1437,16 @@ static cf_status apply_override(loader *ld, int scene, const char *ov)
     luaL_addstring(&code, "return ");
     luaL_addstring(&code, eq + 1);
     luaL_pushresult(&code);
-    if (luaL_loadbufferx(L, lua_tostring(L, -1), lua_rawlen(L, -1), "=override", "t") != LUA_OK)
+    int rc = luaL_loadbufferx(L, lua_tostring(L, -1), lua_rawlen(L, -1), "=override", "t");
+    if (rc == LUA_ERRMEM)
+        return memory_failure(ld, "parsing an override");
+    if (rc != LUA_OK)
         return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': the value does not parse: %s",
                     ov, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "?");
-    if (lua_pcall(L, 0, 1, 0) != LUA_OK)
+    rc = lua_pcall(L, 0, 1, 0);
+    if (rc == LUA_ERRMEM)
+        return memory_failure(ld, "evaluating an override");
+    if (rc != LUA_OK)
         return fail(ld, CF_ERR_SCENE_OVERRIDE, "bad override '%s': the value fails: %s", ov,
                     lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "?");
     if (lua_isnil(L, -1))
@@ -1801,17 +1838,6 @@ static char *resolved_text(const cf_world_def *s)
 
 /* ---------------------------------------------------------------- API */
 
-/* Limits on a scene script (docs/reliability.md): a script that loops
- * forever or fills memory stops with an error naming the limit. */
-#define SCENE_MAX_INSTRUCTIONS 200000000L /* about a second of Lua */
-#define SCENE_MAX_BYTES (256L << 20)
-#define SCENE_HOOK_EVERY 100000
-
-typedef struct script_budget {
-    size_t bytes;
-    long instructions;
-} script_budget;
-
 static void *budget_alloc(void *ud, void *ptr, size_t osize, size_t nsize)
 {
     script_budget *b = ud;
@@ -1821,11 +1847,15 @@ static void *budget_alloc(void *ud, void *ptr, size_t osize, size_t nsize)
         free(ptr);
         return NULL;
     }
-    if (nsize > old && b->bytes + (nsize - old) > (size_t)SCENE_MAX_BYTES)
+    if (nsize > old && b->bytes + (nsize - old) > (size_t)SCENE_MAX_BYTES) {
+        b->refused_by_limit = 1;
         return NULL; /* Lua raises "not enough memory" */
+    }
     void *p = realloc(ptr, nsize);
     if (p)
         b->bytes = b->bytes - old + nsize;
+    else
+        b->refused_by_limit = 0;
     return p;
 }
 
@@ -1842,29 +1872,53 @@ static void budget_hook(lua_State *L, lua_Debug *ar)
                    (int)(SCENE_MAX_INSTRUCTIONS / 1000000));
 }
 
+/* The script's chunk (or the error message) and the load's status.
+ * luaL_loadfilex pushes the chunk's name and its error messages outside
+ * the parser's protection: run unprotected, a memory error there would end
+ * in Lua's panic handler, which aborts. */
+static int load_protected(lua_State *L)
+{
+    loader *ld = lua_touserdata(L, 1);
+    int rc = ld->text ? luaL_loadbufferx(L, ld->text, strlen(ld->text), ld->file, "t")
+                      : luaL_loadfilex(L, ld->file, "t");
+    lua_pushinteger(L, rc);
+    return 2;
+}
+
 static cf_status load(loader *ld)
 {
     lua_State *L = ld->L;
     int rc;
     if (!ld->text) {
         FILE *f = fopen(ld->file, "r");
-        if (!f)
-            return fail(ld, CF_ERR_FILE_OPEN, "cannot open the scene file: %s", strerror(errno));
+        if (!f) /* fopen allocates: ENOMEM is memory, not the file */
+            return fail(ld, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
+                        "cannot open the scene file: %s", strerror(errno));
         fclose(f);
     }
 
     lua_pushcfunction(L, open_sandbox);
     if (lua_pcall(L, 0, 0, 0) != LUA_OK)
-        return fail(ld, CF_ERR_NOMEM, "cannot set up the Lua state");
+        return fail(ld, CF_ERR_NOMEM, "out of memory setting up the Lua state");
 
     /* Mode "t": precompiled chunks bypass the parser's checks and can crash
      * the VM, so only source text is accepted. */
-    rc = ld->text ? luaL_loadbufferx(L, ld->text, strlen(ld->text), ld->file, "t")
-                  : luaL_loadfilex(L, ld->file, "t");
+    lua_pushcfunction(L, load_protected);
+    lua_pushlightuserdata(L, ld);
+    errno = 0;
+    rc = lua_pcall(L, 1, 2, 0);
+    if (rc == LUA_ERRMEM)
+        return memory_failure(ld, "loading the script");
+    if (rc != LUA_OK)
+        return lua_failure(ld, CF_ERR_SCENE_SYNTAX, NULL);
+    rc = (int)lua_tointeger(L, -1);
+    lua_pop(L, 1);
+    if (rc == LUA_ERRFILE && errno == ENOMEM) /* its fopen could not allocate */
+        return fail(ld, CF_ERR_NOMEM, "out of memory opening the scene file");
     if (rc == LUA_ERRFILE)
         return lua_failure(ld, CF_ERR_FILE_OPEN, NULL);
     if (rc == LUA_ERRMEM)
-        return fail(ld, CF_ERR_NOMEM, "out of memory while parsing");
+        return memory_failure(ld, "while parsing");
     if (rc != LUA_OK)
         return lua_failure(ld, CF_ERR_SCENE_SYNTAX,
                            lua_type(L, -1) == LUA_TSTRING &&
@@ -1873,9 +1927,7 @@ static cf_status load(loader *ld)
                                : NULL);
     rc = lua_pcall(L, 0, 1, 0);
     if (rc == LUA_ERRMEM)
-        return fail(ld, CF_ERR_SCENE_SYNTAX,
-                    "the script used more than %ld MiB of memory: a scene only builds a table",
-                    SCENE_MAX_BYTES >> 20);
+        return memory_failure(ld, "running the script");
     if (rc != LUA_OK) {
         const char *msg = lua_tostring(L, -1);
         return lua_failure(ld, CF_ERR_SCENE_SYNTAX,
@@ -1893,7 +1945,7 @@ static cf_status load(loader *ld)
     lua_pushvalue(L, -3);
     rc = lua_pcall(L, 2, 0, 0);
     if (rc == LUA_ERRMEM)
-        return fail(ld, CF_ERR_NOMEM, "out of memory while reading the scene");
+        return memory_failure(ld, "while reading the scene");
     if (rc != LUA_OK)
         return lua_failure(ld, CF_ERR_SCENE_SYNTAX, NULL);
     if (ld->status != CF_OK)
@@ -1935,10 +1987,10 @@ static cf_status load_scene(const char *path, const char *text, const char *cons
     else
         return fail(&ld, CF_ERR_FILE_OPEN, "scene path too long");
 
-    script_budget budget = {0, 0};
+    script_budget budget = {0, 0, 0};
     ld.L = lua_newstate(budget_alloc, &budget);
     if (!ld.L)
-        return fail(&ld, CF_ERR_NOMEM, "cannot create a Lua state");
+        return fail(&ld, CF_ERR_NOMEM, "out of memory creating a Lua state");
     lua_sethook(ld.L, budget_hook, LUA_MASKCOUNT, SCENE_HOOK_EVERY);
     st = load(&ld);
     lua_close(ld.L);

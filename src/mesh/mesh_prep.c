@@ -561,11 +561,12 @@ static cf_status write_stamp(const cf_mesh_prep_opts *o, const char *key, const 
                              int n_tris, const cf_mesh *m, cf_error *err)
 {
     char *sp = str_cat(o->output, ".stamp"), *tmp = str_cat(o->output, ".stamp.tmp");
-    FILE *f = tmp ? fopen(tmp, "w") : NULL;
+    FILE *f = sp && tmp ? fopen(tmp, "w") : NULL;
     cf_status st = CF_OK;
-    if (!f) {
-        st = cf_error_set(err, CF_ERR_OUTPUT, "%s: cannot write (%s)", tmp ? tmp : "stamp",
-                          strerror(errno));
+    if (!f) { /* str_cat or fopen out of memory is memory, not the disk */
+        st = !sp || !tmp ? cf_error_set(err, CF_ERR_NOMEM, "out of memory writing the stamp")
+                  : cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_OUTPUT,
+                                 "%s: cannot write (%s)", tmp, strerror(errno));
     } else {
         fprintf(f, "%s", key);
         fprintf(f, "# informational\ntetgen -%s\nsurface_triangles %d\nnodes %d\ntets %d\n",

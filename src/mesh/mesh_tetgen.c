@@ -394,9 +394,9 @@ static cf_status write_atomic(const char *path, const cf_mesh *m, int ele, cf_er
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     snprintf(tmp, n + 5, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");
-    if (!f) {
-        cf_status st = cf_error_set(err, CF_ERR_OUTPUT, "%s: cannot write (%s)", tmp,
-                                    strerror(errno));
+    if (!f) { /* fopen allocates: ENOMEM is memory, not the disk */
+        cf_status st = cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_OUTPUT,
+                                    "%s: cannot write (%s)", tmp, strerror(errno));
         free(tmp);
         return st;
     }
