@@ -10,12 +10,12 @@
 -- at z = 1 m; from 0.5 m the small bunny does not crack).
 -- Default mesh: the coarse `bunny_small` (14,390 tets; `make run`), about
 -- 10 s here.  Source scale (the source's bunny has 208,353 tets; ours
--- 202,404): --set 'bodies[1].mesh="bunny"', about 6 minutes on 2 threads
+-- 202,404): --set 'bodies[1].mesh="bunny"', about 8 minutes on 2 threads
 -- (see the README and docs/performance.md).
 -- Expected: the bunny rebounds at the impact (fracture mode is PBD with
 -- k = 0.9 and 3 iterations, an almost rigid elastic body: the compression
 -- wave comes back) and loses small pieces where it meets the ground:
--- bunny_small ~260 pieces of one to a few tets, the body keeping 99.5% of its mass,
+-- bunny_small ~260 pieces of one to a few tets, the body keeping 99.4% of its mass,
 -- the fastest piece ~3-4 m/s (the fall gives 4.4 m/s).  It chips; it does
 -- not break into large pieces (the source's Fig 6.3 shows several): with
 -- the source's parameters, Weibull strength scatter, the traction rule,
