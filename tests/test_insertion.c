@@ -90,6 +90,16 @@ static void test_two_tets_split_into_two_fragments(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* 1 when interior facet f lies on the plane x = x0. */
+static int facet_on_plane_x(const cf_solid *s, int f, double x0)
+{
+    const int *F = &s->facet[4 * f];
+    int on = F[2] >= 0;
+    for (int i = 0; i < 3; i++)
+        on &= fabs(s->X[3 * s->tet[4 * F[0] + CF_TET_FACE[F[1]][i]]] - x0) < 1e-12;
+    return on;
+}
+
 /* Crack every facet on the plane x = L/2 of a box: two fragments of equal
  * mass, momentum to round-off.  A single interior facet alone does not split. */
 static void test_box_split_along_a_plane(void **state)
@@ -104,13 +114,7 @@ static void test_box_split_along_a_plane(void **state)
     cf_int_list nodes = {0}, touched = {0};
     int first = -1, cracked = 0;
     for (int f = 0; f < s.n_facets; f++) {
-        const int *F = &s.facet[4 * f];
-        if (F[2] < 0)
-            continue;
-        int on_plane = 1;
-        for (int i = 0; i < 3; i++)
-            on_plane &= fabs(s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][i]]] - 0.2) < 1e-12;
-        if (!on_plane)
+        if (!facet_on_plane_x(&s, f, 0.2))
             continue;
         assert_int_equal(cf_crack_facet(&s, f, &nodes, &touched), 0);
         if (first < 0) {
@@ -285,13 +289,9 @@ static void test_bars_patched_after_insertion_equal_a_rebuild(void **state)
     for (int round = 0; round < 4; round++) {
         touched.n = 0;
         for (int f = 0; f < s.n_facets; f++) {
-            const int *F = &s.facet[4 * f];
-            if (F[2] < 0 || s.cracked[f])
+            if (s.facet[4 * f + 2] < 0 || s.cracked[f])
                 continue;
-            int on_plane = 1;
-            for (int i = 0; i < 3; i++)
-                on_plane &= fabs(s.X[3 * s.tet[4 * F[0] + CF_TET_FACE[F[1]][i]]] - 0.2) < 1e-12;
-            int pick = round < 3 ? (f * 7 + round) % 11 == 0 : on_plane;
+            int pick = round < 3 ? (f * 7 + round) % 11 == 0 : facet_on_plane_x(&s, f, 0.2);
             if (pick)
                 assert_int_equal(cf_crack_facet(&s, f, &nodes, &touched), 0);
         }
