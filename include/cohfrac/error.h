@@ -62,6 +62,11 @@ const char *cf_status_name(cf_status s);
 const char *cf_status_meaning(cf_status s);
 int cf_status_exit_code(cf_status s);
 
+/* The status of a call that failed with errno `e`: CF_ERR_NOMEM for ENOMEM
+ * (fopen, realpath and the like allocate: out of memory is not a problem
+ * with the file), `otherwise` for anything else. */
+cf_status cf_status_of_errno(int e, cf_status otherwise);
+
 /* Fill `err` (may be NULL) with code and a printf-style message; returns code. */
 cf_status cf_error_set(cf_error *err, cf_status code, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -20,8 +20,8 @@ cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error
     snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
     snprintf(o->tmp, sizeof o->tmp, "%s/%s.%ld.tmp", dir, name, (long)getpid());
     o->f = fopen(o->tmp, "w");
-    if (!o->f) /* fopen allocates: ENOMEM is memory, not the disk */
-        return cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_OUTPUT,
+    if (!o->f)
+        return cf_error_set(err, cf_status_of_errno(errno, CF_ERR_OUTPUT),
                             "cannot write %s: %s", o->tmp, strerror(errno));
     return CF_OK;
 }

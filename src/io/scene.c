@@ -687,8 +687,8 @@ static cf_status absolute_path(loader *ld, const char *key, const char *path, co
         dir[cut - path] = '\0';
     }
     char *real = realpath(dir, NULL);
-    if (!real) /* realpath allocates its result: ENOMEM is memory, not the path */
-        return fail(ld, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
+    if (!real)
+        return fail(ld, cf_status_of_errno(errno, CF_ERR_FILE_OPEN),
                     "%s: cannot resolve directory %s: %s", kp(ld, key), dir, strerror(errno));
     int w = snprintf(out, size, "%s%s%s", real, ends_with(real, "/") ? "" : "/", cut + 1);
     free(real);
@@ -1891,8 +1891,8 @@ static cf_status load(loader *ld)
     int rc;
     if (!ld->text) {
         FILE *f = fopen(ld->file, "r");
-        if (!f) /* fopen allocates: ENOMEM is memory, not the file */
-            return fail(ld, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
+        if (!f)
+            return fail(ld, cf_status_of_errno(errno, CF_ERR_FILE_OPEN),
                         "cannot open the scene file: %s", strerror(errno));
         fclose(f);
     }

@@ -803,7 +803,7 @@ cf_status cf_mesh_load_gmsh(const char *path, cf_mesh *m, cf_error *err)
     size_t len = 0;
     char *buf = cf_file_read(path, &len);
     if (!buf)
-        return cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
+        return cf_error_set(err, cf_status_of_errno(errno, CF_ERR_FILE_OPEN),
                             "%s: cannot read (%s); give the path of a Gmsh .msh file", path,
                             strerror(errno));
     msh f = {.path = path, .buf = buf, .len = len, .line = 1, .err = err, .first = -1};

@@ -565,7 +565,7 @@ static cf_status write_stamp(const cf_mesh_prep_opts *o, const char *key, const 
     cf_status st = CF_OK;
     if (!f) { /* str_cat or fopen out of memory is memory, not the disk */
         st = !sp || !tmp ? cf_error_set(err, CF_ERR_NOMEM, "out of memory writing the stamp")
-                  : cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_OUTPUT,
+                  : cf_error_set(err, cf_status_of_errno(errno, CF_ERR_OUTPUT),
                                  "%s: cannot write (%s)", tmp, strerror(errno));
     } else {
         fprintf(f, "%s", key);

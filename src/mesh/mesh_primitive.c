@@ -211,8 +211,8 @@ static char *geo_script(const cf_primitive *p)
 static cf_status write_text(const char *path, const char *text, cf_error *err)
 {
     FILE *f = fopen(path, "w");
-    if (!f) /* fopen allocates: ENOMEM is memory, not the disk */
-        return cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_OUTPUT,
+    if (!f)
+        return cf_error_set(err, cf_status_of_errno(errno, CF_ERR_OUTPUT),
                             "%s: cannot write (%s)", path, strerror(errno));
     fputs(text, f);
     int bad = ferror(f);

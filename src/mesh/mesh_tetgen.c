@@ -272,7 +272,7 @@ cf_status cf_mesh_load_tetgen_unchecked(const char *base, cf_mesh *m, cf_error *
         snprintf(path, bl + 6, "%s%s", b, pass == 0 ? ".node" : ".ele");
         char *text = cf_file_read(path, NULL);
         if (!text) {
-            st = cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_FILE_OPEN,
+            st = cf_error_set(err, cf_status_of_errno(errno, CF_ERR_FILE_OPEN),
                               "%s: cannot read (%s); give the mesh as the base name of a "
                               "TetGen .node/.ele pair",
                               path, strerror(errno));
@@ -394,8 +394,8 @@ static cf_status write_atomic(const char *path, const cf_mesh *m, int ele, cf_er
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     snprintf(tmp, n + 5, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");
-    if (!f) { /* fopen allocates: ENOMEM is memory, not the disk */
-        cf_status st = cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_OUTPUT,
+    if (!f) {
+        cf_status st = cf_error_set(err, cf_status_of_errno(errno, CF_ERR_OUTPUT),
                                     "%s: cannot write (%s)", tmp, strerror(errno));
         free(tmp);
         return st;

@@ -171,8 +171,8 @@ cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err)
 cf_status cf_surface_write_off(const cf_surface *s, const char *path, cf_error *err)
 {
     FILE *f = fopen(path, "w");
-    if (!f) /* fopen allocates: ENOMEM is memory, not the disk */
-        return cf_error_set(err, errno == ENOMEM ? CF_ERR_NOMEM : CF_ERR_OUTPUT,
+    if (!f)
+        return cf_error_set(err, cf_status_of_errno(errno, CF_ERR_OUTPUT),
                             "%s: cannot write (%s)", path, strerror(errno));
     fprintf(f, "OFF\n%d %d 0\n", s->n_verts, s->n_tris);
     for (int i = 0; i < s->n_verts; i++)

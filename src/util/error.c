@@ -1,5 +1,6 @@
 #include "cohfrac/error.h"
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 
@@ -44,4 +45,9 @@ cf_status cf_error_set(cf_error *err, cf_status code, const char *fmt, ...)
         va_end(ap);
     }
     return code;
+}
+
+cf_status cf_status_of_errno(int e, cf_status otherwise)
+{
+    return e == ENOMEM ? CF_ERR_NOMEM : otherwise;
 }
