@@ -311,24 +311,20 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
 static int *group_by_component(const int *tets, const int *comp, int nt, int k, int **start)
 {
     int *out = malloc((size_t)(nt ? nt : 1) * sizeof(int));
-    int *at = calloc((size_t)k + 1, sizeof(int));
+    int *at = calloc((size_t)k + 2, sizeof(int));
     if (!out || !at) {
         free(out), free(at);
         return NULL;
     }
+    /* Counts shifted by two, summed: at[c + 1] is where component c starts.
+     * Filling moves it to where c ends, which is where c + 1 starts, so at
+     * ends as the start of each component. */
     for (int i = 0; i < nt; i++)
-        at[comp[i] + 1]++;
+        at[comp[i] + 2]++;
     for (int c = 0; c < k; c++)
-        at[c + 1] += at[c];
-    int *next = malloc((size_t)k * sizeof(int));
-    if (!next) {
-        free(out), free(at);
-        return NULL;
-    }
-    memcpy(next, at, (size_t)k * sizeof(int));
+        at[c + 2] += at[c + 1];
     for (int i = 0; i < nt; i++)
-        out[next[comp[i]]++] = tets[i];
-    free(next);
+        out[at[comp[i] + 1]++] = tets[i];
     *start = at;
     return out;
 }

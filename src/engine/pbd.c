@@ -249,24 +249,21 @@ int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touch
     if (scratch_reserve(w, s->n_nodes, 0))
         return -1;
     /* The touched nodes, once each, ascending: the order the new bars are
-     * made and coloured in, so that the result does not depend on the order
-     * the facets cracked in beyond their list order. */
-    int nd = 0;
+     * made and coloured in depends only on which nodes changed. */
+    int nd = 0, room = 0;
     for (int i = 0; i < n_touched; i++)
-        if (!w->flag[touched[i]])
+        if (!w->flag[touched[i]]) {
             w->flag[touched[i]] = TOUCHED, w->list[nd++] = touched[i];
+            room += 3 * star_size(s, touched[i]); /* node_bars' bound */
+        }
     qsort(w->list, (size_t)nd, sizeof(int), by_int);
     /* Their bars: every bar at a touched node, a pair of touched nodes once. */
-    int n_new = 0, m;
-    for (int i = 0; i < nd; i++) {
-        if (fill_node(s, w->list[i], w->flag, NULL, NULL, NULL, 0, &m))
-            return -1;
-        n_new += m;
-    }
-    if (scratch_reserve(w, s->n_nodes, n_new))
+    if (scratch_reserve(w, s->n_nodes, room))
         return -1;
-    for (int i = 0, at = 0; i < nd; i++, at += m)
-        fill_node(s, w->list[i], w->flag, w->ends, w->rest, w->compliance, at, &m);
+    int n_new = 0, m;
+    for (int i = 0; i < nd; i++, n_new += m)
+        if (fill_node(s, w->list[i], w->flag, w->ends, w->rest, w->compliance, n_new, &m))
+            return -1;
     /* The colours the kept bars use at the new bars' untouched ends. */
     int nn = nd;
     for (int i = 0; i < 2 * n_new; i++) {
