@@ -1045,9 +1045,13 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
     return CF_OK;
 }
 
-/* Fracture-only runs: fragments that cracked in this step and now fall
- * apart become one fragment per connected piece, labelled and written like
- * the pieces of a hybrid run's hand-off. */
+/* Fragments that cracked in this step and now fall apart become one
+ * fracture-mode fragment per connected piece, labelled and written like the
+ * pieces of a hand-off.  The failed cohesive elements between two pieces go
+ * with the split: their compression penalty, kept between pieces that
+ * tumble apart, acted along a mid-surface that no longer means anything and
+ * pumped energy in (an explicit drop's cohesive stored energy fell to -48 kJ
+ * in 0.1 ms, docs/physics.md §14.6). */
 static cf_status split_fragments(cf_world *sim, cf_error *err)
 {
     int n = sim->n_frag;
@@ -1115,10 +1119,10 @@ cf_status cf_world_step(cf_world *sim, cf_error *err)
                       .count = sim->solid.n_coh - n_coh, .alive = alive_fragments(sim, NULL)};
         st = push_event(sim, &e, err);
     }
+    if (st == CF_OK)
+        st = split_fragments(sim, err);
     if (st == CF_OK && sc->solver.mode == CF_RUN_HYBRID)
         st = return_to_rigid(sim, err);
-    if (st == CF_OK && sc->solver.mode == CF_RUN_FRACTURE)
-        st = split_fragments(sim, err);
     if (st == CF_OK)
         st = check_energy(sim, err);
     return st;
