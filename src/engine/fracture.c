@@ -55,6 +55,13 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, int n_hot, int 
     return CF_OK;
 }
 
+/* An explicit step: fracture mode without the constraint projection (no
+ * bars), where the kinetic energy is the leapfrog product (impulse_removes). */
+static int explicit_step(const cf_solver_settings *set, int fracture)
+{
+    return fracture && set->constraints == CF_CONSTRAINTS_NONE;
+}
+
 /* Energy an impulse takes out of node i, J: the velocity goes from `from`
  * to `to`.  With the constraint projection (PBD, XPBD) the node's velocity
  * is the projected one, and the change of kinetic energy is what it takes.
@@ -295,7 +302,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         f->contact[i] = -1;
         f->vn_pre[i] = 0;
     }
-    int bars = set->constraints != CF_CONSTRAINTS_NONE || !fracture;
+    int bars = !explicit_step(set, fracture);
     int iterations = bars ? set->iterations : 1;
     double k = cf_pbd_effective_stiffness(set->k_stiffness, set->iterations,
                                           set->iteration_independent);
@@ -407,8 +414,8 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
     double t1 = cf_wall_time();
     sim->prof.forces += t1 - t0;
     project(sim, f, t + dt, dt, fracture);
-    int leapfrog = fracture && sim->def.solver.constraints == CF_CONSTRAINTS_NONE;
-    sim->flow.contact += contact_velocities(sim, f, t + dt, dt, leapfrog);
+    sim->flow.contact +=
+        contact_velocities(sim, f, t + dt, dt, explicit_step(&sim->def.solver, fracture));
     sim->prof.pbd += cf_wall_time() - t1;
     f->steps++;
     return CF_OK;

@@ -2,8 +2,9 @@
  * (docs/architecture.md, docs/physics.md §9).  Each rigid step: Bullet (or the pbd rigid backend)
  * moves the rigid fragments; a fragment hit harder than the impact threshold
  * is rolled back to the start of the step and re-done in fracture mode,
- * sub-cycled at dt_fracture; a fracture-mode fragment quiet for quiet_steps
- * steps is split into its components and handed back to rigid mode. */
+ * sub-cycled at dt_fracture; a fracture-mode fragment that falls apart is
+ * split into its pieces at the end of the rigid step, and one quiet for
+ * quiet_steps steps is handed back to rigid mode. */
 #include "world_impl.h"
 #include "hash.h"
 
@@ -1050,8 +1051,8 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
  * pieces of a hand-off.  The failed cohesive elements between two pieces go
  * with the split: their compression penalty, kept between pieces that
  * tumble apart, acted along a mid-surface that no longer means anything and
- * pumped energy in (an explicit drop's cohesive stored energy fell to -48 kJ
- * in 0.1 ms, docs/physics.md §14.6). */
+ * pumped energy in (an explicit drop's cohesive stored energy fell to -280 J
+ * within 50 us, docs/physics.md §14.6). */
 static cf_status split_fragments(cf_world *sim, cf_error *err)
 {
     int n = sim->n_frag;
