@@ -109,7 +109,7 @@ static const struct {
      "      -o, --output PATH               gltf: the file (default OUT minus .h5, .glb);\n"
      "                                      pvd: the directory (default OUT minus .h5, _pvd)\n"},
     {"bench",
-     "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 3.1 m/s)\n"
+     "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 4.43 m/s)\n"
      "                                      against the memory floor, 1 against N threads\n"
      "      --mesh NAME                     prepared mesh or TetGen base (default bunny)\n"
      "      --steps N                       timed steps per repeat (default 60), after\n"

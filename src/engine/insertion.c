@@ -1,6 +1,7 @@
 #include "insertion.h"
 
 #include "linalg.h"
+#include "tet4.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -66,28 +67,71 @@ static double nodal_principal(const cf_solid *s, int n)
     return max_principal(sig);
 }
 
-/* Whether facet (ta, face k) passes the source's rule: the nodal value at
- * each of its three nodes, computed once per node and check (mark 2). */
-static int source_rule(cf_solid *s, int ta, int k, double threshold)
+/* Whether facet (ta, face k) passes the source's rule: every one of its
+ * three nodes is held by a hot tet and its nodal value (computed for those
+ * nodes by nodal_values) reaches the threshold. */
+static int source_rule(const cf_solid *s, int ta, int k, double threshold)
 {
-    int all = 1;
-    for (int j = 0; j < 3 && all; j++) {
+    for (int j = 0; j < 3; j++) {
         int n = s->tet[4 * ta + CF_TET_FACE[k][j]];
-        if (s->node_mark[n] == 0) /* no hot tet holds it: below the bound */
+        if (!s->node_mark[n] || s->nodal[n] < threshold)
             return 0;
-        if (s->node_mark[n] == 1)
-            s->nodal[n] = nodal_principal(s, n), s->node_mark[n] = 2;
-        all &= s->nodal[n] >= threshold;
     }
-    return all;
+    return 1;
 }
 
-static void mark_hot_nodes(cf_solid *s, const int *tets, int nt, unsigned char value)
+/* Marks the nodes of hot tets (listed once each in `marked`) or clears them. */
+static int mark_hot_nodes(cf_solid *s, const int *tets, int nt, unsigned char value,
+                          cf_int_list *marked)
 {
     for (int i = 0; i < nt; i++)
         if (s->hot[tets[i]])
-            for (int j = 0; j < 4; j++)
-                s->node_mark[s->tet[4 * tets[i] + j]] = value;
+            for (int j = 0; j < 4; j++) {
+                int n = s->tet[4 * tets[i] + j];
+                if (value && !s->node_mark[n] && cf_int_list_push(marked, n))
+                    return -1;
+                s->node_mark[n] = value;
+            }
+    return 0;
+}
+
+/* The source's nodal values at the marked nodes; each node writes its own. */
+static void nodal_values(cf_solid *s, const cf_int_list *marked)
+{
+#pragma omp parallel for schedule(static) if (marked->n >= CF_NODES_PARALLEL_MIN)
+    for (int i = 0; i < marked->n; i++)
+        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i]);
+}
+
+/* The faces of tet ta that qualify, as bits 1 << k. */
+static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion rule)
+{
+    double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
+    unsigned char bits = 0;
+    for (int k = 0; k < 4; k++) {
+        int f = s->tet_facet[4 * ta + k];
+        const int *F = &s->facet[4 * f];
+        if (F[2] < 0 || s->cracked[f] || F[0] != ta || (s->candidate && !s->candidate[f]))
+            continue;
+        double w = s->strength ? s->strength[f] : 1.0; /* this facet's strength */
+        if (rule == CF_CRITERION_SOURCE) {
+            bits |= (unsigned char)(source_rule(s, ta, k, 0.9 * smax * w) << k);
+            continue;
+        }
+        int tb = F[2];
+        if (!s->hot[ta] && !s->hot[tb]) /* the mean stress is below both bounds */
+            continue;
+        double sig[9], n[3], t[3];
+        for (int j = 0; j < 9; j++)
+            sig[j] = 0.5 * (s->sigma[9 * ta + j] + s->sigma[9 * tb + j]);
+        face_normal(s, ta, k, n);
+        m3_mulv(sig, n, t);
+        double sn = v3_dot(n, t);
+        double tau2 = v3_dot(t, t) - sn * sn;
+        double tau = tau2 > 0 ? sqrt(tau2) : 0;
+        bits |= (unsigned char)((sn >= smax * w || tau >= tmax * w) << k);
+    }
+    return bits;
 }
 
 cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule)
@@ -107,40 +151,24 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     out->n = 0;
     if (n_hot == 0 || rule == CF_CRITERION_NONE)
         return 0;
-    if (rule == CF_CRITERION_SOURCE)
-        mark_hot_nodes(s, tets, nt, 1);
-    int rc = 0;
-    double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
-    for (int i = 0; i < nt && rc == 0; i++) {
-        int ta = tets[i];
-        for (int k = 0; k < 4; k++) {
-            int f = s->tet_facet[4 * ta + k];
-            const int *F = &s->facet[4 * f];
-            if (F[2] < 0 || s->cracked[f] || F[0] != ta || (s->candidate && !s->candidate[f]))
-                continue;
-            double w = s->strength ? s->strength[f] : 1.0; /* this facet's strength */
-            if (rule == CF_CRITERION_SOURCE) {
-                if (source_rule(s, ta, k, 0.9 * smax * w) && cf_int_list_push(out, f))
-                    rc = -1;
-                continue;
-            }
-            int tb = F[2];
-            if (!s->hot[ta] && !s->hot[tb]) /* the mean stress is below both bounds */
-                continue;
-            double sig[9], n[3], t[3];
-            for (int j = 0; j < 9; j++)
-                sig[j] = 0.5 * (s->sigma[9 * ta + j] + s->sigma[9 * tb + j]);
-            face_normal(s, ta, k, n);
-            m3_mulv(sig, n, t);
-            double sn = v3_dot(n, t);
-            double tau2 = v3_dot(t, t) - sn * sn;
-            double tau = tau2 > 0 ? sqrt(tau2) : 0;
-            if ((sn >= smax * w || tau >= tmax * w) && cf_int_list_push(out, f))
-                rc = -1;
-        }
+    if (rule == CF_CRITERION_SOURCE) { /* `out` lists the marked nodes meanwhile */
+        if (mark_hot_nodes(s, tets, nt, 1, out))
+            return -1;
+        nodal_values(s, out);
+        out->n = 0;
     }
+    /* Each tet's faces in parallel (reads only, one byte written per tet),
+     * then the facets in list order: the same list for any thread count. */
+#pragma omp parallel for schedule(static) if (nt >= CF_TET4_PARALLEL_MIN)
+    for (int i = 0; i < nt; i++)
+        s->qualify[tets[i]] = qualifying_faces(s, tets[i], rule);
+    int rc = 0;
+    for (int i = 0; i < nt && rc == 0; i++)
+        for (int k = 0; k < 4 && rc == 0; k++)
+            if (s->qualify[tets[i]] >> k & 1)
+                rc = cf_int_list_push(out, s->tet_facet[4 * tets[i] + k]);
     if (rule == CF_CRITERION_SOURCE)
-        mark_hot_nodes(s, tets, nt, 0);
+        mark_hot_nodes(s, tets, nt, 0, NULL);
     return rc ? -1 : out->n;
 }
 

@@ -190,9 +190,10 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
         return CF_OK;
     s->sigma = malloc((size_t)s->n_tets * 9 * sizeof(double));
     s->hot = calloc((size_t)s->n_tets, 1);
+    s->qualify = calloc((size_t)s->n_tets, 1);
     s->node_mark = calloc((size_t)s->cap_nodes, 1);
     s->nodal = malloc((size_t)s->cap_nodes * sizeof(double));
-    if (!s->sigma || !s->hot || !s->node_mark || !s->nodal || build_facets(s))
+    if (!s->sigma || !s->hot || !s->qualify || !s->node_mark || !s->nodal || build_facets(s))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
                             s->n_tets);
     s->strength_min = 1.0;
@@ -294,7 +295,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 void cf_solid_free(cf_solid *s)
 {
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->origin, s->tet, s->tet0,
-                    s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->node_mark, s->nodal, s->tf, s->tw, s->bc, s->tet_frag, s->facet,
+                    s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark, s->nodal, s->tf, s->tw, s->bc, s->tet_frag, s->facet,
                     s->tet_facet, s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);

@@ -61,6 +61,8 @@ typedef struct cf_solid {
     double *sigma;            /* [nt][9] Cauchy stress at the last check, Pa (fracture state) */
     unsigned char *hot;       /* [nt] may qualify for insertion at the last check
                                  (cf_stress_check; fracture state) */
+    unsigned char *qualify;   /* [nt] scratch of the criterion: bit k, face k qualifies
+                                 (fracture state) */
     double *tf;               /* [nt][12] internal force on each slot, N */
     double *tw;               /* [nt] strain energy at the last force pass, J */
     int *tet_frag;            /* [nt] fragment id */

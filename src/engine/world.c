@@ -1205,7 +1205,7 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
     m->solid = cn * (16 * D + 2 * I) + nt * (27 * D + 9 * I) +
                ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I;
     if (s->facet)
-        m->fracture = nt * (9 * D + 1 + 20 * I) + cn * (1 + D) +
+        m->fracture = nt * (9 * D + 2 + 20 * I) + cn * (1 + D) +
                       (unsigned long long)s->n_facets * (1 + (s->candidate != NULL));
     m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
     m->fragments = (unsigned long long)sim->cap_frag * sizeof(cf_fragment);
