@@ -123,7 +123,7 @@ static inline void polar_rotation(const double F[9], double q[4], int max_iter, 
         om[0] *= s, om[1] *= s, om[2] *= s;
         double angle = v3_norm(om);
         if (angle < tol)
-            break;
+            return; /* R already holds q */
         double half = 0.5 * angle, sh = sin(half) / angle;
         double dq[4] = {cos(half), om[0] * sh, om[1] * sh, om[2] * sh};
         /* q <- dq * q */
