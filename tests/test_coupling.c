@@ -18,6 +18,7 @@
 
 #define STORED_HASH 0xc36ecb17cb257b60ull
 #define STORED_HASH_COLOURED 0x47acaec4acd4f6dcull
+#define STORED_HASH_COLOURED_SOURCE 0x3c583d769990102cull
 
 static char dir[256];
 
@@ -186,30 +187,31 @@ static void test_determinism_hash(void **state)
 }
 
 /* A 8,640-tet box (more bars than CF_BARS_PARALLEL_MIN, so the coloured
- * PBD sweep, the element loop and the node gather all run on the threads)
- * hits the ground at 5 m/s in fracture mode and cracks: 1 and 2 threads
- * give the same bits, and those this test was written against. */
+ * PBD sweep, the element loop, the insertion scan and the node gather all
+ * run on the threads) hits the ground at 5 m/s in fracture mode and cracks,
+ * under the traction and under the source's rule: 1 and 2 threads give the
+ * same bits, and those this test was written against. */
 static const char *coloured_scene =
     "return {\n"
     "  name = 'coloured', duration = 1e-3, gravity = {0, 0, -9.81},\n"
-    "  material = {E = 1e6, nu = 0.3, rho = 1000, G_I = 1, sigma_max = 1e3,\n"
+    "  material = {E = 1e6, nu = 0.3, rho = 1000, G_I = 1, sigma_max = %g,\n"
     "              friction = 0.5, restitution = 0},\n"
     "  bodies = {{mesh = {type = 'box', size = {0.12, 0.12, 0.12}, cells = {12, 12, 12},\n"
     "                     tets_per_cell = 5},\n"
     "             position = {0, 0, 0.0605}, velocity = {0, 0, -5}}},\n"
     "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
-    "  solver = {mode = 'fracture', dt_rigid = 1e-4, dt_fracture = 5e-6, threads = %d},\n"
+    "  solver = {mode = 'fracture', criterion = '%s', dt_rigid = 1e-4, dt_fracture = 5e-6,\n"
+    "            threads = %d},\n"
     "  output = {file = ''},\n"
     "}\n";
 
-static void test_determinism_hash_coloured(void **state)
+/* The coloured scene with strength sigma_max (Pa) under `criterion` on 1
+ * and 2 threads: hashes and cohesive element counts. */
+static void run_coloured(double sigma_max, const char *criterion, uint64_t h[2], int coh[2])
 {
-    (void)state;
-    uint64_t h[2];
-    int coh[2];
     for (int r = 0; r < 2; r++) {
         char text[2048];
-        snprintf(text, sizeof text, coloured_scene, r + 1);
+        snprintf(text, sizeof text, coloured_scene, sigma_max, criterion, r + 1);
         cf_world_def sc;
         cf_sim *sim = make_sim(text, &sc);
         assert_true(cf_sim_world(sim)->frag[0].bars.n >= CF_BARS_PARALLEL_MIN); /* the coloured sweep runs */
@@ -219,12 +221,27 @@ static void test_determinism_hash_coloured(void **state)
         cf_sim_destroy(sim);
         cf_scene_free(&sc);
     }
-    printf("FIGURE determinism (coloured PBD): hash %016llx (1 thread), %016llx (2 threads), "
-           "%d cohesive elements\n",
-           (unsigned long long)h[0], (unsigned long long)h[1], coh[0]);
+    printf("FIGURE determinism (coloured PBD, criterion %s): hash %016llx (1 thread), %016llx "
+           "(2 threads), %d cohesive elements\n",
+           criterion, (unsigned long long)h[0], (unsigned long long)h[1], coh[0]);
+}
+
+static void test_determinism_hash_coloured(void **state)
+{
+    (void)state;
+    uint64_t h[2];
+    int coh[2];
+    run_coloured(1e3, "traction", h, coh);
     assert_true(h[0] == h[1]);
     assert_true(coh[0] > 0);
     assert_true(h[0] == STORED_HASH_COLOURED);
+    /* The source's rule (weaker, so that it inserts: it needs 0.9 sigma_max
+     * at all three nodes of a facet): its nodal averages and the face test
+     * run on the threads from 4096 tets on (this box has 8,640). */
+    run_coloured(200.0, "source", h, coh);
+    assert_true(h[0] == h[1]);
+    assert_true(coh[0] > 0);
+    assert_true(h[0] == STORED_HASH_COLOURED_SOURCE);
 }
 
 /* A weak box lands on the ground at 4 m/s and breaks; a sweeper box then
