@@ -266,8 +266,8 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
                 "traffic model: %.1f MB per step -> floor %.3f ms at %.1f GB/s (docs/performance.md)\n"
                 "  %-10s %8s %9s %8s %9s %8s %9s %7s %7s %10s\n",
                 r->tets, r->nodes, r->bars, r->colours, r->serial_bars, r->memory_per_tet,
-                r->bytes / 1e6, r->floor_ms, r->bw_nt / 1e9, "threads", "min ms", "median ms", "CPU ms", "ns/tet", "stress",
-                "insertion", "forces", "PBD", "insertions");
+                r->bytes / 1e6, r->floor_ms, r->bw_nt / 1e9, "threads", "min ms", "median ms",
+                "CPU ms", "ns/tet", "stress", "insertion", "forces", "PBD", "insertions");
         char what[32];
         print_row(log, "1", &r->t1, r->tets);
         snprintf(what, sizeof what, "%d", nt);

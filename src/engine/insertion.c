@@ -80,17 +80,28 @@ static int source_rule(const cf_solid *s, int ta, int k, double threshold)
     return 1;
 }
 
-/* Marks the nodes of hot tets (listed once each in `marked`) or clears them. */
-static int mark_hot_nodes(cf_solid *s, const int *tets, int nt, unsigned char value,
-                          cf_int_list *marked)
+/* Clears the marks of the listed nodes. */
+static void clear_marks(cf_solid *s, const cf_int_list *marked)
+{
+    for (int i = 0; i < marked->n; i++)
+        s->node_mark[marked->v[i]] = 0;
+}
+
+/* Marks the nodes of hot tets, listing each once in `marked`; out of
+ * memory: -1, with no mark left set. */
+static int mark_hot_nodes(cf_solid *s, const int *tets, int nt, cf_int_list *marked)
 {
     for (int i = 0; i < nt; i++)
         if (s->hot[tets[i]])
             for (int j = 0; j < 4; j++) {
                 int n = s->tet[4 * tets[i] + j];
-                if (value && !s->node_mark[n] && cf_int_list_push(marked, n))
+                if (s->node_mark[n])
+                    continue;
+                if (cf_int_list_push(marked, n)) {
+                    clear_marks(s, marked);
                     return -1;
-                s->node_mark[n] = value;
+                }
+                s->node_mark[n] = 1;
             }
     return 0;
 }
@@ -151,24 +162,26 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     out->n = 0;
     if (n_hot == 0 || rule == CF_CRITERION_NONE)
         return 0;
-    if (rule == CF_CRITERION_SOURCE) { /* `out` lists the marked nodes meanwhile */
-        if (mark_hot_nodes(s, tets, nt, 1, out))
+    /* The source's rule: `out` lists the marked nodes until the faces are
+     * tested. */
+    if (rule == CF_CRITERION_SOURCE) {
+        if (mark_hot_nodes(s, tets, nt, out))
             return -1;
         nodal_values(s, out);
-        out->n = 0;
     }
     /* Each tet's faces in parallel (reads only, one byte written per tet),
      * then the facets in list order: the same list for any thread count. */
 #pragma omp parallel for schedule(static) if (nt >= CF_TET4_PARALLEL_MIN)
     for (int i = 0; i < nt; i++)
         s->qualify[tets[i]] = qualifying_faces(s, tets[i], rule);
+    if (rule == CF_CRITERION_SOURCE)
+        clear_marks(s, out);
+    out->n = 0;
     int rc = 0;
     for (int i = 0; i < nt && rc == 0; i++)
         for (int k = 0; k < 4 && rc == 0; k++)
             if (s->qualify[tets[i]] >> k & 1)
                 rc = cf_int_list_push(out, s->tet_facet[4 * tets[i] + k]);
-    if (rule == CF_CRITERION_SOURCE)
-        mark_hot_nodes(s, tets, nt, 0, NULL);
     return rc ? -1 : out->n;
 }
 

@@ -295,8 +295,9 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 void cf_solid_free(cf_solid *s)
 {
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->origin, s->tet, s->tet0,
-                    s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark, s->nodal, s->tf, s->tw, s->bc, s->tet_frag, s->facet,
-                    s->tet_facet, s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
+                    s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
+                    s->nodal, s->tf, s->tw, s->bc, s->tet_frag, s->facet, s->tet_facet,
+                    s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
     memset(s, 0, sizeof *s);

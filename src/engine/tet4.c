@@ -2,22 +2,6 @@
 
 #include "linalg.h"
 
-/* The kernel's own copy, so that the tet loop inlines it. */
-static inline void gradients(const cf_solid *s, int t, double g[4][3])
-{
-    const double *Di = &s->Dm_inv[9 * t];
-    for (int i = 0; i < 3; i++) {
-        g[i + 1][0] = Di[3 * i], g[i + 1][1] = Di[3 * i + 1], g[i + 1][2] = Di[3 * i + 2];
-    }
-    for (int c = 0; c < 3; c++)
-        g[0][c] = -(g[1][c] + g[2][c] + g[3][c]);
-}
-
-void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3])
-{
-    gradients(s, t, g);
-}
-
 /* Deformation gradient F = Ds Dm^-1 of tet t at positions x. */
 static inline void deformation_gradient(const cf_solid *s, int t, double F[9])
 {
@@ -93,7 +77,7 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
         element_stress(s, F, kind, &s->rq[4 * t], R, sig, &w);
         s->tw[t] = w * s->vol[t];
         m3_mul(R, sig, P); /* f_i = -V R sigma grad N_i */
-        gradients(s, t, g);
+        cf_tet4_gradients(s, t, g);
         double *tf = &s->tf[12 * t];
         for (int a = 0; a < 4; a++) {
             double fa[3];

@@ -10,8 +10,17 @@
 
 #include "solid.h"
 
-/* Gradients of the 4 shape functions of tet t, [4][3], 1/m. */
-void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3]);
+/* Gradients of the 4 shape functions of tet t, [4][3], 1/m (inline: the
+ * force kernel calls it for every tet at every step). */
+static inline void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3])
+{
+    const double *Di = &s->Dm_inv[9 * t];
+    for (int i = 0; i < 3; i++) {
+        g[i + 1][0] = Di[3 * i], g[i + 1][1] = Di[3 * i + 1], g[i + 1][2] = Di[3 * i + 2];
+    }
+    for (int c = 0; c < 3; c++)
+        g[0][c] = -(g[1][c] + g[2][c] + g[3][c]);
+}
 
 /* Fragments of fewer tets than this are done on one thread. */
 #define CF_TET4_PARALLEL_MIN 4096
