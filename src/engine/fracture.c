@@ -56,26 +56,29 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, int n_hot, int 
 }
 
 /* An explicit step: fracture mode without the constraint projection (no
- * bars), where the kinetic energy is the leapfrog product (impulse_removes). */
+ * bars). */
 static int explicit_step(const cf_solver_settings *set, int fracture)
 {
     return fracture && set->constraints == CF_CONSTRAINTS_NONE;
 }
 
-/* Energy an impulse takes out of node i, J: the velocity goes from `from`
- * to `to`.  With the constraint projection (PBD, XPBD) the node's velocity
- * is the projected one, and the change of kinetic energy is what it takes.
- * In explicit runs the kinetic energy is the leapfrog product 1/2 m v_old .
- * v (update_velocities), and an impulse J = m (to - from) does the work
- * J . (v_old + to)/2: a node resting on an obstacle while the body above
- * presses it down takes J = -m dt f/m every step but does no work (it does
- * not move), where 1/2 m |from|^2 would book 1/2 dt^2 |f|^2/m at each step,
- * a loss of the order of the impact's energy at dt ~ dt_cfl. */
+/* Energy a velocity change takes out of node i, J: from `from` to `to`.
+ * The ledger's kinetic energy is the leapfrog product 1/2 m v_old . v
+ * (update_velocities).  A change that also moves the node (`moves`: the
+ * projection's, which sets x = p, and explicit friction) is the impulse
+ * J = m (to - from) doing the work J . (v_old + to)/2, with which the product
+ * telescopes from step to step (docs/physics.md §10): a node resting on an
+ * obstacle while the body above presses it down takes J = -m dt f/m every
+ * step but does no work (it does not move), where 1/2 m (|from|^2 - |to|^2)
+ * would book 1/2 dt^2 |f|^2/m at each step, a loss of the order of the
+ * impact's energy at dt ~ dt_cfl.  A change of the velocity alone (the speed
+ * cap, PBD friction and restitution) changes the next product by
+ * 1/2 m (|to|^2 - |from|^2). */
 static double impulse_removes(const cf_solid *s, const cf_fragment *f, int i, const double from[3],
-                              const double to[3], int leapfrog)
+                              const double to[3], int moves)
 {
     double m = s->m[f->nodes.v[i]];
-    if (!leapfrog)
+    if (!moves)
         return 0.5 * m * (v3_dot(from, from) - v3_dot(to, to));
     double dv[3], mid[3];
     v3_sub(to, from, dv);
@@ -129,7 +132,7 @@ static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double
             v3_axpy(-dt * (1.0 - scale), vt, &s->x[3 * a]);
         /* A moving obstacle's work: the impulse it gives times its velocity. */
         double w = s->m[a] * v3_dot(dv, u);
-        sim->flow.obstacles += w;
+        f->pending.obstacles += w;
         removed += w;
     }
     return removed;
@@ -230,11 +233,21 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
     }
     sim->flow.boundary += w_bc;
     if (!fracture) {
-        cf_node_state before, after;
-        cf_nodes_momenta(s, nodes, nn, &before);
+        /* Global damping D is linear, keeps momentum, and leaves the uniform
+         * kick dt g as it is, so D(v_old + dt g) = D(v_old) + dt g: it acts
+         * as a change of the velocity at the step's start, v_old <- D(v_old),
+         * which takes 1/2 m (|v|^2 - |D v|^2) and which the leapfrog product
+         * below then starts from.  (The velocities before damping wait in p,
+         * free until the prediction.) */
+        for (int i = 0; i < nn; i++)
+            memcpy(&s->p[3 * nodes[i]], &s->v[3 * nodes[i]], 3 * sizeof(double));
         cf_global_damping(s, nodes, nn, sim->def.solver.k_damping);
-        cf_nodes_momenta(s, nodes, nn, &after);
-        sim->flow.damping += before.ke - after.ke;
+        for (int i = 0; i < nn; i++) {
+            int a = nodes[i];
+            sim->flow.damping += impulse_removes(s, f, i, &s->p[3 * a], &s->v[3 * a], 0);
+            for (int k = 0; k < 3; k++)
+                f->v_old[3 * i + k] = s->v[3 * a + k] - dt * s->f[3 * a + k] / s->m[a];
+        }
     }
     double ke = 0, mx[3] = {0, 0, 0};
     for (int i = 0; i < nn; i++) {
@@ -308,7 +321,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
                                           set->iteration_independent);
     if (set->constraints == CF_CONSTRAINTS_XPBD)
         cf_bars_reset_lambda(&f->bars);
-    double w_obs = 0; /* work of moving obstacles on the nodes */
+    double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
     for (int it = 0; it < iterations; it++) {
         if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
             cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
@@ -326,7 +339,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
             w_obs += f->term[i];
         for (int i = 0; i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
-                sim->flow.boundary += impose_boundary(sim, nodes[i], dt, 1);
+                w_bc += impose_boundary(sim, nodes[i], dt, 1);
     }
     /* v <- (p - x)/dt ; x <- p, with a node's new speed bounded by the
      * fastest predicted speed among itself and its bar neighbours, or, on a
@@ -338,8 +351,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
      * has just split a compressed impact zone, in a 4.4 m/s drop), energy
      * that no load put in.  Nodes pushed by rigid neighbours' hulls are left
      * as they are (their push is booked as an impulse on the body).  The
-     * projection's energy is measured as the kinetic energy it removes,
-     * 1/2 m (v_pred^2 - v^2). */
+     * projection's energy is the work of its impulses m (v - v_pred)
+     * (impulse_removes), booked when the next step starts. */
     if (bars) {
 #pragma omp parallel for schedule(static) if (par)
         for (int i = 0; i < nn; i++)
@@ -364,7 +377,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         if (bars && speed > cap && (f->near.n == 0 || f->push.frag[i] < 0))
             scale = cap / speed;
         double vout[3] = {scale * vnew[0], scale * vnew[1], scale * vnew[2]};
-        f->term[i] = impulse_removes(s, f, i, va, vout, !bars);
+        f->term[i] = impulse_removes(s, f, i, va, vnew, 1) + impulse_removes(s, f, i, vnew, vout, 0);
         for (int c = 0; c < 3; c++) {
             va[c] = vout[c];
             s->x[3 * a + c] = s->p[3 * a + c];
@@ -386,26 +399,39 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         double dv[3] = {dP[0] / mass, dP[1] / mass, dP[2] / mass};
 #pragma omp parallel for schedule(static) if (par)
         for (int i = 0; i < nn; i++) {
-            double *va = &s->v[3 * nodes[i]], m = s->m[nodes[i]];
-            f->term[i] = 0.5 * m * v3_dot(va, va);
-            v3_axpy(1.0, dv, va);
-            f->term[i] -= 0.5 * m * v3_dot(va, va);
+            double *va = &s->v[3 * nodes[i]], to[3];
+            for (int c = 0; c < 3; c++)
+                to[c] = va[c] + dv[c];
+            f->term[i] = impulse_removes(s, f, i, va, to, 0);
+            memcpy(va, to, sizeof to);
         }
         for (int i = 0; i < nn; i++)
             removed += f->term[i];
     }
-    /* The kinetic change includes what moving obstacles put in: book that as
+    /* The kinetic change includes what moving obstacles and prescribed nodes
+     * put in (a prescribed node that the bars push back and the projection
+     * restores passes the bars' impulse on at its velocity): book that as
      * their work, and the rest as the projection's own removal. */
-    sim->flow.obstacles += w_obs;
+    f->pending.obstacles += w_obs;
+    f->pending.boundary += w_bc;
     if (bars)
-        sim->flow.pbd += removed + w_obs;
+        f->pending.pbd += removed + w_obs + w_bc;
     else
-        sim->flow.contact += removed + w_obs;
+        f->pending.contact += removed + w_obs + w_bc;
+}
+
+void cf_fragment_book_pending(cf_world *sim, cf_fragment *f)
+{
+    cf_energy_flows *p = &f->pending, *w = &sim->flow;
+    w->boundary += p->boundary, w->obstacles += p->obstacles;
+    w->contact += p->contact, w->pbd += p->pbd;
+    memset(p, 0, sizeof *p);
 }
 
 cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture)
 {
     cf_fragment *f = &sim->frag[fi];
+    cf_fragment_book_pending(sim, f);
     cf_status st = forces(sim, f, dt, fracture);
     if (st != CF_OK)
         return st;
@@ -414,7 +440,7 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
     double t1 = cf_wall_time();
     sim->prof.forces += t1 - t0;
     project(sim, f, t + dt, dt, fracture);
-    sim->flow.contact +=
+    f->pending.contact +=
         contact_velocities(sim, f, t + dt, dt, explicit_step(&sim->def.solver, fracture));
     sim->prof.pbd += cf_wall_time() - t1;
     f->steps++;

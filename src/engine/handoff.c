@@ -129,6 +129,7 @@ void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double 
 void cf_fragment_ledger_reset(cf_world *sim, int fi)
 {
     cf_fragment *f = &sim->frag[fi];
+    cf_fragment_book_pending(sim, f);
     cf_node_state ns;
     cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
     f->e_kin = ns.ke;
@@ -267,6 +268,7 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
 {
     cf_fragment *f = &sim->frag[fi];
     cf_solid *s = &sim->solid;
+    cf_fragment_book_pending(sim, f);
     double P0[3], L0[3], P1[3], L1[3];
     if (st)
         cf_body_momenta(f, st, P0, L0);
@@ -358,6 +360,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
 {
     cf_solid *s = &sim->solid;
     cf_fragment *f = &sim->frag[fi];
+    cf_fragment_book_pending(sim, f);
     f->cracked = 0;
     int nt = f->nt, *tets = f->tets;
     int *comp = malloc((size_t)nt * sizeof(int));
@@ -431,6 +434,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
 {
     cf_solid *s = &sim->solid;
     cf_fragment *f = &sim->frag[fi];
+    cf_fragment_book_pending(sim, f);
     int nt = f->nt;
     int *tets = f->tets;
     int *comp = malloc((size_t)nt * sizeof(int));

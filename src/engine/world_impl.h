@@ -15,6 +15,20 @@
 #include "pbd.h"
 #include "solid.h"
 
+/* Energy removed or put in by each mechanism since t = 0, J (docs/physics.md §4-§6;
+ * the ledger balance is in cf_world_ledger). */
+typedef struct cf_energy_flows {
+    double boundary;   /* work of prescribed velocities */
+    double obstacles;  /* work of moving obstacles (the energy contact with them put in) */
+    double contact;    /* removed by obstacle contact: restitution, friction, and
+                          the Bullet bodies' energy change beyond gravity's work */
+    double pbd;        /* removed by the PBD/XPBD projection */
+    double damping;    /* removed by global damping */
+    double handoff;    /* non-rigid kinetic + strain + cohesive stored energy
+                          dropped at fracture -> rigid hand-offs */
+    double integration; /* changed by Bullet's integrator in bodies touching nothing */
+} cf_energy_flows;
+
 typedef enum { CF_MODE_DEAD = -1, CF_MODE_RIGID = 0, CF_MODE_FRACTURE = 1 } cf_mode;
 
 typedef struct cf_fragment {
@@ -42,6 +56,12 @@ typedef struct cf_fragment {
     double e_kin;            /* J, 1/2 sum m v(n-1/2).v(n+1/2) (leapfrog estimate) */
     double e_strain;         /* J */
     double mx[3];            /* kg m, sum m x */
+    /* What the last projection (bars, obstacles, prescribed nodes, friction
+     * and restitution) did, booked into the world's flows when the next step
+     * starts or the hand-off takes the fragment (cf_fragment_book_pending):
+     * the projection of step n takes the state to n + 1, and e_kin is the
+     * kinetic energy at step n. */
+    cf_energy_flows pending;
     int n_inverted;          /* tets with det F <= 0 */
     /* Rigid mode with Bullet: the convex decomposition (principal frame). */
     cf_hulls hulls;
@@ -62,19 +82,6 @@ typedef struct cf_fragment {
 #define CF_HULL_MAX_COUNT 64
 #define CF_HULL_MIN_TETS 4
 
-/* Energy removed or put in by each mechanism since t = 0, J (docs/physics.md §4-§6;
- * the ledger balance is in cf_world_ledger). */
-typedef struct cf_energy_flows {
-    double boundary;   /* work of prescribed velocities */
-    double obstacles;  /* work of moving obstacles (the energy contact with them put in) */
-    double contact;    /* removed by obstacle contact: restitution, friction, and
-                          the Bullet bodies' energy change beyond gravity's work */
-    double pbd;        /* removed by the PBD/XPBD projection */
-    double damping;    /* removed by global damping */
-    double handoff;    /* non-rigid kinetic + strain + cohesive stored energy
-                          dropped at fracture -> rigid hand-offs */
-    double integration; /* changed by Bullet's integrator in bodies touching nothing */
-} cf_energy_flows;
 
 typedef struct cf_profile {
     double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s of wall time */
@@ -163,6 +170,9 @@ void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double 
 /* The ledger state of fragment fi from its nodes now: exact kinetic energy,
  * zero strain energy, sum m x. */
 void cf_fragment_ledger_reset(cf_world *sim, int fi);
+
+/* Adds fragment f's pending flows to the world's and clears them. */
+void cf_fragment_book_pending(cf_world *sim, cf_fragment *f);
 
 /* Bullet collision margin of fragment fi: 0.1% of its size, m (Bullet's
  * default 4 cm would hold small fragments off the ground). */
