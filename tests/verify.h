@@ -39,6 +39,26 @@ static cf_sim *verify_open(const char *file, const char *const *sets, cf_world_d
     return sim;
 }
 
+/* Step sim to its end; returns the largest |residual| / input over its
+ * rigid steps (input: initial energy + the positive work of gravity,
+ * prescribed nodes and moving obstacles), and the last ledger in *last.
+ * A step that fails fails the test. */
+static inline double verify_worst_residual(cf_sim *sim, cf_ledger *last)
+{
+    cf_error err;
+    double worst = 0;
+    while (!cf_sim_done(sim)) {
+        if (cf_sim_advance(sim, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        cf_world_ledger(cf_sim_world(sim), last);
+        double in = last->initial + fmax(0.0, last->work_gravity) +
+                    fmax(0.0, last->work_boundary) + fmax(0.0, last->work_obstacles);
+        if (in > 0)
+            worst = fmax(worst, fabs(last->residual) / in);
+    }
+    return worst;
+}
+
 /* Report `quantity` of case `name`: measured against reference with a
  * relative (or, when reference is 0, absolute) tolerance; returns whether
  * it holds.  tolerance <= 0: reported only, never fails. */

@@ -43,18 +43,8 @@ static double worst_residual(const char *file, const char *const *sets)
     all[n] = NULL;
     cf_world_def sc;
     cf_sim *sim = verify_open(rel, all, &sc);
-    cf_error err;
-    double worst = 0;
     cf_ledger l;
-    while (!cf_sim_done(sim)) {
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("%s: %s", file, err.msg);
-        cf_world_ledger(cf_sim_world(sim), &l);
-        double in = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
-                    fmax(0.0, l.work_obstacles);
-        if (in > 0)
-            worst = fmax(worst, fabs(l.residual) / in);
-    }
+    double worst = verify_worst_residual(sim, &l);
     printf("%s: removed by the projection %.4g J, residual at the end %.3g J\n", file, l.pbd,
            l.residual);
     cf_sim_destroy(sim);
