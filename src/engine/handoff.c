@@ -26,6 +26,7 @@ int cf_fragment_new(cf_world *sim, int parent, double birth_time)
     f->mode = CF_MODE_RIGID;
     f->body = -1;
     f->q_match[0] = 1;
+    f->separated = -1;
     return sim->n_frag++;
 }
 
@@ -297,6 +298,7 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     }
     clear_obstacles(sim, f);
     f->mode = CF_MODE_FRACTURE;
+    f->separated = -1;
     f->steps = f->quiet = 0;
     f->t_enter = sim->t;
     cf_fragment_ledger_reset(sim, fi);
@@ -360,8 +362,19 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
 {
     cf_solid *s = &sim->solid;
     cf_fragment *f = &sim->frag[fi];
-    cf_fragment_book_pending(sim, f);
     f->cracked = 0;
+    /* Insertion alone never splits a fragment: a new cohesive element joins
+     * the two tets whose nodes it duplicated until all three of its node
+     * pairs have failed (cf_label_pieces).  Unless more elements have failed
+     * completely since the last check, the pieces are those it found. */
+    int separated = 0;
+    for (int e = 0; e < f->coh.n; e++) {
+        const unsigned char *failed = s->coh[f->coh.v[e]].failed;
+        separated += failed[0] && failed[1] && failed[2];
+    }
+    if (separated == f->separated)
+        return 0;
+    f->separated = separated;
     int nt = f->nt, *tets = f->tets;
     int *comp = malloc((size_t)nt * sizeof(int));
     if (!comp)
@@ -371,6 +384,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         free(comp);
         return k < 0 ? -1 : 0;
     }
+    cf_fragment_book_pending(sim, f);
     /* The parent's per-node leapfrog kinetic energy terms, by node id. */
     int *index = malloc((size_t)s->n_nodes * sizeof(int));
     unsigned char *seen = calloc((size_t)s->n_nodes, 1);

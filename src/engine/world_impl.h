@@ -46,6 +46,8 @@ typedef struct cf_fragment {
     cf_int_list coh;         /* its cohesive elements */
     long steps, quiet;       /* solver steps in this mode; steps since the last insertion */
     int cracked;             /* facets inserted since the last split check (fracture-only runs) */
+    int separated;           /* its cohesive elements with every node pair failed at the
+                                last split check; -1: not counted yet */
     double t_enter;          /* s, when fracture mode began */
     int *contact;            /* [nodes.n] obstacle in contact after the last projection, -1 */
     double *vn_pre;          /* [nodes.n] normal velocity before projection, m/s */
