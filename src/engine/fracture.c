@@ -377,7 +377,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         if (bars && speed > cap && (f->near.n == 0 || f->push.frag[i] < 0))
             scale = cap / speed;
         double vout[3] = {scale * vnew[0], scale * vnew[1], scale * vnew[2]};
-        f->term[i] = impulse_removes(s, f, i, va, vnew, 1) + impulse_removes(s, f, i, vnew, vout, 0);
+        f->term[i] =
+            impulse_removes(s, f, i, va, vnew, 1) + impulse_removes(s, f, i, vnew, vout, 0);
         for (int c = 0; c < 3; c++) {
             va[c] = vout[c];
             s->x[3 * a + c] = s->p[3 * a + c];
