@@ -285,10 +285,15 @@ double cf_world_crack_area(const cf_world *w);
 /* The initial state's bounds, for readers that check a run's outcome
  * (tools/check_physics.py): the box around the nodes (m), total mass (kg),
  * kinetic + strain energy (J), fastest node (m/s), fastest kinematic
- * obstacle or prescribed velocity (m/s). */
+ * obstacle or prescribed velocity (m/s), and the release speed (m/s): the
+ * particle velocity a stress wave of the strongest facet's strength carries,
+ * max(sigma_max / sqrt(rho E), tau_max / sqrt(rho mu)) times the largest
+ * strength factor (1-D wave theory, v = sigma / (rho c)); 0 without an
+ * insertion criterion.  A piece cut free from a body held at its strength
+ * springs back at most at about that speed. */
 typedef struct cf_initial_bounds {
     double lower[3], upper[3];
-    double mass, energy, max_speed, max_obstacle_speed;
+    double mass, energy, max_speed, max_obstacle_speed, release_speed;
 } cf_initial_bounds;
 
 void cf_world_initial_bounds(const cf_world *w, cf_initial_bounds *out);

@@ -196,7 +196,7 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     if (!s->sigma || !s->hot || !s->qualify || !s->node_mark || !s->nodal || build_facets(s))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
                             s->n_tets);
-    s->strength_min = 1.0;
+    s->strength_min = s->strength_max = 1.0;
     if (s->mat.weibull) {
         s->strength = malloc((size_t)(s->n_facets > 0 ? s->n_facets : 1) * sizeof(float));
         if (!s->strength)
@@ -204,6 +204,7 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
         for (int f = 0; f < s->n_facets; f++) {
             s->strength[f] = (float)weibull_factor(s->mat.strength_seed, f, s->mat.weibull_modulus);
             s->strength_min = fmin(s->strength_min, s->strength[f]);
+            s->strength_max = fmax(s->strength_max, s->strength[f]);
         }
     }
     return CF_OK;

@@ -75,6 +75,7 @@ typedef struct cf_solid {
     float *strength;          /* [nf] facet strength / sigma_max (material.strength;
                                  NULL: 1 everywhere) */
     double strength_min;      /* the smallest of them (1 when uniform) */
+    double strength_max;      /* the largest (1 when uniform) */
     unsigned char *node_mark; /* [cap_nodes] scratch of the source criterion, all 0 between
                                  checks (fracture state) */
     double *nodal;            /* [cap_nodes] its nodal values, Pa (fracture state) */

@@ -422,6 +422,11 @@ static void initial_bounds(cf_world *sim)
         b->max_obstacle_speed = fmax(b->max_obstacle_speed, v3_norm(sc->boundaries[j].velocity));
     b->max_speed = sqrt(v2);
     b->energy = sim->e0;
+    const cf_material *m = &s->mat;
+    b->release_speed = 0;
+    if (s->facet) /* an insertion criterion: facets can be held up to their strength */
+        b->release_speed = s->strength_max * fmax(m->sigma_max / sqrt(m->rho * m->E),
+                                                  m->tau_max / sqrt(m->rho * s->mu));
 }
 
 void cf_world_initial_bounds(const cf_world *sim, cf_initial_bounds *out) { *out = sim->bounds; }

@@ -251,7 +251,8 @@ static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
              {"total_mass", &b.mass, 1, "kg"},
              {"initial_energy", &b.energy, 1, "J"},
              {"max_initial_speed", &b.max_speed, 1, "m/s"},
-             {"max_obstacle_speed", &b.max_obstacle_speed, 1, "m/s"}};
+             {"max_obstacle_speed", &b.max_obstacle_speed, 1, "m/s"},
+             {"release_speed", &b.release_speed, 1, "m/s"}};
     cf_status st = CF_OK;
     for (size_t i = 0; i < sizeof p / sizeof p[0] && st == CF_OK; i++)
         st = cf_h5_write_parameter(sim->h5, p[i].name, p[i].v, p[i].n, p[i].unit, err);
