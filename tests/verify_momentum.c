@@ -40,12 +40,17 @@ static void momentum_to_round_off(void **state)
         worst_fracture = fmax(worst_fracture, drift(sim, P0));
     }
     int n_coh = cf_sim_world(sim)->solid.n_coh, copies = cf_sim_world(sim)->solid.n_nodes - nodes0;
-    /* Hand the torn block to rigid mode (pbd rigid backend: no Bullet world
-     * in this scene) and fly on. */
-    if (cf_handoff_to_rigid(cf_sim_world(sim), 0, &err) != CF_OK)
-        fail_msg("%s", err.msg);
+    /* Hand the torn block (the fracture-mode fragments it has come apart
+     * into) to rigid mode (pbd rigid backend: no Bullet world in this scene)
+     * and fly on. */
+    cf_world *w = cf_sim_world(sim);
+    for (int fi = 0, n = w->n_frag; fi < n; fi++)
+        if (w->frag[fi].mode == CF_MODE_FRACTURE && cf_handoff_to_rigid(w, fi, &err) != CF_OK)
+            fail_msg("%s", err.msg);
     double after_handoff = drift(sim, P0), worst_rigid = 0;
-    int pieces = cf_sim_world(sim)->n_frag - 1;
+    int pieces = 0;
+    for (int fi = 0; fi < w->n_frag; fi++)
+        pieces += w->frag[fi].mode != CF_MODE_DEAD;
     for (int k = 0; k < 50; k++) {
         cf_sim_world(sim)->n_steps++;
         if (cf_sim_advance(sim, &err) != CF_OK)

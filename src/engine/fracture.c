@@ -50,7 +50,6 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, int n_hot, int 
     if (cf_bars_patch(&f->bars, s, sim->touched.v, sim->touched.n, &sim->bar_scratch))
         return CF_ERR_NOMEM;
     *inserted = nc;
-    f->cracked += nc;
     sim->prof.insertion += cf_wall_time() - t0;
     return CF_OK;
 }

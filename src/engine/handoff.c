@@ -362,7 +362,6 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
 {
     cf_solid *s = &sim->solid;
     cf_fragment *f = &sim->frag[fi];
-    f->cracked = 0;
     /* Insertion alone never splits a fragment: a new cohesive element joins
      * the two tets whose nodes it duplicated until all three of its node
      * pairs have failed (cf_label_pieces).  Unless more elements have failed

@@ -1051,9 +1051,11 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
     return CF_OK;
 }
 
-/* Fragments that cracked in this step and now fall apart become one
- * fracture-mode fragment per connected piece, labelled and written like the
- * pieces of a hand-off.  The failed cohesive elements between two pieces go
+/* Fracture-mode fragments that now fall apart (more of their cohesive
+ * elements have failed at all three node pairs since the last check, with or
+ * without a new insertion: a piece comes free when its last node pair fails)
+ * become one fracture-mode fragment per connected piece, labelled and
+ * written like the pieces of a hand-off.  The failed cohesive elements between two pieces go
  * with the split: their compression penalty, kept between pieces that
  * tumble apart, acted along a mid-surface that no longer means anything and
  * pumped energy in (an explicit drop's cohesive stored energy fell to -280 J
@@ -1062,7 +1064,7 @@ static cf_status split_fragments(cf_world *sim, cf_error *err)
 {
     int n = sim->n_frag;
     for (int fi = 0; fi < n; fi++) {
-        if (sim->frag[fi].mode != CF_MODE_FRACTURE || !sim->frag[fi].cracked)
+        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
         int first = sim->n_frag;
         double th = cf_wall_time();

@@ -45,7 +45,6 @@ typedef struct cf_fragment {
     cf_bars bars;
     cf_int_list coh;         /* its cohesive elements */
     long steps, quiet;       /* solver steps in this mode; steps since the last insertion */
-    int cracked;             /* facets inserted since the last split check (fracture-only runs) */
     int separated;           /* its cohesive elements with every node pair failed at the
                                 last split check; -1: not counted yet */
     double t_enter;          /* s, when fracture mode began */
