@@ -32,22 +32,103 @@ static inline void hooke(const cf_solid *s, const double A[9], double sig[9], do
     *energy_density = w;
 }
 
-/* Stress in the element frame from the deformation gradient F, the
- * rotation that takes it to the world, and the strain energy density. */
+/* Tets whose rotations are found side by side.  The rotation iteration is
+ * one long dependent chain per tet (square roots, divisions, a sine and a
+ * cosine), so a core running one tet at a time mostly waits on it; running
+ * LANES independent chains phase by phase lets it overlap them.  Each lane
+ * does exactly the operations of polar_rotation (linalg.h) in the same
+ * order, so the bits are those of one tet at a time. */
+#define LANES 4
+
+/* polar_rotation for the first n lanes: q[l] the warm start (updated), R[l]
+ * the rotation, at most max_iter updates, stop below tol (rad). */
+static void polar_rotation_lanes(double F[LANES][9], double q[LANES][4], int n,
+                                 int max_iter, double tol, double R[LANES][9])
+{
+    int active[LANES];
+    for (int l = 0; l < n; l++) {
+        quat_normalize(q[l]);
+        active[l] = 1;
+    }
+    for (int it = 0; it < max_iter; it++) {
+        double om[LANES][3], angle[LANES];
+        int left = 0;
+        for (int l = 0; l < n; l++) {
+            if (!active[l])
+                continue;
+            quat_to_mat(q[l], R[l]);
+            const double *Rl = R[l], *Fl = F[l];
+            double dotsum = 0;
+            om[l][0] = om[l][1] = om[l][2] = 0;
+            for (int c = 0; c < 3; c++) {
+                double r[3] = {Rl[c], Rl[3 + c], Rl[6 + c]}, f[3] = {Fl[c], Fl[3 + c], Fl[6 + c]},
+                       rf[3];
+                v3_cross(r, f, rf);
+                om[l][0] += rf[0], om[l][1] += rf[1], om[l][2] += rf[2];
+                dotsum += v3_dot(r, f);
+            }
+            double s = 1.0 / (fabs(dotsum) + 1e-9);
+            om[l][0] *= s, om[l][1] *= s, om[l][2] *= s;
+            angle[l] = v3_norm(om[l]);
+            if (angle[l] < tol)
+                active[l] = 0; /* R[l] already holds q[l] */
+            left += active[l];
+        }
+        if (!left)
+            return;
+        for (int l = 0; l < n; l++) {
+            if (!active[l])
+                continue;
+            double half = 0.5 * angle[l], sh = sin(half) / angle[l];
+            double dq[4] = {cos(half), om[l][0] * sh, om[l][1] * sh, om[l][2] * sh};
+            double *ql = q[l];
+            /* q <- dq * q */
+            double nq[4] = {dq[0] * ql[0] - dq[1] * ql[1] - dq[2] * ql[2] - dq[3] * ql[3],
+                            dq[0] * ql[1] + dq[1] * ql[0] + dq[2] * ql[3] - dq[3] * ql[2],
+                            dq[0] * ql[2] - dq[1] * ql[3] + dq[2] * ql[0] + dq[3] * ql[1],
+                            dq[0] * ql[3] + dq[1] * ql[2] - dq[2] * ql[1] + dq[3] * ql[0]};
+            memcpy(ql, nq, sizeof nq);
+            quat_normalize(ql);
+        }
+    }
+    for (int l = 0; l < n; l++)
+        if (active[l])
+            quat_to_mat(q[l], R[l]);
+}
+
+/* Stress in the element frame from the deformation gradient F and its
+ * rotation R to the world, and the strain energy density. */
 static inline void element_stress(const cf_solid *s, const double F[9], cf_elasticity kind,
-                                  double q[4], double R[9], double sig[9], double *w)
+                                  const double R[9], double sig[9], double *w)
 {
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         double S[9];
-        /* A rotation error theta leaves a strain error O(theta^2 + theta eps): 1e-7
-         * rad is far below any cracking strain. */
-        polar_rotation(F, q, 10, 1e-7, R);
         m3_mul_tn(R, F, S);
         hooke(s, S, sig, w);
     } else {
-        R[0] = R[4] = R[8] = 1, R[1] = R[2] = R[3] = R[5] = R[6] = R[7] = 0;
         hooke(s, F, sig, w);
     }
+}
+
+/* The rotations of tets t[0..n-1] (n <= LANES) at deformation gradients F,
+ * from and into the warm starts s->rq; the identity for small strain.  A
+ * rotation error theta leaves a strain error O(theta^2 + theta eps): 1e-7
+ * rad is far below any cracking strain. */
+static void element_rotations(cf_solid *s, const int *t, int n, double F[LANES][9],
+                              cf_elasticity kind, double R[LANES][9])
+{
+    if (kind != CF_ELASTICITY_COROTATIONAL) {
+        for (int l = 0; l < n; l++)
+            R[l][0] = R[l][4] = R[l][8] = 1, R[l][1] = R[l][2] = R[l][3] = R[l][5] = R[l][6] =
+                R[l][7] = 0;
+        return;
+    }
+    double q[LANES][4];
+    for (int l = 0; l < n; l++)
+        memcpy(q[l], &s->rq[4 * t[l]], sizeof q[l]);
+    polar_rotation_lanes(F, q, n, 10, 1e-7, R);
+    for (int l = 0; l < n; l++)
+        memcpy(&s->rq[4 * t[l]], q[l], sizeof q[l]);
 }
 
 /* Gershgorin bounds of a symmetric 3x3 matrix's eigenvalues: every one
@@ -69,28 +150,35 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
      * hundreds of few-tet fragments in fracture mode ran slower on 2
      * threads than on 1. */
 #pragma omp parallel for schedule(static) reduction(+ : inverted, hot) if (nt >= CF_TET4_PARALLEL_MIN)
-    for (int i = 0; i < nt; i++) {
-        int t = tets[i];
-        double R[9], sig[9], P[9], g[4][3], F[9], w;
-        deformation_gradient(s, t, F);
-        inverted += m3_det(F) <= 0;
-        element_stress(s, F, kind, &s->rq[4 * t], R, sig, &w);
-        s->tw[t] = w * s->vol[t];
-        m3_mul(R, sig, P); /* f_i = -V R sigma grad N_i */
-        cf_tet4_gradients(s, t, g);
-        double *tf = &s->tf[12 * t];
-        for (int a = 0; a < 4; a++) {
-            double fa[3];
-            m3_mulv(P, g[a], fa);
-            for (int c = 0; c < 3; c++)
-                tf[3 * a + c] = -s->vol[t] * fa[c];
+    for (int i0 = 0; i0 < nt; i0 += LANES) {
+        int n = nt - i0 < LANES ? nt - i0 : LANES;
+        const int *t = &tets[i0];
+        double F[LANES][9], R[LANES][9];
+        for (int l = 0; l < n; l++) {
+            deformation_gradient(s, t[l], F[l]);
+            inverted += m3_det(F[l]) <= 0;
         }
-        if (check) {
-            double lo, hi;
-            m3_mul_nt(P, R, &s->sigma[9 * t]); /* R sigma R^T */
-            gershgorin(sig, &lo, &hi);
-            s->hot[t] = hi >= check->s1 || 0.5 * (hi - lo) >= check->tau;
-            hot += s->hot[t];
+        element_rotations(s, t, n, F, kind, R);
+        for (int l = 0; l < n; l++) {
+            double sig[9], P[9], g[4][3], w;
+            element_stress(s, F[l], kind, R[l], sig, &w);
+            s->tw[t[l]] = w * s->vol[t[l]];
+            m3_mul(R[l], sig, P); /* f_i = -V R sigma grad N_i */
+            cf_tet4_gradients(s, t[l], g);
+            double *tf = &s->tf[12 * t[l]];
+            for (int a = 0; a < 4; a++) {
+                double fa[3];
+                m3_mulv(P, g[a], fa);
+                for (int c = 0; c < 3; c++)
+                    tf[3 * a + c] = -s->vol[t[l]] * fa[c];
+            }
+            if (check) {
+                double lo, hi;
+                m3_mul_nt(P, R[l], &s->sigma[9 * t[l]]); /* R sigma R^T */
+                gershgorin(sig, &lo, &hi);
+                s->hot[t[l]] = hi >= check->s1 || 0.5 * (hi - lo) >= check->tau;
+                hot += s->hot[t[l]];
+            }
         }
     }
     if (n_hot)
@@ -104,7 +192,11 @@ void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9
     for (int k = 0; k < 4; k++)
         q[k] = s->rq[4 * t + k];
     deformation_gradient(s, t, F);
-    element_stress(s, F, kind, q, R, sig, &w);
+    if (kind == CF_ELASTICITY_COROTATIONAL)
+        polar_rotation(F, q, 10, 1e-7, R);
+    else
+        R[0] = R[4] = R[8] = 1, R[1] = R[2] = R[3] = R[5] = R[6] = R[7] = 0;
+    element_stress(s, F, kind, R, sig, &w);
     m3_mul(R, sig, P);
     m3_mul_nt(P, R, sigma);
 }
