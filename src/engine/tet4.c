@@ -81,14 +81,8 @@ static void polar_rotation_lanes(double F[LANES][9], double q[LANES][4], int n,
                 continue;
             double half = 0.5 * angle[l], sh = sin(half) / angle[l];
             double dq[4] = {cos(half), om[l][0] * sh, om[l][1] * sh, om[l][2] * sh};
-            double *ql = q[l];
-            /* q <- dq * q */
-            double nq[4] = {dq[0] * ql[0] - dq[1] * ql[1] - dq[2] * ql[2] - dq[3] * ql[3],
-                            dq[0] * ql[1] + dq[1] * ql[0] + dq[2] * ql[3] - dq[3] * ql[2],
-                            dq[0] * ql[2] - dq[1] * ql[3] + dq[2] * ql[0] + dq[3] * ql[1],
-                            dq[0] * ql[3] + dq[1] * ql[2] - dq[2] * ql[1] + dq[3] * ql[0]};
-            memcpy(ql, nq, sizeof nq);
-            quat_normalize(ql);
+            quat_premul(dq, q[l]);
+            quat_normalize(q[l]);
         }
     }
     for (int l = 0; l < n; l++)

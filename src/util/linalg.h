@@ -101,6 +101,16 @@ static inline void quat_normalize(double q[4])
         q[i] /= n;
 }
 
+/* q <- dq q (Hamilton product). */
+static inline void quat_premul(const double dq[4], double q[4])
+{
+    double nq[4] = {dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
+                    dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
+                    dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
+                    dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]};
+    memcpy(q, nq, sizeof nq);
+}
+
 /* Rotation part R of F = R S (polar decomposition), by the quaternion
  * iteration of Müller, Bender, Chentanez, Macklin 2016 ("A robust method to
  * extract the rotational part of deformations"); q is the warm start and is
@@ -126,12 +136,7 @@ static inline void polar_rotation(const double F[9], double q[4], int max_iter, 
             return; /* R already holds q */
         double half = 0.5 * angle, sh = sin(half) / angle;
         double dq[4] = {cos(half), om[0] * sh, om[1] * sh, om[2] * sh};
-        /* q <- dq * q */
-        double nq[4] = {dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
-                        dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
-                        dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
-                        dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]};
-        memcpy(q, nq, sizeof nq);
+        quat_premul(dq, q);
         quat_normalize(q);
     }
     quat_to_mat(q, R);
