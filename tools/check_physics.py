@@ -67,18 +67,19 @@ def read(path):
         frames = len(f["particles/fragments/position/step"])
         pos = f["particles/fragments/position/value"][:frames]
         vel = f["particles/fragments/velocity/value"][:frames]
-        release = float(f["parameters/release_speed"][()]) if "parameters/release_speed" in f else 0.0
-    return scene, p, o, pos, vel, release
+        p["release_speed"] = (np.asarray(f["parameters/release_speed"][()], dtype=float)
+                              if "parameters/release_speed" in f else 0.0)
+    return scene, p, o, pos, vel
 
 
 def check_file(path, quiet=False):
-    scene, p, o, pos, vel, release = read(path)
+    scene, p, o, pos, vel = read(path)
     g = gravity_of(scene)
     gn = float(np.linalg.norm(g))
     up = -g / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
     v0 = float(p["max_initial_speed"])
     U = float(p["max_obstacle_speed"])
-    v_r = release
+    v_r = float(p["release_speed"])
     M = float(p["total_mass"])
     top = float(np.dot(p["initial_upper"], up)) if gn > 0 else 0.0
     heights = pos @ up

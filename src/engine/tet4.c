@@ -56,34 +56,16 @@ static void polar_rotation_lanes(double F[LANES][9], double q[LANES][4], int n,
         for (int l = 0; l < n; l++) {
             if (!active[l])
                 continue;
-            quat_to_mat(q[l], R[l]);
-            const double *Rl = R[l], *Fl = F[l];
-            double dotsum = 0;
-            om[l][0] = om[l][1] = om[l][2] = 0;
-            for (int c = 0; c < 3; c++) {
-                double r[3] = {Rl[c], Rl[3 + c], Rl[6 + c]}, f[3] = {Fl[c], Fl[3 + c], Fl[6 + c]},
-                       rf[3];
-                v3_cross(r, f, rf);
-                om[l][0] += rf[0], om[l][1] += rf[1], om[l][2] += rf[2];
-                dotsum += v3_dot(r, f);
-            }
-            double s = 1.0 / (fabs(dotsum) + 1e-9);
-            om[l][0] *= s, om[l][1] *= s, om[l][2] *= s;
-            angle[l] = v3_norm(om[l]);
+            angle[l] = polar_axis(F[l], q[l], R[l], om[l]);
             if (angle[l] < tol)
                 active[l] = 0; /* R[l] already holds q[l] */
             left += active[l];
         }
         if (!left)
             return;
-        for (int l = 0; l < n; l++) {
-            if (!active[l])
-                continue;
-            double half = 0.5 * angle[l], sh = sin(half) / angle[l];
-            double dq[4] = {cos(half), om[l][0] * sh, om[l][1] * sh, om[l][2] * sh};
-            quat_premul(dq, q[l]);
-            quat_normalize(q[l]);
-        }
+        for (int l = 0; l < n; l++)
+            if (active[l])
+                polar_turn(q[l], om[l], angle[l]);
     }
     for (int l = 0; l < n; l++)
         if (active[l])
@@ -113,8 +95,7 @@ static void element_rotations(cf_solid *s, const int *t, int n, double F[LANES][
 {
     if (kind != CF_ELASTICITY_COROTATIONAL) {
         for (int l = 0; l < n; l++)
-            R[l][0] = R[l][4] = R[l][8] = 1, R[l][1] = R[l][2] = R[l][3] = R[l][5] = R[l][6] =
-                R[l][7] = 0;
+            m3_identity(R[l]);
         return;
     }
     double q[LANES][4];
@@ -189,7 +170,7 @@ void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9
     if (kind == CF_ELASTICITY_COROTATIONAL)
         polar_rotation(F, q, 10, 1e-7, R);
     else
-        R[0] = R[4] = R[8] = 1, R[1] = R[2] = R[3] = R[5] = R[6] = R[7] = 0;
+        m3_identity(R);
     element_stress(s, F, kind, R, sig, &w);
     m3_mul(R, sig, P);
     m3_mul_nt(P, R, sigma);

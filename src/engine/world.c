@@ -1055,11 +1055,11 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
  * elements have failed at all three node pairs since the last check, with or
  * without a new insertion: a piece comes free when its last node pair fails)
  * become one fracture-mode fragment per connected piece, labelled and
- * written like the pieces of a hand-off.  The failed cohesive elements between two pieces go
- * with the split: their compression penalty, kept between pieces that
- * tumble apart, acted along a mid-surface that no longer means anything and
- * pumped energy in (an explicit drop's cohesive stored energy fell to -280 J
- * within 50 us, docs/physics.md §14.6). */
+ * written like the pieces of a hand-off.  The failed cohesive elements
+ * between two pieces go with the split: their compression penalty, kept
+ * between pieces that tumble apart, acted along a mid-surface that no
+ * longer means anything and pumped energy in (an explicit drop's cohesive
+ * stored energy fell to -280 J within 50 us, docs/physics.md §14.6). */
 static cf_status split_fragments(cf_world *sim, cf_error *err)
 {
     int n = sim->n_frag;

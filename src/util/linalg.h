@@ -82,6 +82,11 @@ static inline double m3_det(const double A[9])
 /* Inverse; returns the determinant (0 and out untouched when singular). */
 double m3_inv(const double A[9], double out[9]);
 
+static inline void m3_identity(double R[9])
+{
+    R[0] = R[4] = R[8] = 1, R[1] = R[2] = R[3] = R[5] = R[6] = R[7] = 0;
+}
+
 /* Quaternion (w,x,y,z) <-> rotation matrix; normalise in place. */
 static inline void quat_to_mat(const double q[4], double R[9])
 {
@@ -101,14 +106,37 @@ static inline void quat_normalize(double q[4])
         q[i] /= n;
 }
 
-/* q <- dq q (Hamilton product). */
-static inline void quat_premul(const double dq[4], double q[4])
+/* One step of the polar iteration below: R from the current q, and the
+ * update omega = sum r_i x f_i / (|sum r_i . f_i| + eps) over the columns
+ * of R and F; returns its angle |omega| (rad). */
+static inline double polar_axis(const double F[9], const double q[4], double R[9], double om[3])
 {
+    quat_to_mat(q, R);
+    double dotsum = 0;
+    om[0] = om[1] = om[2] = 0;
+    for (int c = 0; c < 3; c++) {
+        double r[3] = {R[c], R[3 + c], R[6 + c]}, f[3] = {F[c], F[3 + c], F[6 + c]}, rf[3];
+        v3_cross(r, f, rf);
+        om[0] += rf[0], om[1] += rf[1], om[2] += rf[2];
+        dotsum += v3_dot(r, f);
+    }
+    double s = 1.0 / (fabs(dotsum) + 1e-9);
+    om[0] *= s, om[1] *= s, om[2] *= s;
+    return v3_norm(om);
+}
+
+/* q <- exp(omega / 2) q, normalised: the rotation by omega (angle |omega|
+ * > 0) applied to q. */
+static inline void polar_turn(double q[4], const double om[3], double angle)
+{
+    double half = 0.5 * angle, sh = sin(half) / angle;
+    double dq[4] = {cos(half), om[0] * sh, om[1] * sh, om[2] * sh};
     double nq[4] = {dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
                     dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
                     dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
                     dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]};
     memcpy(q, nq, sizeof nq);
+    quat_normalize(q);
 }
 
 /* Rotation part R of F = R S (polar decomposition), by the quaternion
@@ -120,24 +148,10 @@ static inline void polar_rotation(const double F[9], double q[4], int max_iter, 
 {
     quat_normalize(q);
     for (int it = 0; it < max_iter; it++) {
-        quat_to_mat(q, R);
-        /* Columns of R and F; omega = sum r_i x f_i / (|sum r_i . f_i| + eps). */
-        double om[3] = {0, 0, 0}, dotsum = 0;
-        for (int c = 0; c < 3; c++) {
-            double r[3] = {R[c], R[3 + c], R[6 + c]}, f[3] = {F[c], F[3 + c], F[6 + c]}, rf[3];
-            v3_cross(r, f, rf);
-            om[0] += rf[0], om[1] += rf[1], om[2] += rf[2];
-            dotsum += v3_dot(r, f);
-        }
-        double s = 1.0 / (fabs(dotsum) + 1e-9);
-        om[0] *= s, om[1] *= s, om[2] *= s;
-        double angle = v3_norm(om);
+        double om[3], angle = polar_axis(F, q, R, om);
         if (angle < tol)
             return; /* R already holds q */
-        double half = 0.5 * angle, sh = sin(half) / angle;
-        double dq[4] = {cos(half), om[0] * sh, om[1] * sh, om[2] * sh};
-        quat_premul(dq, q);
-        quat_normalize(q);
+        polar_turn(q, om, angle);
     }
     quat_to_mat(q, R);
 }
