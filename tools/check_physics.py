@@ -20,7 +20,10 @@ ledger in /observables:
             (when positive) + 1/2 M (2U)^2 for kinematic impactors;
   dissipation  energy_cohesive_dissipated is never negative and never falls
             (by more than 1e-9 of the input, round-off);
-  residual  |energy_residual| <= 1% of the input at every frame.
+  residual  |energy_residual| <= 1% of the input at every frame;
+  complete  the last frame is at the scene's duration: a run that stopped
+            early (diverged, exit 3, or interrupted) has no end to check,
+            and its frames so far may all look fine.
 
 Prints one line per check with the figure and its bound.  Exit status 0
 when every check of every file holds, 1 when one fails, 2 when a file
@@ -48,6 +51,15 @@ def gravity_of(scene):
     return np.zeros(3)
 
 
+def duration_of(scene):
+    """The run's duration (s) from the resolved scene text (its top-level key)."""
+    for line in scene.splitlines():
+        key, _, value = line.strip().partition("=")
+        if key.strip() == "duration" and line.startswith("  duration"):
+            return float(value.strip().rstrip(","))
+    raise KeyError("duration in /parameters/scene")
+
+
 def read(path):
     """The figures the checks need, or raises KeyError naming what is missing."""
     with h5py.File(path, "r") as f:
@@ -64,6 +76,8 @@ def read(path):
         p = {n: np.asarray(f[f"parameters/{n}"][()], dtype=float) for n in REQUIRED_PARAMETERS}
         o = {n: np.asarray(f[f"observables/{n}/value"][()], dtype=float)
              for n in REQUIRED_OBSERVABLES}
+        p["last_time"] = (float(f["observables/energy_kinetic/time"][-1])
+                          if len(f["observables/energy_kinetic/time"]) else 0.0)
         frames = len(f["particles/fragments/position/step"])
         pos = f["particles/fragments/position/value"][:frames]
         vel = f["particles/fragments/velocity/value"][:frames]
@@ -99,6 +113,7 @@ def check_file(path, quiet=False):
     diss_drop = float(np.max(diss[:-1] - diss[1:])) if len(diss) > 1 else 0.0
     resid = float(np.max(np.abs(o["energy_residual"]))) if len(o["energy_residual"]) else 0.0
     tol = 1e-9 * input_ref
+    duration, t_last = duration_of(scene), float(p["last_time"])
 
     checks = [
         ("speed", v_max <= v_bound,
@@ -113,6 +128,10 @@ def check_file(path, quiet=False):
         ("residual", resid <= 0.01 * input_ref,
          f"ledger residual {resid:.4g} J = {100 * resid / input_ref:.3g}% of the input "
          f"{input_ref:.4g} J (<= 1%)"),
+        ("complete", t_last >= duration * (1 - 1e-9),
+         f"last frame at t = {t_last:.6g} s against the duration {duration:.6g} s"
+         + ("" if t_last >= duration * (1 - 1e-9) else
+            " (the run stopped early: its exit status and log say why)")),
     ]
     ok = all(c[1] for c in checks)
     if not quiet or not ok:
