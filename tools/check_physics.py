@@ -41,23 +41,31 @@ REQUIRED_OBSERVABLES = ("energy_kinetic", "energy_cohesive_dissipated", "energy_
                         "work_gravity", "work_boundary")
 
 
+def scene_value(scene, key):
+    """The text after `key =` on the resolved scene's top-level line for key
+    (written at two spaces' indent), without its trailing comma; None when
+    the scene text has no such line."""
+    for line in scene.splitlines():
+        name, _, value = line.partition("=")
+        if line.startswith("  " + key) and name.strip() == key:
+            return value.strip().rstrip(",")
+    return None
+
+
 def gravity_of(scene):
     """The scene's gravity vector (m/s^2) from the resolved scene text."""
-    for line in scene.splitlines():
-        line = line.strip()
-        if line.startswith("gravity") and "{" in line:
-            inner = line[line.index("{") + 1:line.index("}")]
-            return np.array([float(x) for x in inner.split(",")])
-    return np.zeros(3)
+    value = scene_value(scene, "gravity")
+    if value is None or "{" not in value:
+        return np.zeros(3)
+    return np.array([float(x) for x in value.strip("{}").split(",")])
 
 
 def duration_of(scene):
-    """The run's duration (s) from the resolved scene text (its top-level key)."""
-    for line in scene.splitlines():
-        key, _, value = line.strip().partition("=")
-        if key.strip() == "duration" and line.startswith("  duration"):
-            return float(value.strip().rstrip(","))
-    raise KeyError("duration in /parameters/scene")
+    """The run's duration (s) from the resolved scene text."""
+    value = scene_value(scene, "duration")
+    if value is None:
+        raise KeyError("duration in /parameters/scene")
+    return float(value)
 
 
 def read(path):
@@ -114,6 +122,7 @@ def check_file(path, quiet=False):
     resid = float(np.max(np.abs(o["energy_residual"]))) if len(o["energy_residual"]) else 0.0
     tol = 1e-9 * input_ref
     duration, t_last = duration_of(scene), float(p["last_time"])
+    complete = t_last >= duration * (1 - 1e-9)
 
     checks = [
         ("speed", v_max <= v_bound,
@@ -128,10 +137,9 @@ def check_file(path, quiet=False):
         ("residual", resid <= 0.01 * input_ref,
          f"ledger residual {resid:.4g} J = {100 * resid / input_ref:.3g}% of the input "
          f"{input_ref:.4g} J (<= 1%)"),
-        ("complete", t_last >= duration * (1 - 1e-9),
+        ("complete", complete,
          f"last frame at t = {t_last:.6g} s against the duration {duration:.6g} s"
-         + ("" if t_last >= duration * (1 - 1e-9) else
-            " (the run stopped early: its exit status and log say why)")),
+         + ("" if complete else " (the run stopped early: its exit status and log say why)")),
     ]
     ok = all(c[1] for c in checks)
     if not quiet or not ok:
