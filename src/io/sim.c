@@ -259,6 +259,19 @@ static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
     return st == CF_OK ? write_obstacles(sim, err) : st;
 }
 
+/* Close the output after `err` ended the run.  A close that fails too
+ * (HDF5 out of memory part way through writing its metadata) adds its own
+ * message, which says when the file may not open. */
+static void close_after_error(cf_sim *sim, cf_error *err)
+{
+    cf_error cerr;
+    if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK && err) {
+        size_t n = strlen(err->msg);
+        snprintf(err->msg + n, sizeof err->msg - n, "; then closing it: %s", cerr.msg);
+    }
+    sim->h5 = NULL;
+}
+
 cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
                         cf_error *err)
 {
@@ -311,6 +324,7 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
     if (st == CF_OK)
         st = drain_events(sim, err);
     if (st != CF_OK) {
+        close_after_error(sim, err);
         cf_sim_destroy(sim);
         return st;
     }
@@ -508,8 +522,12 @@ cf_status cf_sim_run(cf_sim *sim, cf_error *err)
         last_written = sim->frames_written > frames;
     }
     progress(sim, 1);
+    if (st != CF_OK) {
+        close_after_error(sim, err);
+        return st;
+    }
     cf_error cerr;
-    if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK && st == CF_OK) {
+    if (sim->h5 && cf_h5_close(sim->h5, &cerr) != CF_OK) {
         *err = cerr;
         st = cerr.code;
     }
