@@ -16,7 +16,7 @@
 
 static cf_material material(double E, double nu, double rho)
 {
-    cf_material m = {E, nu, rho, 22, 22, 1e4, 1e4, 2, 2, 0.5, 0, 0, 10, 1};
+    cf_material m = {E, nu, rho, 22, 22, 1e4, 1e4, 2, 2, 0.5, 0, 0, 10, 1, 0};
     return m;
 }
 
@@ -104,6 +104,67 @@ static void stretch_case(cf_elasticity kind)
 static void test_uniaxial_stretch_corotational(void **state) { (void)state; stretch_case(CF_ELASTICITY_COROTATIONAL); }
 static void test_uniaxial_stretch_linear(void **state) { (void)state; stretch_case(CF_ELASTICITY_LINEAR); }
 
+/* Crushing (von Mises perfect plasticity at sigma_c): uniaxial strain
+ * F = diag(1+e,1,1), e < 0, has the deviatoric part e diag(2/3,-1/3,-1/3)
+ * and the equivalent trial stress 2 mu |e|.  Beyond e_y = sigma_c / (2 mu)
+ * the stress returns to the yield surface: sigma_xx - sigma_yy = -sigma_c,
+ * the mean stress K e unchanged, and the plastic work is
+ * (2/3) sigma_c (|e| - e_y) V.  At the same strain again nothing more
+ * flows; unloading by less than 2 e_y is elastic; once the hand-off to
+ * rigid mode has dropped the plastic strain the rest shape is unstressed. */
+static void test_crushing_uniaxial_strain(void **state)
+{
+    (void)state;
+    cf_material mat = material(5e9, 0.2, 1200);
+    mat.compressive_strength = 15e6;
+    cf_solid s;
+    one_tet(&s, skew, &mat);
+    double sc = mat.compressive_strength, ey = sc / (2 * s.mu), e = -3 * ey;
+    double K = s.lambda + 2 * s.mu / 3, V = s.vol[0];
+    int t = 0;
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    assert_true(s.wp[0] == 0); /* at rest: elastic */
+    for (int i = 0; i < 4; i++)
+        s.x[3 * i] = (1 + e) * s.X[3 * i];
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    double sigma[9];
+    cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
+    assert_near(sigma[0] - sigma[4], -sc, 1e-9 * sc);
+    assert_near(sigma[4], sigma[8], 1e-9 * sc);
+    assert_near((sigma[0] + sigma[4] + sigma[8]) / 3, K * e, 1e-9 * sc);
+    double w_closed = 2.0 / 3.0 * sc * (fabs(e) - ey) * V;
+    assert_near(s.wp[0], w_closed, 1e-9 * w_closed);
+    /* strain energy: the elastic part only, 1/2 sigma : (eps - eps_p) V */
+    assert_near(s.tw[0], 0.5 * V * (K * e * e + sc * sc / (3 * s.mu)), 1e-9 * s.tw[0]);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    assert_near(s.wp[0], w_closed, 1e-9 * w_closed); /* on the surface: no more flow */
+    for (int i = 0; i < 4; i++) /* unloading by 1.5 e_y (< 2 e_y): elastic */
+        s.x[3 * i] = (1 + e / 2) * s.X[3 * i];
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
+    assert_near(s.wp[0], w_closed, 1e-9 * w_closed);
+    assert_near(sigma[0] - sigma[4], 0.5 * sc, 1e-9 * sc);
+    cf_tet4_drop_plastic_strain(&s, &t, 1);
+    for (int i = 0; i < 4; i++)
+        memcpy(&s.x[3 * i], &s.X[3 * i], 3 * sizeof(double));
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    assert_near(s.wp[0], w_closed, 1e-9 * w_closed); /* the work done stays booked */
+    assert_near(s.tw[0], 0.0, 1e-20);
+    cf_solid_free(&s);
+}
+
+/* Without compressive_strength the solid keeps no plastic state. */
+static void test_no_crushing_no_plastic_state(void **state)
+{
+    (void)state;
+    cf_material mat = material(5e9, 0.2, 1200);
+    cf_solid s;
+    one_tet(&s, skew, &mat);
+    assert_null(s.ep);
+    assert_null(s.wp);
+    cf_solid_free(&s);
+}
+
 /* A rigid rotation makes no corotational stress; small strain sees a spurious one. */
 static void test_rigid_rotation_is_stress_free(void **state)
 {
@@ -150,6 +211,8 @@ int main(void)
         cmocka_unit_test(test_uniaxial_stretch_corotational),
         cmocka_unit_test(test_uniaxial_stretch_linear),
         cmocka_unit_test(test_rigid_rotation_is_stress_free),
+        cmocka_unit_test(test_crushing_uniaxial_strain),
+        cmocka_unit_test(test_no_crushing_no_plastic_state),
         cmocka_unit_test(test_cfl_of_regular_tet),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -18,8 +18,9 @@ ledger in /observables:
   energy    kinetic energy at every frame <= the input: initial (kinetic +
             strain at t = 0) + gravity's work + the prescribed nodes' work
             (when positive) + 1/2 M (2U)^2 for kinematic impactors;
-  dissipation  energy_cohesive_dissipated is never negative and never falls
-            (by more than 1e-9 of the input, round-off);
+  dissipation  energy_cohesive_dissipated and energy_plastic_dissipated
+            (crushing; absent in older files) are never negative and never
+            fall (by more than 1e-9 of the input, round-off);
   residual  |energy_residual| <= 1% of the input at every frame;
   complete  the last frame is at the scene's duration: a run that stopped
             early (diverged, exit 3, or interrupted) has no end to check,
@@ -91,6 +92,9 @@ def read(path):
         vel = f["particles/fragments/velocity/value"][:frames]
         p["release_speed"] = (np.asarray(f["parameters/release_speed"][()], dtype=float)
                               if "parameters/release_speed" in f else 0.0)
+        plastic = "observables/energy_plastic_dissipated/value"
+        o["energy_plastic_dissipated"] = (np.asarray(f[plastic][()], dtype=float) if plastic in f
+                                          else np.zeros(0))
     return scene, p, o, pos, vel
 
 
@@ -116,9 +120,11 @@ def check_file(path, quiet=False):
     input_ref = float(np.max(np.maximum(input_e, 1e-300)))
     ke = o["energy_kinetic"]
     ke_excess = float(np.max(ke - input_e)) if len(ke) else 0.0
-    diss = o["energy_cohesive_dissipated"]
-    diss_min = float(np.min(diss)) if len(diss) else 0.0
-    diss_drop = float(np.max(diss[:-1] - diss[1:])) if len(diss) > 1 else 0.0
+    dissipated = [d for d in (o["energy_cohesive_dissipated"], o["energy_plastic_dissipated"])
+                  if len(d)]
+    diss_min = min((float(np.min(d)) for d in dissipated), default=0.0)
+    diss_drop = max((float(np.max(d[:-1] - d[1:])) for d in dissipated if len(d) > 1),
+                    default=0.0)
     resid = float(np.max(np.abs(o["energy_residual"]))) if len(o["energy_residual"]) else 0.0
     tol = 1e-9 * input_ref
     duration, t_last = duration_of(scene), float(p["last_time"])
@@ -132,7 +138,7 @@ def check_file(path, quiet=False):
          f"kinetic energy <= input at every frame (largest {float(np.max(ke)) if len(ke) else 0:.4g} J "
          f"against {float(input_e[int(np.argmax(ke))]) if len(ke) else 0:.4g} J then)"),
         ("dissipation", diss_min >= -tol and diss_drop <= tol,
-         f"cohesive dissipation never negative (min {diss_min:.3g} J) and never falls "
+         f"cohesive and plastic dissipation never negative (min {diss_min:.3g} J) and never fall "
          f"(largest fall {max(diss_drop, 0):.3g} J)"),
         ("residual", resid <= 0.01 * input_ref,
          f"ledger residual {resid:.4g} J = {100 * resid / input_ref:.3g}% of the input "

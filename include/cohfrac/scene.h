@@ -17,6 +17,10 @@
  *     G_I [22] N/m, sigma_max [1e4] Pa, alpha [2],
  *     G_II [=G_I] N/m, tau_max [=sigma_max] Pa, beta [=alpha],
  *     friction [0.5], restitution [0.0],
+ *     compressive_strength [0] Pa: sigma_c > 0 makes the Tet4s crush
+ *       (von Mises perfect plasticity at sigma_c in the element frame, the
+ *       work booked as energy_plastic_dissipated; docs/physics.md §2.1);
+ *       0 keeps them linear elastic,
  *     strength = { distribution ["uniform"] | "weibull",
  *                  modulus [10] (Weibull modulus m > 0), seed [1] (integer) } }
  *       per-facet strength scatter: with "weibull" each interior facet f gets

@@ -43,6 +43,8 @@ typedef struct cf_material {
     int weibull;                   /* strength distribution: 0 uniform, 1 Weibull */
     double weibull_modulus;        /* m, > 0 */
     int strength_seed;
+    double compressive_strength;   /* sigma_c, Pa: von Mises crushing of the Tet4s
+                                      (docs/physics.md §2.1); 0 none (linear elastic) */
 } cf_material;
 
 typedef struct cf_body_def {

@@ -20,7 +20,8 @@ typedef struct cf_world cf_world;
 
 /* The energy ledger (J) and momenta of the whole scene at the current
  * state.  Balance: residual = kinetic + strain + cohesive_stored +
- * cohesive_dissipated + contact + pbd + damping + handoff + integration
+ * cohesive_dissipated + plastic_dissipated + contact + pbd + damping +
+ * handoff + integration
  * - (initial + work_gravity + work_boundary + work_obstacles); zero for an
  * exact integrator.  work_obstacles is the work of moving obstacles: the
  * impulse they give a node times their velocity, and for Bullet bodies the
@@ -31,9 +32,11 @@ typedef struct cf_world cf_world;
  * energies removed since t = 0 (see docs/physics.md §4-§9);
  * `integration` is what Bullet's integrator changed in bodies that touched
  * nothing during a rigid step (its implicit gyroscopic term: a free
- * spinning asymmetric body loses a little), never booked as contact. */
+ * spinning asymmetric body loses a little), never booked as contact.
+ * `plastic_dissipated` is the work of crushing (material
+ * compressive_strength, docs/physics.md §2.1), 0 without it. */
 typedef struct cf_ledger {
-    double kinetic, strain, cohesive_stored, cohesive_dissipated;
+    double kinetic, strain, cohesive_stored, cohesive_dissipated, plastic_dissipated;
     double work_gravity, work_boundary, work_obstacles;
     double contact, pbd, damping, handoff, integration;
     double initial;            /* kinetic + strain at t = 0 */

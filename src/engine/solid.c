@@ -249,6 +249,15 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->tw = calloc((size_t)nt, sizeof(double));
     s->bc = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet_frag = malloc((size_t)nt * sizeof(int));
+    if (mat->compressive_strength > 0) { /* crushing: a scene pays only for what it uses */
+        s->ep = calloc((size_t)nt * 6, sizeof(double));
+        s->wp = calloc((size_t)nt, sizeof(double));
+        if (!s->ep || !s->wp) {
+            cf_solid_free(s);
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for the plastic strain of %d tets",
+                                nt);
+        }
+    }
     if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->origin || !s->tet ||
         !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
@@ -297,7 +306,7 @@ void cf_solid_free(cf_solid *s)
 {
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
-                    s->nodal, s->tf, s->tw, s->bc, s->tet_frag, s->facet, s->tet_facet,
+                    s->nodal, s->tf, s->tw, s->ep, s->wp, s->bc, s->tet_frag, s->facet, s->tet_facet,
                     s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);

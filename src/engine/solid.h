@@ -65,6 +65,10 @@ typedef struct cf_solid {
                                  (fracture state) */
     double *tf;               /* [nt][12] internal force on each slot, N */
     double *tw;               /* [nt] strain energy at the last force pass, J */
+    double *ep;               /* [nt][6] plastic strain in the element frame (xx yy zz
+                                 xy xz yz), only with crushing (mat.compressive_strength
+                                 > 0), else NULL */
+    double *wp;               /* [nt] plastic work dissipated since t = 0, J (crushing) */
     int *tet_frag;            /* [nt] fragment id */
 
     int n_facets;

@@ -16,19 +16,69 @@ static inline void deformation_gradient(const cf_solid *s, int t, double F[9])
     m3_mul(Ds, &s->Dm_inv[9 * t], F);
 }
 
-/* Strain (symmetric part minus identity) -> linear elastic stress. */
-static inline void hooke(const cf_solid *s, const double A[9], double sig[9], double *energy_density)
+/* Voigt slots (xx yy zz xy xz yz) of the plastic strain, as row and column. */
+static const int VOIGT[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+
+/* Crushing (docs/physics.md §2.1): von Mises perfect plasticity at the
+ * compressive strength sigma_c.  A trial stress sig whose equivalent stress
+ * sqrt(3/2 s:s) exceeds sigma_c has its deviator s scaled back onto the
+ * yield surface (radial return); the elastic strain eps loses, and the
+ * plastic strain ep (Voigt, tensor shear) gains, the removed deviator over
+ * 2 mu.  Returns the plastic work density sig : d ep >= 0 (J/m^3). */
+static inline double crush(const cf_solid *s, double sig[9], double eps[9], double ep[6])
+{
+    double p = (sig[0] + sig[4] + sig[8]) / 3, dev[9], ss = 0;
+    for (int k = 0; k < 9; k++) {
+        dev[k] = sig[k] - ((k % 4) == 0 ? p : 0);
+        ss += dev[k] * dev[k];
+    }
+    double seq = sqrt(1.5 * ss), sc = s->mat.compressive_strength;
+    if (!(seq > sc))
+        return 0;
+    double back = 1 - sc / seq; /* share of the deviator removed */
+    for (int k = 0; k < 9; k++) {
+        sig[k] -= back * dev[k];
+        eps[k] -= back * dev[k] / (2 * s->mu);
+    }
+    for (int v = 0; v < 6; v++)
+        ep[v] += back * dev[3 * VOIGT[v][0] + VOIGT[v][1]] / (2 * s->mu);
+    return (sc / seq) * back * ss / (2 * s->mu); /* (1 - back) s : back s / 2 mu */
+}
+
+/* Strain of A (symmetric part minus identity, less the plastic strain ep
+ * when crushing) -> stress and strain energy density.  With ep, a trial
+ * stress beyond sigma_c returns to the yield surface: when `update`, ep
+ * keeps the new plastic strain and *plastic_work gets the work density;
+ * otherwise ep is read only. */
+static inline void hooke(const cf_solid *s, const double A[9], double *ep, int update,
+                         double sig[9], double *energy_density, double *plastic_work)
 {
     double eps[9];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
             eps[3 * i + j] = 0.5 * (A[3 * i + j] + A[3 * j + i]) - (i == j);
+    if (ep)
+        for (int v = 0; v < 6; v++) {
+            int i = VOIGT[v][0], j = VOIGT[v][1];
+            eps[3 * i + j] -= ep[v];
+            if (i != j)
+                eps[3 * j + i] -= ep[v];
+        }
     double tr = eps[0] + eps[4] + eps[8];
-    double w = 0;
-    for (int k = 0; k < 9; k++) {
+    for (int k = 0; k < 9; k++)
         sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : 0);
-        w += 0.5 * sig[k] * eps[k];
+    if (ep) {
+        double ep_new[6];
+        memcpy(ep_new, ep, sizeof ep_new);
+        double wp = crush(s, sig, eps, ep_new);
+        if (update) {
+            memcpy(ep, ep_new, sizeof ep_new);
+            *plastic_work = wp;
+        }
     }
+    double w = 0;
+    for (int k = 0; k < 9; k++)
+        w += 0.5 * sig[k] * eps[k];
     *energy_density = w;
 }
 
@@ -72,17 +122,21 @@ static void polar_rotation_lanes(double F[LANES][9], double q[LANES][4], int n,
             quat_to_mat(q[l], R[l]);
 }
 
-/* Stress in the element frame from the deformation gradient F and its
- * rotation R to the world, and the strain energy density. */
-static inline void element_stress(const cf_solid *s, const double F[9], cf_elasticity kind,
-                                  const double R[9], double sig[9], double *w)
+/* Stress in the element frame of tet t from the deformation gradient F and
+ * its rotation R to the world, and the strain energy density; with
+ * crushing, `update` moves the tet's plastic strain and *wp gets the
+ * plastic work density of this pass (hooke). */
+static inline void element_stress(const cf_solid *s, int t, const double F[9], cf_elasticity kind,
+                                  const double R[9], int update, double sig[9], double *w,
+                                  double *wp)
 {
+    double *ep = s->ep ? &s->ep[6 * t] : NULL;
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         double S[9];
         m3_mul_tn(R, F, S);
-        hooke(s, S, sig, w);
+        hooke(s, S, ep, update, sig, w, wp);
     } else {
-        hooke(s, F, sig, w);
+        hooke(s, F, ep, update, sig, w, wp);
     }
 }
 
@@ -135,9 +189,11 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
         }
         element_rotations(s, t, n, F, kind, R);
         for (int l = 0; l < n; l++) {
-            double sig[9], P[9], g[4][3], w;
-            element_stress(s, F[l], kind, R[l], sig, &w);
+            double sig[9], P[9], g[4][3], w, wp = 0;
+            element_stress(s, t[l], F[l], kind, R[l], 1, sig, &w, &wp);
             s->tw[t[l]] = w * s->vol[t[l]];
+            if (s->wp)
+                s->wp[t[l]] += wp * s->vol[t[l]];
             m3_mul(R[l], sig, P); /* f_i = -V R sigma grad N_i */
             cf_tet4_gradients(s, t[l], g);
             double *tf = &s->tf[12 * t[l]];
@@ -163,7 +219,7 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
 
 void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9])
 {
-    double F[9], R[9], sig[9], P[9], w, q[4];
+    double F[9], R[9], sig[9], P[9], w, wp, q[4];
     for (int k = 0; k < 4; k++)
         q[k] = s->rq[4 * t + k];
     deformation_gradient(s, t, F);
@@ -171,9 +227,16 @@ void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9
         polar_rotation(F, q, 10, 1e-7, R);
     else
         m3_identity(R);
-    element_stress(s, F, kind, R, sig, &w);
+    element_stress(s, t, F, kind, R, 0, sig, &w, &wp);
     m3_mul(R, sig, P);
     m3_mul_nt(P, R, sigma);
+}
+
+void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt)
+{
+    if (s->ep)
+        for (int i = 0; i < nt; i++)
+            memset(&s->ep[6 * tets[i]], 0, 6 * sizeof(double));
 }
 
 void cf_tet4_gather(cf_solid *s, const int *nodes, int nn, const double g[3])

@@ -36,6 +36,9 @@ typedef struct cf_stress_check {
 
 /* For each tet of the list: internal nodal forces into s->tf ([4][3] per
  * tet, N) and strain energy V (1/2 sigma : eps) into s->tw (J).  With
+ * crushing (s->ep, docs/physics.md §2.1) the stress is returned to the
+ * yield surface, the plastic strain s->ep updated and its work added to
+ * s->wp (J).  With
  * `check` (a check is due; needs the fracture state of
  * cf_solid_init_facets), also the world-frame Cauchy stress into s->sigma
  * (Pa) and s->hot (0/1) per tet, and the number of hot tets into *n_hot.
@@ -46,8 +49,14 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
                    const cf_stress_check *check, int *n_hot);
 
 /* World-frame Cauchy stress of tet t at the current positions (Pa), from
- * the rotation warm start (not updated). */
+ * the rotation warm start and the plastic strain (neither updated). */
 void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9]);
+
+/* A fragment going back to rigid mode: its tets' plastic strain is dropped
+ * with their elastic strain (a rigid fragment keeps the rest shape, so on
+ * re-entry its nodes start from it unstressed).  The plastic work already
+ * dissipated (s->wp) stays.  No-op without crushing. */
+void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt);
 
 /* Nodal forces of the listed nodes: f = m g + the tf slots of the tets
  * that hold the node, added in ascending tet order (the same sum for any

@@ -646,6 +646,10 @@ void cf_world_ledger(const cf_world *sim, cf_ledger *l)
         v3_axpy(1.0, L, l->angular_momentum);
     }
     cf_cohesive_energy(s, NULL, 0, &l->cohesive_stored, &l->cohesive_dissipated);
+    l->plastic_dissipated = 0;
+    if (s->wp)
+        for (int t = 0; t < s->n_tets; t++) /* tet order: the same sum on any thread count */
+            l->plastic_dissipated += s->wp[t];
     double dmx[3];
     v3_sub(l->mass_moment, sim->mx0, dmx);
     l->work_gravity = v3_dot(sim->def.gravity, dmx);
@@ -656,7 +660,7 @@ void cf_world_ledger(const cf_world *sim, cf_ledger *l)
     l->integration = sim->flow.integration;
     l->initial = sim->e0;
     l->residual = l->kinetic + l->strain + l->cohesive_stored + l->cohesive_dissipated +
-                  l->contact + l->pbd + l->damping + l->handoff + l->integration -
+                  l->plastic_dissipated + l->contact + l->pbd + l->damping + l->handoff + l->integration -
                   (l->initial + l->work_gravity + l->work_boundary + l->work_obstacles);
 }
 
@@ -1015,7 +1019,8 @@ static cf_status check_energy(cf_world *sim, cf_error *err)
 {
     cf_ledger l;
     cf_world_ledger(sim, &l);
-    double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated;
+    double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated +
+                  l.plastic_dissipated;
     double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
                    fmax(0.0, l.work_obstacles);
     if (have <= (1 + sim->def.solver.max_energy_growth) * input + 1e-12)
@@ -1210,7 +1215,7 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
     unsigned long long cn = (unsigned long long)s->cap_nodes, nt = (unsigned long long)s->n_tets;
     memset(m, 0, sizeof *m);
     m->solid = cn * (16 * D + 2 * I) + nt * (27 * D + 9 * I) +
-               ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I;
+               ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I + (s->ep ? nt * 7 * D : 0);
     if (s->facet)
         m->fracture = nt * (9 * D + 2 + 20 * I) + cn * (1 + D) +
                       (unsigned long long)s->n_facets * (1 + (s->candidate != NULL));

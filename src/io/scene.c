@@ -50,7 +50,8 @@ static const char *const top_keys[] = {"name",     "duration", "gravity",   "mat
                                        "boundary", "obstacles", "solver",   "output"};
 static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
                                             "sigma_max", "alpha", "G_II", "tau_max",
-                                            "beta",  "friction", "restitution", "strength"};
+                                            "beta",  "friction", "restitution", "compressive_strength",
+                                            "strength"};
 static const char *const strength_keys[] = {"distribution", "modulus", "seed"};
 static const char *const distribution_names[] = {"uniform", "weibull"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
@@ -812,7 +813,7 @@ static cf_status read_strength(loader *ld, int t, cf_material *m)
 static cf_status read_material(loader *ld, int t, cf_material *m)
 {
     static const double E = 1e6, nu = 0.3, rho = 2400.0, G_I = 22.0, sigma = 1e4, alpha = 2.0,
-                        friction = 0.5, restitution = 0.0;
+                        friction = 0.5, restitution = 0.0, none = 0.0;
     static const range restitution_range = {0.0, 1.0, 1, 1, NULL};
     TRY(check_keys(ld, t, material_keys, COUNT(material_keys)));
     TRY(get_num(ld, t, "E", &E, &POSITIVE, &m->E));
@@ -827,6 +828,7 @@ static cf_status read_material(loader *ld, int t, cf_material *m)
     TRY(get_num(ld, t, "beta", &m->alpha, &PPR_SHAPE, &m->beta));
     TRY(get_num(ld, t, "friction", &friction, &NON_NEGATIVE, &m->friction));
     TRY(get_num(ld, t, "restitution", &restitution, &restitution_range, &m->restitution));
+    TRY(get_num(ld, t, "compressive_strength", &none, &NON_NEGATIVE, &m->compressive_strength));
     WITH_TABLE(ld, t, "strength", read_strength(ld, lua_gettop(ld->L), m));
     return CF_OK;
 }
@@ -1723,6 +1725,7 @@ static char *resolved_text(const cf_world_def *s)
     put_num(&b, 4, "beta", m->beta);
     put_num(&b, 4, "friction", m->friction);
     put_num(&b, 4, "restitution", m->restitution);
+    put_num(&b, 4, "compressive_strength", m->compressive_strength);
     put(&b, "    strength = {\n");
     put_str(&b, 6, "distribution", distribution_names[m->weibull]);
     put_num(&b, 6, "modulus", m->weibull_modulus);

@@ -398,6 +398,7 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
         {"energy_strain", "J", l.strain},
         {"energy_cohesive_stored", "J", l.cohesive_stored},
         {"energy_cohesive_dissipated", "J", l.cohesive_dissipated},
+        {"energy_plastic_dissipated", "J", l.plastic_dissipated},
         {"work_gravity", "J", l.work_gravity},
         {"work_boundary", "J", l.work_boundary},
         {"work_obstacles", "J", l.work_obstacles},
@@ -603,8 +604,8 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
                             fabs(l.work_obstacles),
                         1e-300);
     fprintf(out, "energy ledger (J)  kinetic %.6g | strain %.6g | cohesive stored %.6g | "
-                 "cohesive dissipated %.6g\n",
-            l.kinetic, l.strain, l.cohesive_stored, l.cohesive_dissipated);
+                 "cohesive dissipated %.6g | plastic dissipated %.6g\n",
+            l.kinetic, l.strain, l.cohesive_stored, l.cohesive_dissipated, l.plastic_dissipated);
     fprintf(out, "                   initial %.6g | work: gravity %.6g, boundary %.6g, "
                  "moving obstacles %.6g\n",
             l.initial, l.work_gravity, l.work_boundary, l.work_obstacles);
