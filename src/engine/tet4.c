@@ -23,9 +23,10 @@ static const int VOIGT[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
  * compressive strength sigma_c.  A trial stress sig whose equivalent stress
  * sqrt(3/2 s:s) exceeds sigma_c has its deviator s scaled back onto the
  * yield surface (radial return); the elastic strain eps loses, and the
- * plastic strain ep (Voigt, tensor shear) gains, the removed deviator over
- * 2 mu.  Returns the plastic work density sig : d ep >= 0 (J/m^3). */
-static inline double crush(const cf_solid *s, double sig[9], double eps[9], double ep[6])
+ * plastic strain ep (Voigt, tensor shear; NULL: not kept) gains, the
+ * removed deviator over 2 mu.  Returns the plastic work density
+ * sig : d ep >= 0 (J/m^3). */
+static inline double crush(const cf_solid *s, double sig[9], double eps[9], double *ep)
 {
     double p = (sig[0] + sig[4] + sig[8]) / 3, dev[9], ss = 0;
     for (int k = 0; k < 9; k++) {
@@ -40,18 +41,18 @@ static inline double crush(const cf_solid *s, double sig[9], double eps[9], doub
         sig[k] -= back * dev[k];
         eps[k] -= back * dev[k] / (2 * s->mu);
     }
-    for (int v = 0; v < 6; v++)
+    for (int v = 0; ep && v < 6; v++)
         ep[v] += back * dev[3 * VOIGT[v][0] + VOIGT[v][1]] / (2 * s->mu);
     return (sc / seq) * back * ss / (2 * s->mu); /* (1 - back) s : back s / 2 mu */
 }
 
 /* Strain of A (symmetric part minus identity, less the plastic strain ep
  * when crushing) -> stress and strain energy density.  With ep, a trial
- * stress beyond sigma_c returns to the yield surface: when `update`, ep
- * keeps the new plastic strain and *plastic_work gets the work density;
- * otherwise ep is read only. */
-static inline void hooke(const cf_solid *s, const double A[9], double *ep, int update,
-                         double sig[9], double *energy_density, double *plastic_work)
+ * stress beyond sigma_c returns to the yield surface, and ep keeps the new
+ * plastic strain when `update` (otherwise it is read only).  Returns the
+ * plastic work density of the return (J/m^3; 0 without crushing). */
+static inline double hooke(const cf_solid *s, const double A[9], double *ep, int update,
+                           double sig[9], double *energy_density)
 {
     double eps[9];
     for (int i = 0; i < 3; i++)
@@ -67,19 +68,12 @@ static inline void hooke(const cf_solid *s, const double A[9], double *ep, int u
     double tr = eps[0] + eps[4] + eps[8];
     for (int k = 0; k < 9; k++)
         sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : 0);
-    if (ep) {
-        double ep_new[6];
-        memcpy(ep_new, ep, sizeof ep_new);
-        double wp = crush(s, sig, eps, ep_new);
-        if (update) {
-            memcpy(ep, ep_new, sizeof ep_new);
-            *plastic_work = wp;
-        }
-    }
+    double wp = ep ? crush(s, sig, eps, update ? ep : NULL) : 0;
     double w = 0;
     for (int k = 0; k < 9; k++)
         w += 0.5 * sig[k] * eps[k];
     *energy_density = w;
+    return wp;
 }
 
 /* Tets whose rotations are found side by side.  The rotation iteration is
@@ -124,20 +118,19 @@ static void polar_rotation_lanes(double F[LANES][9], double q[LANES][4], int n,
 
 /* Stress in the element frame of tet t from the deformation gradient F and
  * its rotation R to the world, and the strain energy density; with
- * crushing, `update` moves the tet's plastic strain and *wp gets the
- * plastic work density of this pass (hooke). */
-static inline void element_stress(const cf_solid *s, int t, const double F[9], cf_elasticity kind,
-                                  const double R[9], int update, double sig[9], double *w,
-                                  double *wp)
+ * crushing, `update` moves the tet's plastic strain.  Returns the plastic
+ * work density of this pass (hooke). */
+static inline double element_stress(const cf_solid *s, int t, const double F[9],
+                                    cf_elasticity kind, const double R[9], int update,
+                                    double sig[9], double *w)
 {
     double *ep = s->ep ? &s->ep[6 * t] : NULL;
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         double S[9];
         m3_mul_tn(R, F, S);
-        hooke(s, S, ep, update, sig, w, wp);
-    } else {
-        hooke(s, F, ep, update, sig, w, wp);
+        return hooke(s, S, ep, update, sig, w);
     }
+    return hooke(s, F, ep, update, sig, w);
 }
 
 /* The rotations of tets t[0..n-1] (n <= LANES) at deformation gradients F,
@@ -189,8 +182,8 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
         }
         element_rotations(s, t, n, F, kind, R);
         for (int l = 0; l < n; l++) {
-            double sig[9], P[9], g[4][3], w, wp = 0;
-            element_stress(s, t[l], F[l], kind, R[l], 1, sig, &w, &wp);
+            double sig[9], P[9], g[4][3], w;
+            double wp = element_stress(s, t[l], F[l], kind, R[l], 1, sig, &w);
             s->tw[t[l]] = w * s->vol[t[l]];
             if (s->wp)
                 s->wp[t[l]] += wp * s->vol[t[l]];
@@ -219,7 +212,7 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
 
 void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9])
 {
-    double F[9], R[9], sig[9], P[9], w, wp, q[4];
+    double F[9], R[9], sig[9], P[9], w, q[4];
     for (int k = 0; k < 4; k++)
         q[k] = s->rq[4 * t + k];
     deformation_gradient(s, t, F);
@@ -227,7 +220,7 @@ void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9
         polar_rotation(F, q, 10, 1e-7, R);
     else
         m3_identity(R);
-    element_stress(s, t, F, kind, R, 0, sig, &w, &wp);
+    element_stress(s, t, F, kind, R, 0, sig, &w);
     m3_mul(R, sig, P);
     m3_mul_nt(P, R, sigma);
 }
