@@ -188,6 +188,111 @@ static void test_rigid_rotation_is_stress_free(void **state)
     cf_solid_free(&s);
 }
 
+/* The reference for one tet at a time: the scalar formulas of linalg.h in
+ * the order the kernel's comments give (F = Ds Dm^-1, the quaternion
+ * polar iteration from the warm start q, Hooke on sym(R^T F) - I,
+ * f_a = -V R sigma grad N_a, sigma_world = R sigma R^T); q is updated. */
+static void one_tet_at_a_time(const cf_solid *s, int t, cf_elasticity kind, double q[4],
+                              double f[12], double *w, double sigma[9])
+{
+    const int *T = &s->tet[4 * t];
+    double Ds[9], F[9], R[9], S[9], eps[9], sig[9], P[9], g[4][3];
+    for (int j = 0; j < 3; j++)
+        for (int r = 0; r < 3; r++)
+            Ds[3 * r + j] = s->x[3 * T[j + 1] + r] - s->x[3 * T[0] + r];
+    m3_mul(Ds, &s->Dm_inv[9 * t], F);
+    if (kind == CF_ELASTICITY_COROTATIONAL) {
+        polar_rotation(F, q, 10, 1e-7, R);
+        m3_mul_tn(R, F, S);
+    } else {
+        m3_identity(R);
+        memcpy(S, F, sizeof S);
+    }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            eps[3 * i + j] = 0.5 * (S[3 * i + j] + S[3 * j + i]) - (i == j);
+    double tr = eps[0] + eps[4] + eps[8];
+    *w = 0;
+    for (int k = 0; k < 9; k++) {
+        sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : 0);
+        *w += 0.5 * sig[k] * eps[k];
+    }
+    m3_mul(R, sig, P);
+    cf_tet4_gradients(s, t, g);
+    for (int a = 0; a < 4; a++) {
+        double fa[3];
+        m3_mulv(P, g[a], fa);
+        for (int c = 0; c < 3; c++)
+            f[3 * a + c] = -s->vol[t] * fa[c];
+    }
+    m3_mul_nt(P, R, sigma);
+}
+
+/* The force kernel runs four tets side by side in vector lanes; every
+ * lane must give the bits of the scalar formulas for its tet alone, with
+ * the lanes' rotation iterations needing different numbers of steps (warm
+ * starts from exact to 0.5 rad off, and one of zero length), for a list
+ * whose last block is partial, both elasticity kinds. */
+static void test_lanes_equal_one_tet_at_a_time(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 3, 2, 3, 0.3, 0.2, 0.3);
+    int *body = calloc((size_t)m.n_tets, sizeof(int));
+    cf_material mat = material(1e6, 0.3, 1000);
+    cf_solid s;
+    assert_int_equal(cf_solid_init(&s, &m, &mat, body, NULL), CF_OK);
+    s.sigma = calloc((size_t)s.n_tets * 9, sizeof(double));
+    s.hot = calloc((size_t)s.n_tets, 1);
+    unsigned long long r = 12345;
+    double qr[4] = {cos(0.4), sin(0.4) * 0.48, sin(0.4) * 0.6, sin(0.4) * 0.64}, R[9];
+    quat_to_mat(qr, R);
+    for (int i = 0; i < s.n_nodes; i++) { /* rotated 0.8 rad, strained by up to 5 % */
+        double y[3];
+        for (int k = 0; k < 3; k++) {
+            r = r * 6364136223846793005ull + 1442695040888963407ull;
+            y[k] = s.X[3 * i + k] * (1 + 0.05 * ((double)(r >> 11) / 9007199254740992.0 - 0.5));
+        }
+        m3_mulv(R, y, &s.x[3 * i]);
+    }
+    int nt = s.n_tets - 3, *list = malloc((size_t)nt * sizeof(int));
+    for (int i = 0; i < nt; i++)
+        list[i] = (7 * i) % s.n_tets; /* not in order, and tets of many blocks */
+    assert_int_equal(nt % 4 != 0, 1);
+    for (int kind = 0; kind < 2; kind++) {
+        cf_elasticity el = kind ? CF_ELASTICITY_LINEAR : CF_ELASTICITY_COROTATIONAL;
+        double *q0 = malloc((size_t)s.n_tets * 4 * sizeof(double));
+        for (int t = 0; t < s.n_tets; t++) {
+            double a = 0.4 - 0.5 * (t % 5) / 4.0; /* 0.4 exact ... -0.1: 0.5 rad off */
+            double qt[4] = {cos(a), sin(a) * 0.48, sin(a) * 0.6, sin(a) * 0.64};
+            if (t % 11 == 3)
+                qt[0] = qt[1] = qt[2] = qt[3] = 0; /* zero length: the identity */
+            memcpy(&s.rq[4 * t], qt, sizeof qt);
+            memcpy(&q0[4 * t], qt, sizeof qt);
+        }
+        cf_stress_check check = {INFINITY, INFINITY};
+        cf_tet4_forces(&s, list, nt, el, &check, NULL);
+        for (int i = 0; i < nt; i++) {
+            int t = list[i];
+            double f[12], w, sigma[9], sigma_one[9];
+            one_tet_at_a_time(&s, t, el, &q0[4 * t], f, &w, sigma);
+            assert_memory_equal(&s.tf[12 * t], f, sizeof f);
+            double tw = w * s.vol[t];
+            assert_memory_equal(&s.tw[t], &tw, sizeof tw);
+            assert_memory_equal(&s.sigma[9 * t], sigma, sizeof sigma);
+            if (el == CF_ELASTICITY_COROTATIONAL)
+                assert_memory_equal(&s.rq[4 * t], &q0[4 * t], 4 * sizeof(double));
+            cf_tet4_stress(&s, t, el, sigma_one); /* one tet, from the updated warm start */
+            one_tet_at_a_time(&s, t, el, &q0[4 * t], f, &w, sigma);
+            assert_memory_equal(sigma_one, sigma, sizeof sigma);
+        }
+        free(q0);
+    }
+    free(list), free(s.sigma), free(s.hot);
+    s.sigma = NULL, s.hot = NULL;
+    cf_solid_free(&s), cf_mesh_free(&m), free(body);
+}
+
 /* dt_cfl = 2 r_in / c_d: for a regular tet of edge a, 2 r_in = a / sqrt(6). */
 static void test_cfl_of_regular_tet(void **state)
 {
@@ -213,6 +318,7 @@ int main(void)
         cmocka_unit_test(test_rigid_rotation_is_stress_free),
         cmocka_unit_test(test_crushing_uniaxial_strain),
         cmocka_unit_test(test_no_crushing_no_plastic_state),
+        cmocka_unit_test(test_lanes_equal_one_tet_at_a_time),
         cmocka_unit_test(test_cfl_of_regular_tet),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

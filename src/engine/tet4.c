@@ -2,20 +2,6 @@
 
 #include "linalg.h"
 
-/* Deformation gradient F = Ds Dm^-1 of tet t at positions x. */
-static inline void deformation_gradient(const cf_solid *s, int t, double F[9])
-{
-    const int *T = &s->tet[4 * t];
-    const double *x0 = &s->x[3 * T[0]];
-    double Ds[9];
-    for (int j = 0; j < 3; j++) {
-        const double *xj = &s->x[3 * T[j + 1]];
-        for (int r = 0; r < 3; r++)
-            Ds[3 * r + j] = xj[r] - x0[r];
-    }
-    m3_mul(Ds, &s->Dm_inv[9 * t], F);
-}
-
 /* Voigt slots (xx yy zz xy xz yz) of the plastic strain, as row and column. */
 static const int VOIGT[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
@@ -46,122 +32,286 @@ static inline double crush(const cf_solid *s, double sig[9], double eps[9], doub
     return (sc / seq) * back * ss / (2 * s->mu); /* (1 - back) s : back s / 2 mu */
 }
 
-/* Strain of A (symmetric part minus identity, less the plastic strain ep
- * when crushing) -> stress and strain energy density.  With ep, a trial
- * stress beyond sigma_c returns to the yield surface, and ep keeps the new
- * plastic strain when `update` (otherwise it is read only).  Returns the
- * plastic work density of the return (J/m^3; 0 without crushing). */
-static inline double hooke(const cf_solid *s, const double A[9], double *ep, int update,
-                           double sig[9], double *energy_density)
+/* The kernel below runs LANES tets side by side: every per-tet number is a
+ * vector of LANES doubles (GCC's vector extension), so each operation is
+ * one vector instruction (two on SSE2) and the core overlaps the lanes'
+ * long dependent chains (the rotation's square roots, divisions, sine and
+ * cosine).  Each lane does exactly the operations of the scalar formulas
+ * (linalg.h: m3_mul, polar_rotation, ...) in the same order, and IEEE
+ * arithmetic rounds each lane alone: the bits are those of one tet at a
+ * time, at any vector width (test_tet4.c compares them). */
+#define LANES 4
+/* The vectors never cross a call that is not inlined, so the ABI note
+ * about passing them without AVX does not apply. */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef double vd __attribute__((vector_size(LANES * sizeof(double))));
+typedef long long vm __attribute__((vector_size(LANES * sizeof(double)))); /* lane masks */
+typedef vd lane9[9];
+
+static inline vd splat(double a) { return (vd){a, a, a, a}; }
+
+/* m ? a : b, lane by lane (m: all ones or all zeros). */
+static inline vd pick(vm m, vd a, vd b) { return (vd)(((vm)a & m) | ((vm)b & ~m)); }
+
+static inline vd v_sqrt(vd a)
 {
-    double eps[9];
+    for (int l = 0; l < LANES; l++)
+        a[l] = sqrt(a[l]);
+    return a;
+}
+
+static inline vd v_fabs(vd a) { return (vd)((vm)a & ~(vm)splat(-0.0)); } /* sign bit off */
+
+/* C = A B (m3_mul); C is neither A nor B, as in all three products. */
+static inline void lanes_mul(lane9 A, lane9 B, lane9 C)
+{
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
-            eps[3 * i + j] = 0.5 * (A[3 * i + j] + A[3 * j + i]) - (i == j);
-    if (ep)
+            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+/* C = A^T B (m3_mul_tn). */
+static inline void lanes_mul_tn(lane9 A, lane9 B, lane9 C)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            C[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
+}
+
+/* C = A B^T (m3_mul_nt). */
+static inline void lanes_mul_nt(lane9 A, lane9 B, lane9 C)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            C[3 * i + j] = A[3 * i] * B[3 * j] + A[3 * i + 1] * B[3 * j + 1] +
+                           A[3 * i + 2] * B[3 * j + 2];
+}
+
+/* q /= |q|, the identity where |q| = 0 (quat_normalize); such a lane
+ * divides by 1 and drops the result. */
+static inline void lanes_quat_normalize(vd q[4])
+{
+    vd n = v_sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    vm zero = (vm)(n == splat(0.0));
+    vd d = pick(zero, splat(1.0), n);
+    for (int k = 0; k < 4; k++)
+        q[k] = pick(zero, splat(k == 0), q[k] / d);
+}
+
+/* R of q (quat_to_mat). */
+static inline void lanes_quat_to_mat(vd q[4], lane9 R)
+{
+    vd w = q[0], x = q[1], y = q[2], z = q[3];
+    R[0] = 1 - 2 * (y * y + z * z), R[1] = 2 * (x * y - w * z), R[2] = 2 * (x * z + w * y);
+    R[3] = 2 * (x * y + w * z), R[4] = 1 - 2 * (x * x + z * z), R[5] = 2 * (y * z - w * x);
+    R[6] = 2 * (x * z - w * y), R[7] = 2 * (y * z + w * x), R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* The rotation part R of F by the quaternion iteration (polar_rotation in
+ * linalg.h: Müller, Bender, Chentanez, Macklin 2016), q the warm start,
+ * updated.  All lanes evaluate the update until none still turns: a lane
+ * whose update fell below tol keeps q, so evaluating it again gives the
+ * same R and the same stop, and R is always that of the final q. */
+static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, vd q[4], int max_iter, double tol, lane9 R)
+{
+    lanes_quat_normalize(q);
+    for (int it = 0; it < max_iter; it++) {
+        lanes_quat_to_mat(q, R);
+        vd om[3] = {splat(0), splat(0), splat(0)}, dot = splat(0);
+        for (int c = 0; c < 3; c++) {
+            vd r0 = R[c], r1 = R[3 + c], r2 = R[6 + c], f0 = F[c], f1 = F[3 + c], f2 = F[6 + c];
+            om[0] += r1 * f2 - r2 * f1;
+            om[1] += r2 * f0 - r0 * f2;
+            om[2] += r0 * f1 - r1 * f0;
+            dot += r0 * f0 + r1 * f1 + r2 * f2;
+        }
+        vd s = 1.0 / (v_fabs(dot) + 1e-9);
+        for (int k = 0; k < 3; k++)
+            om[k] *= s;
+        vd angle = v_sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
+        vm turn = ~(vm)(angle < splat(tol)); /* NaN turns, as in the scalar loop */
+        int turning = 0;
+        for (int l = 0; l < LANES; l++)
+            turning |= turn[l] != 0;
+        if (!turning)
+            return;
+        /* q <- exp(omega / 2) q where the lane turns (polar_turn); a
+         * finished lane turns by nothing, and the result is dropped */
+        vd half = pick(turn, 0.5 * angle, splat(0)), sn, dq[4];
+        for (int l = 0; l < LANES; l++)
+            dq[0][l] = cos(half[l]), sn[l] = sin(half[l]);
+        vd sh = sn / angle;
+        for (int k = 0; k < 3; k++)
+            dq[k + 1] = om[k] * sh;
+        vd nq[4] = {dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
+                    dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
+                    dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
+                    dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]};
+        lanes_quat_normalize(nq);
+        for (int k = 0; k < 4; k++)
+            q[k] = pick(turn, nq[k], q[k]);
+    }
+    lanes_quat_to_mat(q, R);
+}
+
+/* What one pass finds for LANES tets. */
+typedef struct {
+    lane9 F;   /* deformation gradient */
+    lane9 R;   /* rotation to the world (identity for small strain) */
+    lane9 sig; /* stress in the element frame, Pa */
+    vd q[4];   /* the rotation's quaternion: the next warm start */
+    vd ep[6];  /* plastic strain after this pass (crushing) */
+    vd w;      /* strain energy density, J/m^3 */
+    vd wp;     /* plastic work density of this pass, J/m^3 */
+} tet_lanes;
+
+/* Deformation gradient, rotation, element-frame stress (Hooke on the
+ * strain less the plastic strain, then the return to the yield surface
+ * when crushing) and energy densities of tets t[0..LANES-1] at the current
+ * positions, from the warm starts s->rq and plastic strains s->ep, which
+ * it reads only: the new ones are in L. */
+static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid *s, const int t[LANES], cf_elasticity kind,
+                                  tet_lanes *L)
+{
+    lane9 Ds, Di;
+    for (int l = 0; l < LANES; l++) {
+        const int *T = &s->tet[4 * t[l]];
+        const double *x0 = &s->x[3 * T[0]];
+        for (int j = 0; j < 3; j++) {
+            const double *xj = &s->x[3 * T[j + 1]];
+            for (int r = 0; r < 3; r++)
+                Ds[3 * r + j][l] = xj[r] - x0[r];
+        }
+        for (int k = 0; k < 9; k++)
+            Di[k][l] = s->Dm_inv[9 * t[l] + k];
+    }
+    lanes_mul(Ds, Di, L->F);
+    lane9 S; /* the stretch whose symmetric part less I is the strain */
+    if (kind == CF_ELASTICITY_COROTATIONAL) {
+        for (int l = 0; l < LANES; l++)
+            for (int k = 0; k < 4; k++)
+                L->q[k][l] = s->rq[4 * t[l] + k];
+        lanes_polar_rotation(L->F, L->q, 10, 1e-7, L->R);
+        lanes_mul_tn(L->R, L->F, S);
+    } else {
+        for (int k = 0; k < 9; k++)
+            L->R[k] = splat((k % 4) == 0), S[k] = L->F[k];
+    }
+    /* Hooke (hooke's formulas) */
+    lane9 eps;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            eps[3 * i + j] = 0.5 * (S[3 * i + j] + S[3 * j + i]) - (double)(i == j);
+    L->wp = splat(0);
+    if (s->ep)
         for (int v = 0; v < 6; v++) {
             int i = VOIGT[v][0], j = VOIGT[v][1];
-            eps[3 * i + j] -= ep[v];
+            for (int l = 0; l < LANES; l++)
+                L->ep[v][l] = s->ep[6 * t[l] + v];
+            eps[3 * i + j] -= L->ep[v];
             if (i != j)
-                eps[3 * j + i] -= ep[v];
+                eps[3 * j + i] -= L->ep[v];
         }
-    double tr = eps[0] + eps[4] + eps[8];
+    vd tr = eps[0] + eps[4] + eps[8];
     for (int k = 0; k < 9; k++)
-        sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : 0);
-    double wp = ep ? crush(s, sig, eps, update ? ep : NULL) : 0;
-    double w = 0;
+        L->sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : splat(0));
+    if (s->ep)
+        for (int l = 0; l < LANES; l++) {
+            double sg[9], e[9], ep[6];
+            for (int k = 0; k < 9; k++)
+                sg[k] = L->sig[k][l], e[k] = eps[k][l];
+            for (int v = 0; v < 6; v++)
+                ep[v] = L->ep[v][l];
+            L->wp[l] = crush(s, sg, e, ep);
+            for (int k = 0; k < 9; k++)
+                L->sig[k][l] = sg[k], eps[k][l] = e[k];
+            for (int v = 0; v < 6; v++)
+                L->ep[v][l] = ep[v];
+        }
+    L->w = splat(0);
     for (int k = 0; k < 9; k++)
-        w += 0.5 * sig[k] * eps[k];
-    *energy_density = w;
-    return wp;
+        L->w += 0.5 * L->sig[k] * eps[k];
 }
 
-/* Tets whose rotations are found side by side.  The rotation iteration is
- * one long dependent chain per tet (square roots, divisions, a sine and a
- * cosine), so a core running one tet at a time mostly waits on it; running
- * LANES independent chains phase by phase lets it overlap them.  Each lane
- * does exactly the operations of polar_rotation (linalg.h) in the same
- * order, so the bits are those of one tet at a time. */
-#define LANES 4
-
-/* polar_rotation for the first n lanes: q[l] the warm start (updated), R[l]
- * the rotation, at most max_iter updates, stop below tol (rad). */
-static void polar_rotation_lanes(double F[LANES][9], double q[LANES][4], int n,
-                                 int max_iter, double tol, double R[LANES][9])
+/* Gershgorin bounds of a symmetric 3x3 matrix's eigenvalues (lane l of
+ * A): every one lies in [lo, hi].  The element-frame and world-frame
+ * stresses are similar matrices, so these bound the world stress's
+ * principal values too. */
+static inline void gershgorin(lane9 A, int l, double *lo, double *hi)
 {
-    int active[LANES];
+    double r0 = fabs(A[1][l]) + fabs(A[2][l]), r1 = fabs(A[1][l]) + fabs(A[5][l]),
+           r2 = fabs(A[2][l]) + fabs(A[5][l]);
+    *hi = fmax(A[0][l] + r0, fmax(A[4][l] + r1, A[8][l] + r2));
+    *lo = fmin(A[0][l] - r0, fmin(A[4][l] - r1, A[8][l] - r2));
+}
+
+/* With GCC on x86-64 the block is compiled twice, for AVX2 (four lanes in
+ * one register) and for the baseline (two), and the loader picks the one
+ * the processor runs: the same operations either way, so the same bits
+ * (fused multiply-add stays off: -ffp-contract=off). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define CF_LANE_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CF_LANE_CLONES
+#endif
+
+/* cf_tet4_forces for tets t[0..n-1], n <= LANES (the missing lanes repeat
+ * the first tet and are dropped); counts inverted and hot tets. */
+CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_elasticity kind,
+                      const cf_stress_check *check, int *inverted, int *hot)
+{
+    int t[LANES];
+    for (int l = 0; l < LANES; l++)
+        t[l] = tets[l < n ? l : 0];
+    tet_lanes L;
+    tet_lanes_eval(s, t, kind, &L);
+    lane9 P, G; /* P = R sigma; G: rows grad N1..N3 (the rows of Dm^-1) */
+    lanes_mul(L.R, L.sig, P);
+    vd v;
+    for (int l = 0; l < LANES; l++) {
+        for (int k = 0; k < 9; k++)
+            G[k][l] = s->Dm_inv[9 * t[l] + k];
+        v[l] = -s->vol[t[l]];
+    }
+    vd f[12]; /* f_a = -V P grad N_a, grad N0 = -(grad N1 + grad N2 + grad N3) */
+    for (int a = 0; a < 4; a++) {
+        vd g[3];
+        for (int c = 0; c < 3; c++)
+            g[c] = a ? G[3 * (a - 1) + c] : -(G[c] + G[3 + c] + G[6 + c]);
+        for (int r = 0; r < 3; r++)
+            f[3 * a + r] = v * (P[3 * r] * g[0] + P[3 * r + 1] * g[1] + P[3 * r + 2] * g[2]);
+    }
+    lane9 sigma;
+    if (check)
+        lanes_mul_nt(P, L.R, sigma); /* R sigma R^T */
     for (int l = 0; l < n; l++) {
-        quat_normalize(q[l]);
-        active[l] = 1;
-    }
-    for (int it = 0; it < max_iter; it++) {
-        double om[LANES][3], angle[LANES];
-        int left = 0;
-        for (int l = 0; l < n; l++) {
-            if (!active[l])
-                continue;
-            angle[l] = polar_axis(F[l], q[l], R[l], om[l]);
-            if (angle[l] < tol)
-                active[l] = 0; /* R[l] already holds q[l] */
-            left += active[l];
+        int e = t[l];
+        double Fl[9];
+        for (int k = 0; k < 9; k++)
+            Fl[k] = L.F[k][l];
+        *inverted += m3_det(Fl) <= 0;
+        for (int k = 0; k < 12; k++)
+            s->tf[12 * e + k] = f[k][l];
+        s->tw[e] = L.w[l] * s->vol[e];
+        if (kind == CF_ELASTICITY_COROTATIONAL)
+            for (int k = 0; k < 4; k++)
+                s->rq[4 * e + k] = L.q[k][l];
+        if (s->ep) {
+            for (int v = 0; v < 6; v++)
+                s->ep[6 * e + v] = L.ep[v][l];
+            s->wp[e] += L.wp[l] * s->vol[e];
         }
-        if (!left)
-            return;
-        for (int l = 0; l < n; l++)
-            if (active[l])
-                polar_turn(q[l], om[l], angle[l]);
+        if (check) {
+            double lo, hi;
+            for (int k = 0; k < 9; k++)
+                s->sigma[9 * e + k] = sigma[k][l];
+            gershgorin(L.sig, l, &lo, &hi);
+            s->hot[e] = hi >= check->s1 || 0.5 * (hi - lo) >= check->tau;
+            *hot += s->hot[e];
+        }
     }
-    for (int l = 0; l < n; l++)
-        if (active[l])
-            quat_to_mat(q[l], R[l]);
-}
-
-/* Stress in the element frame of tet t from the deformation gradient F and
- * its rotation R to the world, and the strain energy density; with
- * crushing, `update` moves the tet's plastic strain.  Returns the plastic
- * work density of this pass (hooke). */
-static inline double element_stress(const cf_solid *s, int t, const double F[9],
-                                    cf_elasticity kind, const double R[9], int update,
-                                    double sig[9], double *w)
-{
-    double *ep = s->ep ? &s->ep[6 * t] : NULL;
-    if (kind == CF_ELASTICITY_COROTATIONAL) {
-        double S[9];
-        m3_mul_tn(R, F, S);
-        return hooke(s, S, ep, update, sig, w);
-    }
-    return hooke(s, F, ep, update, sig, w);
-}
-
-/* The rotations of tets t[0..n-1] (n <= LANES) at deformation gradients F,
- * from and into the warm starts s->rq; the identity for small strain.  A
- * rotation error theta leaves a strain error O(theta^2 + theta eps): 1e-7
- * rad is far below any cracking strain. */
-static void element_rotations(cf_solid *s, const int *t, int n, double F[LANES][9],
-                              cf_elasticity kind, double R[LANES][9])
-{
-    if (kind != CF_ELASTICITY_COROTATIONAL) {
-        for (int l = 0; l < n; l++)
-            m3_identity(R[l]);
-        return;
-    }
-    double q[LANES][4];
-    for (int l = 0; l < n; l++)
-        memcpy(q[l], &s->rq[4 * t[l]], sizeof q[l]);
-    polar_rotation_lanes(F, q, n, 10, 1e-7, R);
-    for (int l = 0; l < n; l++)
-        memcpy(&s->rq[4 * t[l]], q[l], sizeof q[l]);
-}
-
-/* Gershgorin bounds of a symmetric 3x3 matrix's eigenvalues: every one
- * lies in [lo, hi].  The element-frame and world-frame stresses are similar
- * matrices, so these bound the world stress's principal values too. */
-static inline void gershgorin(const double A[9], double *lo, double *hi)
-{
-    double r0 = fabs(A[1]) + fabs(A[2]), r1 = fabs(A[1]) + fabs(A[5]),
-           r2 = fabs(A[2]) + fabs(A[5]);
-    *hi = fmax(A[0] + r0, fmax(A[4] + r1, A[8] + r2));
-    *lo = fmin(A[0] - r0, fmin(A[4] - r1, A[8] - r2));
 }
 
 int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
@@ -172,39 +322,8 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
      * hundreds of few-tet fragments in fracture mode ran slower on 2
      * threads than on 1. */
 #pragma omp parallel for schedule(static) reduction(+ : inverted, hot) if (nt >= CF_TET4_PARALLEL_MIN)
-    for (int i0 = 0; i0 < nt; i0 += LANES) {
-        int n = nt - i0 < LANES ? nt - i0 : LANES;
-        const int *t = &tets[i0];
-        double F[LANES][9], R[LANES][9];
-        for (int l = 0; l < n; l++) {
-            deformation_gradient(s, t[l], F[l]);
-            inverted += m3_det(F[l]) <= 0;
-        }
-        element_rotations(s, t, n, F, kind, R);
-        for (int l = 0; l < n; l++) {
-            double sig[9], P[9], g[4][3], w;
-            double wp = element_stress(s, t[l], F[l], kind, R[l], 1, sig, &w);
-            s->tw[t[l]] = w * s->vol[t[l]];
-            if (s->wp)
-                s->wp[t[l]] += wp * s->vol[t[l]];
-            m3_mul(R[l], sig, P); /* f_i = -V R sigma grad N_i */
-            cf_tet4_gradients(s, t[l], g);
-            double *tf = &s->tf[12 * t[l]];
-            for (int a = 0; a < 4; a++) {
-                double fa[3];
-                m3_mulv(P, g[a], fa);
-                for (int c = 0; c < 3; c++)
-                    tf[3 * a + c] = -s->vol[t[l]] * fa[c];
-            }
-            if (check) {
-                double lo, hi;
-                m3_mul_nt(P, R[l], &s->sigma[9 * t[l]]); /* R sigma R^T */
-                gershgorin(sig, &lo, &hi);
-                s->hot[t[l]] = hi >= check->s1 || 0.5 * (hi - lo) >= check->tau;
-                hot += s->hot[t[l]];
-            }
-        }
-    }
+    for (int i0 = 0; i0 < nt; i0 += LANES)
+        tet_block(s, &tets[i0], nt - i0 < LANES ? nt - i0 : LANES, kind, check, &inverted, &hot);
     if (n_hot)
         *n_hot = hot;
     return inverted;
@@ -212,17 +331,14 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
 
 void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9])
 {
-    double F[9], R[9], sig[9], P[9], w, q[4];
-    for (int k = 0; k < 4; k++)
-        q[k] = s->rq[4 * t + k];
-    deformation_gradient(s, t, F);
-    if (kind == CF_ELASTICITY_COROTATIONAL)
-        polar_rotation(F, q, 10, 1e-7, R);
-    else
-        m3_identity(R);
-    element_stress(s, t, F, kind, R, 0, sig, &w);
-    m3_mul(R, sig, P);
-    m3_mul_nt(P, R, sigma);
+    int lanes[LANES] = {t, t, t, t};
+    tet_lanes L;
+    tet_lanes_eval(s, lanes, kind, &L);
+    lane9 P, out;
+    lanes_mul(L.R, L.sig, P);
+    lanes_mul_nt(P, L.R, out);
+    for (int k = 0; k < 9; k++)
+        sigma[k] = out[k][0];
 }
 
 void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt)
