@@ -311,6 +311,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         int a = nodes[i];
         for (int k = 0; k < 3; k++)
             s->p[3 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
+        s->w_inv[a] = 1.0 / s->m[a];
         f->contact[i] = -1;
         f->vn_pre[i] = 0;
     }

@@ -391,7 +391,7 @@ typedef struct {
 static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
 {
     int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-    bar_now r = {&s->p[3 * i1], &s->p[3 * i2], 1.0 / s->m[i1], 1.0 / s->m[i2], {0, 0, 0}, 0};
+    bar_now r = {&s->p[3 * i1], &s->p[3 * i2], s->w_inv[i1], s->w_inv[i2], {0, 0, 0}, 0};
     v3_sub(r.p1, r.p2, r.d);
     r.len = v3_norm(r.d);
     return r;

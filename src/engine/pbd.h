@@ -64,7 +64,8 @@ int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touch
 int cf_bars_split(const cf_bars *src, const int *piece_of_node, int k, cf_bars *const *dst);
 
 /* One Gauss-Seidel sweep over the bars on s->p, colour after colour (in
- * parallel within a colour; the same bits for any thread count):
+ * parallel within a colour; the same bits for any thread count), with the
+ * inverse masses w = 1/m from s->w_inv (set by the caller for the bars' nodes):
  * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
 
@@ -77,7 +78,7 @@ void cf_bars_neighbour_speed(const cf_bars *b, const double *v, double *cap);
  * stiffness after all iterations does not depend on their number. */
 double cf_pbd_effective_stiffness(double k, int iterations, int iteration_independent);
 
-/* One XPBD sweep (Macklin, Müller, Chentanez 2016, eq. 18): with
+/* One XPBD sweep (Macklin, Müller, Chentanez 2016, eq. 18; w from s->w_inv): with
  * alpha~ = scale compliance / dt^2, dlambda = (-C - alpha~ lambda)/(w1 + w2 +
  * alpha~), p1 += w1 dlambda n, p2 -= w2 dlambda n.  Reset lambda with
  * cf_bars_reset_lambda at the start of every step. */
