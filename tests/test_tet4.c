@@ -57,16 +57,24 @@ static void test_gradients_reproduce_linear_fields(void **state)
     cf_solid_free(&s);
 }
 
+/* A box of 3 x 2 x nz hexahedra (0.3 x 0.2 x lz m) split into Tet4, E 1 MPa,
+ * nu 0.3, density rho; body receives the body index per tet (free it). */
+static void box_solid(cf_solid *s, cf_mesh *m, int **body, int nz, double lz, double rho)
+{
+    fixture_box(m, 3, 2, nz, 0.3, 0.2, lz);
+    *body = calloc((size_t)m->n_tets, sizeof(int));
+    cf_material mat = material(1e6, 0.3, rho);
+    assert_int_equal(cf_solid_init(s, m, &mat, *body, NULL), CF_OK);
+}
+
 /* The lumped masses of a box add up to rho * volume. */
 static void test_lumped_mass_of_box(void **state)
 {
     (void)state;
     cf_mesh m;
-    fixture_box(&m, 3, 2, 4, 0.3, 0.2, 0.5);
-    int *body = calloc((size_t)m.n_tets, sizeof(int));
-    cf_material mat = material(1e6, 0.3, 2400);
     cf_solid s;
-    assert_int_equal(cf_solid_init(&s, &m, &mat, body, NULL), CF_OK);
+    int *body;
+    box_solid(&s, &m, &body, 4, 0.5, 2400);
     double M = 0;
     for (int i = 0; i < s.n_nodes; i++)
         M += s.m[i];
@@ -237,11 +245,9 @@ static void test_lanes_equal_one_tet_at_a_time(void **state)
 {
     (void)state;
     cf_mesh m;
-    fixture_box(&m, 3, 2, 3, 0.3, 0.2, 0.3);
-    int *body = calloc((size_t)m.n_tets, sizeof(int));
-    cf_material mat = material(1e6, 0.3, 1000);
     cf_solid s;
-    assert_int_equal(cf_solid_init(&s, &m, &mat, body, NULL), CF_OK);
+    int *body;
+    box_solid(&s, &m, &body, 3, 0.3, 1000);
     s.sigma = calloc((size_t)s.n_tets * 9, sizeof(double));
     s.hot = calloc((size_t)s.n_tets, 1);
     unsigned long long r = 12345;
