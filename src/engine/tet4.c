@@ -158,6 +158,7 @@ static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, 
 
 /* What one pass finds for LANES tets. */
 typedef struct {
+    lane9 Di;  /* inverse rest edge matrix: rows grad N1..N3, 1/m */
     lane9 F;   /* deformation gradient */
     lane9 R;   /* rotation to the world (identity for small strain) */
     lane9 sig; /* stress in the element frame, Pa */
@@ -175,7 +176,7 @@ typedef struct {
 static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid *s, const int t[LANES], cf_elasticity kind,
                                   tet_lanes *L)
 {
-    lane9 Ds, Di;
+    lane9 Ds;
     for (int l = 0; l < LANES; l++) {
         const int *T = &s->tet[4 * t[l]];
         const double *x0 = &s->x[3 * T[0]];
@@ -185,9 +186,9 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
                 Ds[3 * r + j][l] = xj[r] - x0[r];
         }
         for (int k = 0; k < 9; k++)
-            Di[k][l] = s->Dm_inv[9 * t[l] + k];
+            L->Di[k][l] = s->Dm_inv[9 * t[l] + k];
     }
-    lanes_mul(Ds, Di, L->F);
+    lanes_mul(Ds, L->Di, L->F);
     lane9 S; /* the stretch whose symmetric part less I is the strain */
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         for (int l = 0; l < LANES; l++)
@@ -267,19 +268,16 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
         t[l] = tets[l < n ? l : 0];
     tet_lanes L;
     tet_lanes_eval(s, t, kind, &L);
-    lane9 P, G; /* P = R sigma; G: rows grad N1..N3 (the rows of Dm^-1) */
+    lane9 P, *G = &L.Di; /* P = R sigma; G: rows grad N1..N3 */
     lanes_mul(L.R, L.sig, P);
     vd v;
-    for (int l = 0; l < LANES; l++) {
-        for (int k = 0; k < 9; k++)
-            G[k][l] = s->Dm_inv[9 * t[l] + k];
+    for (int l = 0; l < LANES; l++)
         v[l] = -s->vol[t[l]];
-    }
     vd f[12]; /* f_a = -V P grad N_a, grad N0 = -(grad N1 + grad N2 + grad N3) */
     for (int a = 0; a < 4; a++) {
         vd g[3];
         for (int c = 0; c < 3; c++)
-            g[c] = a ? G[3 * (a - 1) + c] : -(G[c] + G[3 + c] + G[6 + c]);
+            g[c] = a ? (*G)[3 * (a - 1) + c] : -((*G)[c] + (*G)[3 + c] + (*G)[6 + c]);
         for (int r = 0; r < 3; r++)
             f[3 * a + r] = v * (P[3 * r] * g[0] + P[3 * r + 1] * g[1] + P[3 * r + 2] * g[2]);
     }
