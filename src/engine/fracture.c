@@ -188,7 +188,7 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
     if (ensure_scratch(f))
         return CF_ERR_NOMEM;
     if (fracture) {
-        cf_tet4_gather(s, f->nodes.v, f->nodes.n, g);
+        cf_tet4_scatter(s, f->tets, f->nt, f->nodes.v, f->nodes.n, g);
         /* With PBD the crack faces are kept apart by the constraint in the
          * projection; the penalty is for explicit runs. */
         double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;

@@ -15,7 +15,7 @@
 extern const int CF_TET_FACE[4][3];
 
 /* Loops over a fragment's nodes run on the threads from this many nodes on
- * (force gather, bar building, the step's node loops); each node writes
+ * (force scatter, bar building, the step's node loops); each node writes
  * only its own entries, so the thread count never changes a result. */
 #define CF_NODES_PARALLEL_MIN 2048
 

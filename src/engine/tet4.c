@@ -2,6 +2,8 @@
 
 #include "linalg.h"
 
+#include <omp.h>
+
 /* Voigt slots (xx yy zz xy xz yz) of the plastic strain, as row and column. */
 static const int VOIGT[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
@@ -346,18 +348,38 @@ void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt)
             memset(&s->ep[6 * tets[i]], 0, 6 * sizeof(double));
 }
 
-void cf_tet4_gather(cf_solid *s, const int *nodes, int nn, const double g[3])
+void cf_tet4_scatter(cf_solid *s, const int *tets, int nt, const int *nodes, int nn,
+                     const double g[3])
 {
-#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
+    int lo = 0, hi = -1; /* the fragment's node numbers span [lo, hi] */
     for (int i = 0; i < nn; i++) {
-        int a = nodes[i], o = s->origin[a];
-        double *fa = &s->f[3 * a];
-        for (int k = 0; k < 3; k++)
-            fa[k] = s->m[a] * g[k];
-        for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
-            int slot = s->vt_slot[j];
-            if (s->tet[slot] == a)
-                v3_axpy(1.0, &s->tf[3 * slot], fa);
+        lo = i == 0 || nodes[i] < lo ? nodes[i] : lo;
+        hi = nodes[i] > hi ? nodes[i] : hi;
+    }
+    /* Each thread owns a run of node numbers and streams the whole tet
+     * list, adding only at its own nodes: a node's sum never crosses a
+     * thread, so it is the tet-order sum for any thread count.  With the
+     * nodes and tets in space-filling-curve order (renumber.h) the owner
+     * test is a long run of the same answer. */
+#pragma omp parallel if (nt >= CF_TET4_PARALLEL_MIN)
+    {
+        long span = (long)hi - lo + 1, nth = omp_get_num_threads(), me = omp_get_thread_num();
+        int a0 = lo + (int)(span * me / nth), a1 = lo + (int)(span * (me + 1) / nth);
+        for (int i = 0; i < nn; i++) {
+            int a = nodes[i];
+            if (a >= a0 && a < a1)
+                for (int k = 0; k < 3; k++)
+                    s->f[3 * a + k] = s->m[a] * g[k];
+        }
+        for (int i = 0; i < nt; i++) {
+            const int *tn = &s->tet[4 * tets[i]];
+            const double *tf = &s->tf[12 * tets[i]];
+            for (int j = 0; j < 4; j++) {
+                int a = tn[j];
+                if (a >= a0 && a < a1)
+                    for (int k = 0; k < 3; k++)
+                        s->f[3 * a + k] += tf[3 * j + k];
+            }
         }
     }
 }

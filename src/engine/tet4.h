@@ -58,10 +58,12 @@ void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9
  * dissipated (s->wp) stays.  No-op without crushing. */
 void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt);
 
-/* Nodal forces of the listed nodes: f = m g + the tf slots of the tets
- * that hold the node, added in ascending tet order (the same sum for any
- * thread count; parallel over nodes). g: gravity, m/s^2. */
-void cf_tet4_gather(cf_solid *s, const int *nodes, int nn, const double g[3]);
+/* Nodal forces of a fragment: f = m g at each of its nodes (nn of them),
+ * then the tf slots of its tets (nt, ascending) added at their nodes in
+ * list order, so each node's sum is in ascending tet order: the same bits
+ * for any thread count (parallel over node ranges).  g: gravity, m/s^2. */
+void cf_tet4_scatter(cf_solid *s, const int *tets, int nt, const int *nodes, int nn,
+                     const double g[3]);
 
 /* Elastic strain energy of the listed tets (J), from the last force pass. */
 double cf_tet4_strain_energy(const cf_solid *s, const int *tets, int nt);
