@@ -355,9 +355,11 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
      * (impulse_removes), booked when the next step starts. */
     if (bars) {
 #pragma omp parallel for schedule(static) if (par)
-        for (int i = 0; i < nn; i++)
-            s->vcap[nodes[i]] = v3_norm(&s->v[3 * nodes[i]]);
-        cf_bars_neighbour_speed(&f->bars, s->v, s->vcap);
+        for (int i = 0; i < nn; i++) {
+            int a = nodes[i];
+            s->vcap[a] = s->speed[a] = v3_norm(&s->v[3 * a]);
+        }
+        cf_bars_neighbour_speed(&f->bars, s->speed, s->vcap);
     }
     double removed = 0;
 #pragma omp parallel for schedule(static) if (par)

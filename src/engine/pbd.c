@@ -443,18 +443,19 @@ void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
         SWEEP(b, project_bar(b, s, k, i))
 }
 
-/* Bar i's two ends see each other's speed. */
-static inline void neighbour_speed(const cf_bars *b, const double *v, double *cap, int i)
+/* Bar i's two ends see each other's speed (a comparison, not fmax: the
+ * library call cost more than the rest of the sweep; speeds are never NaN). */
+static inline void neighbour_speed(const cf_bars *b, const double *speed, double *cap, int i)
 {
     int a = b->ends[2 * i], c = b->ends[2 * i + 1];
-    cap[a] = fmax(cap[a], v3_norm(&v[3 * c]));
-    cap[c] = fmax(cap[c], v3_norm(&v[3 * a]));
+    cap[a] = speed[c] > cap[a] ? speed[c] : cap[a];
+    cap[c] = speed[a] > cap[c] ? speed[a] : cap[c];
 }
 
-void cf_bars_neighbour_speed(const cf_bars *b, const double *v, double *cap)
+void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
 {
     if (b->n > 0)
-        SWEEP(b, neighbour_speed(b, v, cap, i))
+        SWEEP(b, neighbour_speed(b, speed, cap, i))
 }
 
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)

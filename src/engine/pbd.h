@@ -69,9 +69,9 @@ int cf_bars_split(const cf_bars *src, const int *piece_of_node, int k, cf_bars *
  * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
 
-/* cap[a] = max(cap[a], |v[c]|) for every bar (a, c), both ways (m/s): the
- * fastest neighbour of each node.  Colour by colour, like the sweep. */
-void cf_bars_neighbour_speed(const cf_bars *b, const double *v, double *cap);
+/* cap[a] = max(cap[a], speed[c]) for every bar (a, c), both ways (m/s):
+ * the fastest neighbour of each node.  Colour by colour, like the sweep. */
+void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap);
 
 /* The stiffness used per iteration: k, or with `iteration_independent`
  * k' = 1 - (1 - k)^(1/iterations) (Müller et al. 2007, §3.3), so that the

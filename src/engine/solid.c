@@ -240,6 +240,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->m = calloc((size_t)s->cap_nodes, sizeof(double));
     s->vcap = calloc((size_t)s->cap_nodes, sizeof(double));
     s->w_inv = calloc((size_t)s->cap_nodes, sizeof(double));
+    s->speed = calloc((size_t)s->cap_nodes, sizeof(double));
     s->origin = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet = malloc((size_t)nt * 4 * sizeof(int));
     s->tet0 = malloc((size_t)nt * 4 * sizeof(int));
@@ -259,7 +260,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
                                 nt);
         }
     }
-    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->w_inv || !s->origin || !s->tet ||
+    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->w_inv || !s->speed || !s->origin || !s->tet ||
         !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
@@ -305,7 +306,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 
 void cf_solid_free(cf_solid *s)
 {
-    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->w_inv, s->origin, s->tet, s->tet0,
+    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->w_inv, s->speed, s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->tf, s->tw, s->ep, s->wp, s->bc, s->tet_frag, s->facet, s->tet_facet,
                     s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
@@ -333,6 +334,7 @@ int cf_solid_copy_node(cf_solid *s, int n)
             grow((void **)&s->f, v3, cap) || grow((void **)&s->m, sizeof(double), cap) ||
             grow((void **)&s->vcap, sizeof(double), cap) ||
             grow((void **)&s->w_inv, sizeof(double), cap) ||
+            grow((void **)&s->speed, sizeof(double), cap) ||
             grow((void **)&s->origin, sizeof(int), cap) || grow((void **)&s->bc, sizeof(int), cap))
             return -1;
         if (s->node_mark && (grow((void **)&s->node_mark, 1, cap) ||

@@ -48,6 +48,9 @@ typedef struct cf_solid {
     double *m;                /* [n] lumped mass, kg */
     double *vcap;             /* [n] scratch of the projection: the fastest bar
                                  neighbour's predicted speed, m/s */
+    double *speed;            /* [n] scratch of the projection: |v| of the projected
+                                 fragment's nodes, m/s (one square root per node
+                                 instead of two per bar) */
     double *w_inv;            /* [n] scratch of the projection: 1/m of the projected
                                  fragment's nodes, 1/kg (one division per node and
                                  step instead of two per bar and iteration) */
