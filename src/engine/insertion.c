@@ -114,9 +114,16 @@ static void nodal_values(cf_solid *s, const cf_int_list *marked)
         s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i]);
 }
 
-/* The faces of tet ta that qualify, as bits 1 << k. */
+/* The faces of tet ta that qualify, as bits 1 << k.  Either rule needs a
+ * hot tet holding all three nodes of the face (the source's rule marks
+ * exactly those nodes; the traction rule needs ta or its neighbour hot), so
+ * a tet with fewer than three marked nodes is done without reading a facet. */
 static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion rule)
 {
+    const int *T = &s->tet[4 * ta];
+    const unsigned char *mark = s->node_mark;
+    if (mark[T[0]] + mark[T[1]] + mark[T[2]] + mark[T[3]] < 3)
+        return 0;
     double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
     unsigned char bits = 0;
     for (int k = 0; k < 4; k++) {
@@ -162,20 +169,18 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     out->n = 0;
     if (n_hot == 0 || rule == CF_CRITERION_NONE)
         return 0;
-    /* The source's rule: `out` lists the marked nodes until the faces are
-     * tested. */
-    if (rule == CF_CRITERION_SOURCE) {
-        if (mark_hot_nodes(s, tets, nt, out))
-            return -1;
+    /* The nodes of hot tets, marked; `out` lists them until the faces are
+     * tested.  The source's rule needs their nodal values. */
+    if (mark_hot_nodes(s, tets, nt, out))
+        return -1;
+    if (rule == CF_CRITERION_SOURCE)
         nodal_values(s, out);
-    }
     /* Each tet's faces in parallel (reads only, one byte written per tet),
      * then the facets in list order: the same list for any thread count. */
 #pragma omp parallel for schedule(static) if (nt >= CF_TET4_PARALLEL_MIN)
     for (int i = 0; i < nt; i++)
         s->qualify[tets[i]] = qualifying_faces(s, tets[i], rule);
-    if (rule == CF_CRITERION_SOURCE)
-        clear_marks(s, out);
+    clear_marks(s, out);
     out->n = 0;
     int rc = 0;
     for (int i = 0; i < nt && rc == 0; i++)

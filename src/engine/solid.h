@@ -86,9 +86,11 @@ typedef struct cf_solid {
                                  NULL: 1 everywhere) */
     double strength_min;      /* the smallest of them (1 when uniform) */
     double strength_max;      /* the largest (1 when uniform) */
-    unsigned char *node_mark; /* [cap_nodes] scratch of the source criterion, all 0 between
-                                 checks (fracture state) */
-    double *nodal;            /* [cap_nodes] its nodal values, Pa (fracture state) */
+    unsigned char *node_mark; /* [cap_nodes] scratch of the insertion check: the
+                                 nodes of hot tets; all 0 between checks
+                                 (fracture state) */
+    double *nodal;            /* [cap_nodes] the source criterion's nodal values, Pa
+                                 (fracture state) */
     int *vt_start, *vt_slot;  /* original vertex -> its slots 4 t + j in the tets that
                                  hold it (CSR, ascending t) */
 
