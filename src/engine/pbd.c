@@ -1,5 +1,6 @@
 #include "pbd.h"
 
+#include "lanes.h"
 #include "linalg.h"
 
 #include <stdint.h>
@@ -421,26 +422,69 @@ static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double s
     v3_axpy(-r.w2 * dl / r.len, r.d, r.p2);
 }
 
-/* Colour by colour; the bars of one colour share no node, so they run in
- * parallel and in any order with the same result.  The last group holds
- * bars no colour could take: one thread. */
-#define SWEEP(b, CALL)                                                                         \
+/* Bars i..i+LANES-1, of one colour: project_bar on each lane, all lanes
+ * loaded before any is stored (they share no node, so that is the order
+ * one at a time gives too).  Each lane does project_bar's operations in
+ * its order: the same bits. */
+CF_LANE_CLONES static void project_lanes(const cf_bars *b, cf_solid *s, double k, int i)
+{
+    const int *e = &b->ends[2 * i];
+    vd p1[3], p2[3], w1, w2, rest, d[3];
+    for (int l = 0; l < LANES; l++) {
+        for (int c = 0; c < 3; c++)
+            p1[c][l] = s->p[3 * e[2 * l] + c], p2[c][l] = s->p[3 * e[2 * l + 1] + c];
+        w1[l] = s->w_inv[e[2 * l]], w2[l] = s->w_inv[e[2 * l + 1]], rest[l] = b->rest[i + l];
+    }
+    for (int c = 0; c < 3; c++)
+        d[c] = p1[c] - p2[c];
+    vd len = v_sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    vd c = splat(k) * (len - rest) / ((w1 + w2) * len), a1 = -w1 * c, a2 = w2 * c;
+    for (int q = 0; q < 3; q++)
+        p1[q] += a1 * d[q], p2[q] += a2 * d[q];
+    for (int l = 0; l < LANES; l++)
+        if (len[l] != 0) /* project_bar leaves a bar of zero length alone */
+            for (int q = 0; q < 3; q++)
+                s->p[3 * e[2 * l] + q] = p1[q][l], s->p[3 * e[2 * l + 1] + q] = p2[q][l];
+}
+
+/* Bars i..i+n-1 of one colour. */
+static inline void project_bars(const cf_bars *b, cf_solid *s, double k, int i, int n)
+{
+    if (n == LANES)
+        project_lanes(b, s, k, i);
+    else
+        for (int j = i; j < i + n; j++)
+            project_bar(b, s, k, j);
+}
+
+/* Colour by colour, in blocks of up to W bars (bars i..i+n-1); the bars of
+ * one colour share no node, so the blocks run in parallel and in any order
+ * with the same result.  The last group holds bars no colour could take:
+ * one thread, one bar at a time (n = 1). */
+#define SWEEP(b, W, CALL)                                                                      \
     _Pragma("omp parallel if ((b)->n >= CF_BARS_PARALLEL_MIN)")                                \
     {                                                                                          \
         for (int c = 0; c < (b)->n_colors && c < CF_BARS_COLORS; c++) {                        \
+            int c0 = (b)->color_start[c], c1 = (b)->color_start[c + 1];                        \
             _Pragma("omp for schedule(static)")                                                \
-            for (int i = (b)->color_start[c]; i < (b)->color_start[c + 1]; i++)                \
+            for (int j = 0; j < (c1 - c0 + (W)-1) / (W); j++) {                                \
+                int i = c0 + (W) * j, n = c1 - i < (W) ? c1 - i : (W);                         \
+                (void)n;                                                                       \
                 CALL;                                                                          \
+            }                                                                                  \
         }                                                                                      \
         _Pragma("omp single")                                                                  \
-        for (int i = (b)->color_start[CF_BARS_COLORS]; i < (b)->n; i++)                        \
+        for (int i = (b)->color_start[CF_BARS_COLORS]; i < (b)->n; i++) {                      \
+            int n = 1;                                                                         \
+            (void)n;                                                                           \
             CALL;                                                                              \
+        }                                                                                      \
     }
 
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
 {
     if (b->n > 0)
-        SWEEP(b, project_bar(b, s, k, i))
+        SWEEP(b, LANES, project_bars(b, s, k, i, n))
 }
 
 /* Bar i's two ends see each other's speed (a comparison, not fmax: the
@@ -455,13 +499,13 @@ static inline void neighbour_speed(const cf_bars *b, const double *speed, double
 void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
 {
     if (b->n > 0)
-        SWEEP(b, neighbour_speed(b, speed, cap, i))
+        SWEEP(b, 1, neighbour_speed(b, speed, cap, i))
 }
 
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
 {
     if (b->n > 0)
-        SWEEP(b, project_bar_xpbd(b, s, dt, scale, i))
+        SWEEP(b, 1, project_bar_xpbd(b, s, dt, scale, i))
 }
 
 void cf_bars_reset_lambda(cf_bars *b)

@@ -1,5 +1,6 @@
 #include "tet4.h"
 
+#include "lanes.h"
 #include "linalg.h"
 
 #include <omp.h>
@@ -34,35 +35,13 @@ static inline double crush(const cf_solid *s, double sig[9], double eps[9], doub
     return (sc / seq) * back * ss / (2 * s->mu); /* (1 - back) s : back s / 2 mu */
 }
 
-/* The kernel below runs LANES tets side by side: every per-tet number is a
- * vector of LANES doubles (GCC's vector extension), so each operation is
- * one vector instruction (two on SSE2) and the core overlaps the lanes'
- * long dependent chains (the rotation's square roots, divisions, sine and
- * cosine).  Each lane does exactly the operations of the scalar formulas
- * (linalg.h: m3_mul, polar_rotation, ...) in the same order, and IEEE
- * arithmetic rounds each lane alone: the bits are those of one tet at a
- * time, at any vector width (test_tet4.c compares them). */
-#define LANES 4
-/* The vectors never cross a call that is not inlined, so the ABI note
- * about passing them without AVX does not apply. */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-typedef double vd __attribute__((vector_size(LANES * sizeof(double))));
-typedef long long vm __attribute__((vector_size(LANES * sizeof(double)))); /* lane masks */
+/* The kernel below runs LANES tets side by side (lanes.h): every per-tet
+ * number is a vector, so the core overlaps the lanes' long dependent chains
+ * (the rotation's square roots, divisions, sine and cosine).  Each lane does
+ * exactly the operations of the scalar formulas (linalg.h: m3_mul,
+ * polar_rotation, ...) in the same order: the bits are those of one tet at
+ * a time (test_tet4.c compares them). */
 typedef vd lane9[9];
-
-static inline vd splat(double a) { return (vd){a, a, a, a}; }
-
-/* m ? a : b, lane by lane (m: all ones or all zeros). */
-static inline vd pick(vm m, vd a, vd b) { return (vd)(((vm)a & m) | ((vm)b & ~m)); }
-
-static inline vd v_sqrt(vd a)
-{
-    for (int l = 0; l < LANES; l++)
-        a[l] = sqrt(a[l]);
-    return a;
-}
 
 static inline vd v_fabs(vd a) { return (vd)((vm)a & ~(vm)splat(-0.0)); } /* sign bit off */
 
@@ -249,16 +228,6 @@ static inline void gershgorin(lane9 A, int l, double *lo, double *hi)
     *hi = fmax(A[0][l] + r0, fmax(A[4][l] + r1, A[8][l] + r2));
     *lo = fmin(A[0][l] - r0, fmin(A[4][l] - r1, A[8][l] - r2));
 }
-
-/* With GCC on x86-64 the block is compiled twice, for AVX2 (four lanes in
- * one register) and for the baseline (two), and the loader picks the one
- * the processor runs: the same operations either way, so the same bits
- * (fused multiply-add stays off: -ffp-contract=off). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define CF_LANE_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define CF_LANE_CLONES
-#endif
 
 /* cf_tet4_forces for tets t[0..n-1], n <= LANES (the missing lanes repeat
  * the first tet and are dropped); counts inverted and hot tets. */
