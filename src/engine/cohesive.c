@@ -45,75 +45,91 @@ static double component_work(double d0, double T0, double d, double T, double t0
     return 0.5 * (T0 + T) * (d - d0);
 }
 
+/* Element ce's three node pairs: tractions, energies and state, and each
+ * pair's force into out[0..2].  Writes only ce and out.  Returns its pairs
+ * in complete failure. */
+static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_law *law,
+                          const void *params, double dt, double kp, cf_pair_force out[3])
+{
+    int n_failed = 0, a[3], b[3];
+    double nrm[3];
+    for (int i = 0; i < 3; i++)
+        out[i].a = -1;
+    double area = mid_normal(s, ce, s->x, a, b, nrm);
+    if (area == 0)
+        return 0;
+    /* The law of the facet's strength (material.strength). */
+    double scaled[CF_LAW_PARAMS_MAX];
+    const void *p = params;
+    if (ce->strength != 1.0) {
+        memcpy(scaled, params, law->params_size);
+        law->scale(scaled, ce->strength);
+        p = scaled;
+    }
+    for (int i = 0; i < 3; i++) {
+        if (a[i] == b[i]) /* the crack has not opened at this vertex yet */
+            continue;
+        double d[3], tv[3];
+        v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
+        double dn = v3_dot(d, nrm);
+        for (int k = 0; k < 3; k++)
+            tv[k] = d[k] - dn * nrm[k];
+        double dtl = v3_norm(tv);
+        double Tn, Tt, e0n, e0t;
+        law->envelope(p, 0, ce->dt_max[i], &e0n, &e0t);
+        double t0plus = ce->dn_max[i] > 0 ? 0 : e0n; /* secant or envelope at 0+ */
+        law->traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
+        n_failed += ce->failed[i];
+        /* Stability cap of a node pair at step dt: a node pair is shared
+         * by up to ~8 elements, so a sixteenth of the two-mass limit
+         * 4/(dt^2 (wa + wb)) keeps their sum stable. */
+        double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
+        double cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
+        if (dn <= 0) { /* compression: penalty, while the faces still face each other */
+            double facing = kp >= 0 && v3_dot(d, d) <= 0.25 * area;
+            Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
+        }
+        /* The tangential traction rises from zero with the capped
+         * stiffness: at zero tangential opening its direction is
+         * undefined, and a jump to tau_max there would act in a
+         * direction set by round-off (time continuity, Papoulia et al.
+         * 2003). */
+        Tt = fmin(Tt, cap * dtl);
+        if (!ce->started[i]) {
+            law->envelope(p, 0, 0, &e0n, &e0t);
+            ce->last[i][0] = 0, ce->last[i][1] = 0, ce->last[i][2] = e0n;
+            ce->last[i][3] = ce->dt_max[i] > 0 ? 0 : e0t; /* secant or envelope at 0 */
+            ce->started[i] = 1;
+        }
+        double *L = ce->last[i];
+        ce->work[i] += area / 3.0 *
+                       (component_work(L[0], L[2], dn, Tn, t0plus) + 0.5 * (L[3] + Tt) * (dtl - L[1]));
+        double elastic = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
+        ce->dissipated[i] = fmax(ce->dissipated[i], ce->work[i] - elastic);
+        ce->stored[i] = ce->work[i] - ce->dissipated[i];
+        L[0] = dn, L[1] = dtl, L[2] = Tn, L[3] = Tt;
+        double fvec[3] = {0, 0, 0};
+        v3_axpy(area / 3.0 * Tn, nrm, fvec);
+        if (dtl > 0)
+            v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
+        out[i] = (cf_pair_force){a[i], b[i], {fvec[0], fvec[1], fvec[2]}};
+    }
+    return n_failed;
+}
+
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
-                       const int *elems, int n, double dt, double kp)
+                       const int *elems, int n, double dt, double kp, cf_pair_force *pairs)
 {
     int n_failed = 0;
-    for (int e = 0; e < n; e++) {
-        cf_cohesive *ce = &s->coh[elems[e]];
-        int a[3], b[3];
-        double nrm[3];
-        double area = mid_normal(s, ce, s->x, a, b, nrm);
-        if (area == 0)
-            continue;
-        /* The law of the facet's strength (material.strength). */
-        double scaled[CF_LAW_PARAMS_MAX];
-        const void *p = params;
-        if (ce->strength != 1.0) {
-            memcpy(scaled, params, law->params_size);
-            law->scale(scaled, ce->strength);
-            p = scaled;
+#pragma omp parallel for schedule(static) reduction(+ : n_failed) if (n >= CF_COHESIVE_PARALLEL_MIN)
+    for (int e = 0; e < n; e++)
+        n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, &pairs[3 * e]);
+    /* Elements share nodes: the sums in list and pair order, on one thread. */
+    for (int j = 0; j < 3 * n; j++)
+        if (pairs[j].a >= 0) {
+            v3_axpy(1.0, pairs[j].f, &s->f[3 * pairs[j].a]); /* pulls A towards B */
+            v3_axpy(-1.0, pairs[j].f, &s->f[3 * pairs[j].b]);
         }
-        for (int i = 0; i < 3; i++) {
-            if (a[i] == b[i]) /* the crack has not opened at this vertex yet */
-                continue;
-            double d[3], tv[3];
-            v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
-            double dn = v3_dot(d, nrm);
-            for (int k = 0; k < 3; k++)
-                tv[k] = d[k] - dn * nrm[k];
-            double dtl = v3_norm(tv);
-            double Tn, Tt, e0n, e0t;
-            law->envelope(p, 0, ce->dt_max[i], &e0n, &e0t);
-            double t0plus = ce->dn_max[i] > 0 ? 0 : e0n; /* secant or envelope at 0+ */
-            law->traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
-            n_failed += ce->failed[i];
-            /* Stability cap of a node pair at step dt: a node pair is shared
-             * by up to ~8 elements, so a sixteenth of the two-mass limit
-             * 4/(dt^2 (wa + wb)) keeps their sum stable. */
-            double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
-            double cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
-            if (dn <= 0) { /* compression: penalty, while the faces still face each other */
-                double facing = kp >= 0 && v3_dot(d, d) <= 0.25 * area;
-                Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
-            }
-            /* The tangential traction rises from zero with the capped
-             * stiffness: at zero tangential opening its direction is
-             * undefined, and a jump to tau_max there would act in a
-             * direction set by round-off (time continuity, Papoulia et al.
-             * 2003). */
-            Tt = fmin(Tt, cap * dtl);
-            if (!ce->started[i]) {
-                law->envelope(p, 0, 0, &e0n, &e0t);
-                ce->last[i][0] = 0, ce->last[i][1] = 0, ce->last[i][2] = e0n;
-                ce->last[i][3] = ce->dt_max[i] > 0 ? 0 : e0t; /* secant or envelope at 0 */
-                ce->started[i] = 1;
-            }
-            double *L = ce->last[i];
-            ce->work[i] += area / 3.0 *
-                           (component_work(L[0], L[2], dn, Tn, t0plus) + 0.5 * (L[3] + Tt) * (dtl - L[1]));
-            double elastic = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
-            ce->dissipated[i] = fmax(ce->dissipated[i], ce->work[i] - elastic);
-            ce->stored[i] = ce->work[i] - ce->dissipated[i];
-            L[0] = dn, L[1] = dtl, L[2] = Tn, L[3] = Tt;
-            double fvec[3] = {0, 0, 0};
-            v3_axpy(area / 3.0 * Tn, nrm, fvec);
-            if (dtl > 0)
-                v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
-            v3_axpy(1.0, fvec, &s->f[3 * a[i]]); /* pulls A towards B */
-            v3_axpy(-1.0, fvec, &s->f[3 * b[i]]);
-        }
-    }
     return n_failed;
 }
 

@@ -23,11 +23,23 @@
  * are never combined.  The tangential traction rises from
  * zero with the same capped stiffness (time continuity).
  * Each pair's absorbed work and stored energy are updated (cf_cohesive).
- * Returns the number of node pairs in complete failure. */
-/* (Each element with the law `law` at `params`, scaled to its facet's
- * strength: law->scale.) */
+ * Returns the number of node pairs in complete failure.
+ * (Each element with the law `law` at `params`, scaled to its facet's
+ * strength: law->scale.)  The elements are evaluated in parallel (OpenMP,
+ * from CF_COHESIVE_PARALLEL_MIN on) into `pairs` ([3 n], the caller's
+ * scratch), and their forces then added in list and pair order: the same
+ * sums for any thread count. */
+#define CF_COHESIVE_PARALLEL_MIN 256
+
+/* One node pair's force of this evaluation: f (N) pulls node a towards b
+ * (a < 0: the pair carries none). */
+typedef struct cf_pair_force {
+    int a, b;
+    double f[3];
+} cf_pair_force;
+
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
-                       const int *elems, int n, double dt, double kp);
+                       const int *elems, int n, double dt, double kp, cf_pair_force *pairs);
 
 /* Energy of cohesive elements elems[0..n) (all of them when elems is NULL),
  * J: stored (recoverable, on the secant; includes compression penalty) and

@@ -10,6 +10,13 @@ static int ensure_scratch(cf_fragment *f)
 {
     if (cf_node_impulses_reserve(&f->push, f->nodes.n))
         return -1;
+    if (f->pairs_cap < f->coh.n) {
+        int cap = f->coh.n + f->coh.n / 2 + 16;
+        cf_pair_force *p = realloc(f->pairs, (size_t)cap * 3 * sizeof *p);
+        if (!p)
+            return -1;
+        f->pairs = p, f->pairs_cap = cap;
+    }
     if (f->scratch_cap >= f->nodes.n)
         return 0;
     int cap = f->nodes.n + f->nodes.n / 2 + 16;
@@ -192,7 +199,7 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
         /* With PBD the crack faces are kept apart by the constraint in the
          * projection; the penalty is for explicit runs. */
         double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;
-        cf_cohesive_forces(s, sim->law, sim->law_params, f->coh.v, f->coh.n, dt, kp);
+        cf_cohesive_forces(s, sim->law, sim->law_params, f->coh.v, f->coh.n, dt, kp, f->pairs);
     } else {
         for (int i = 0; i < f->nodes.n; i++) {
             int a = f->nodes.v[i];

@@ -575,7 +575,7 @@ void cf_world_destroy(cf_world *sim)
     for (int i = 0; i < sim->n_frag; i++) {
         cf_fragment *f = &sim->frag[i];
         free(f->tets), free(f->nodes.v), free(f->coh.v), free(f->contact), free(f->vn_pre);
-        free(f->v_old), free(f->term);
+        free(f->v_old), free(f->term), free(f->pairs);
         cf_bars_free(&f->bars);
         cf_hulls_free(&f->hulls);
         cf_node_impulses_free(&f->push);
@@ -1226,7 +1226,8 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
         m->fragments += (unsigned long long)f->nt * I + (unsigned long long)f->nodes.cap * I +
                         (unsigned long long)f->coh.cap * I +
                         (unsigned long long)f->bars.n * (2 * I + 3 * D) +
-                        (unsigned long long)f->scratch_cap * (I + 5 * D + I + 6 * D);
+                        (unsigned long long)f->scratch_cap * (I + 5 * D + I + 6 * D) +
+                        (unsigned long long)f->pairs_cap * 3 * sizeof(cf_pair_force);
         if (f->hulls.n_hulls)
             m->fragments += (unsigned long long)f->hulls.start[f->hulls.n_hulls] * 3 * D +
                             ((unsigned long long)f->hulls.n_hulls + 1) * I;

@@ -53,6 +53,8 @@ typedef struct cf_fragment {
     double *v_old;           /* [nodes.n][3] velocity at the start of the step, m/s */
     double *term;            /* [nodes.n] per-node energy terms, J, summed in node order */
     int scratch_cap;
+    cf_pair_force *pairs;    /* [3 pairs_cap] cohesive forces of a step (scratch) */
+    int pairs_cap;           /* elements it has room for */
     /* Energy ledger state at the last force evaluation (in-house solver). */
     double e_kin;            /* J, 1/2 sum m v(n-1/2).v(n+1/2) (leapfrog estimate) */
     double e_strain;         /* J */
