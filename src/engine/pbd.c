@@ -3,6 +3,7 @@
 #include "lanes.h"
 #include "linalg.h"
 
+#include <omp.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -426,65 +427,71 @@ static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double s
  * loaded before any is stored (they share no node, so that is the order
  * one at a time gives too).  Each lane does project_bar's operations in
  * its order: the same bits. */
-CF_LANE_CLONES static void project_lanes(const cf_bars *b, cf_solid *s, double k, int i)
+static inline __attribute__((always_inline)) void project_lanes(const cf_bars *b, cf_solid *s,
+                                                                double k, int i)
 {
     const int *e = &b->ends[2 * i];
-    vd p1[3], p2[3], w1, w2, rest, d[3];
+    const double *x1[LANES], *x2[LANES];
+    vd w1, w2, rest;
     for (int l = 0; l < LANES; l++) {
-        for (int c = 0; c < 3; c++)
-            p1[c][l] = s->p[3 * e[2 * l] + c], p2[c][l] = s->p[3 * e[2 * l + 1] + c];
+        x1[l] = &s->p[3 * e[2 * l]], x2[l] = &s->p[3 * e[2 * l + 1]];
         w1[l] = s->w_inv[e[2 * l]], w2[l] = s->w_inv[e[2 * l + 1]], rest[l] = b->rest[i + l];
     }
-    for (int c = 0; c < 3; c++)
-        d[c] = p1[c] - p2[c];
-    vd len = v_sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+#define LANES_OF(x, c) ((vd){x[0][c], x[1][c], x[2][c], x[3][c]})
+    vd p1x = LANES_OF(x1, 0), p1y = LANES_OF(x1, 1), p1z = LANES_OF(x1, 2);
+    vd p2x = LANES_OF(x2, 0), p2y = LANES_OF(x2, 1), p2z = LANES_OF(x2, 2);
+#undef LANES_OF
+    vd dx = p1x - p2x, dy = p1y - p2y, dz = p1z - p2z;
+    vd len = v_sqrt(dx * dx + dy * dy + dz * dz);
     vd c = splat(k) * (len - rest) / ((w1 + w2) * len), a1 = -w1 * c, a2 = w2 * c;
-    for (int q = 0; q < 3; q++)
-        p1[q] += a1 * d[q], p2[q] += a2 * d[q];
+    p1x += a1 * dx, p1y += a1 * dy, p1z += a1 * dz;
+    p2x += a2 * dx, p2y += a2 * dy, p2z += a2 * dz;
     for (int l = 0; l < LANES; l++)
-        if (len[l] != 0) /* project_bar leaves a bar of zero length alone */
-            for (int q = 0; q < 3; q++)
-                s->p[3 * e[2 * l] + q] = p1[q][l], s->p[3 * e[2 * l + 1] + q] = p2[q][l];
+        if (len[l] != 0) { /* project_bar leaves a bar of zero length alone */
+            double *y1 = &s->p[3 * e[2 * l]], *y2 = &s->p[3 * e[2 * l + 1]];
+            y1[0] = p1x[l], y1[1] = p1y[l], y1[2] = p1z[l];
+            y2[0] = p2x[l], y2[1] = p2y[l], y2[2] = p2z[l];
+        }
 }
 
-/* Bars i..i+n-1 of one colour. */
-static inline void project_bars(const cf_bars *b, cf_solid *s, double k, int i, int n)
+/* Bars i0..i1-1 of one colour: four at a time, the rest one by one (one
+ * call per thread and colour, so the clone is chosen once per run). */
+CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, int i0, int i1)
 {
-    if (n == LANES)
+    int i = i0;
+    for (; i + LANES <= i1; i += LANES)
         project_lanes(b, s, k, i);
-    else
-        for (int j = i; j < i + n; j++)
-            project_bar(b, s, k, j);
+    for (; i < i1; i++)
+        project_bar(b, s, k, i);
 }
 
-/* Colour by colour, in blocks of up to W bars (bars i..i+n-1); the bars of
- * one colour share no node, so the blocks run in parallel and in any order
- * with the same result.  The last group holds bars no colour could take:
- * one thread, one bar at a time (n = 1). */
-#define SWEEP(b, W, CALL)                                                                      \
+/* Colour by colour; the bars of one colour share no node, so they run in
+ * parallel and in any order with the same result.  Each thread takes one
+ * run i0..i1-1 of the colour's bars (cut at multiples of W) and does RUN;
+ * then all wait.  The last group holds bars no colour could take: one
+ * thread, one bar i at a time in order (ONE). */
+#define SWEEP(b, W, RUN, ONE)                                                                  \
     _Pragma("omp parallel if ((b)->n >= CF_BARS_PARALLEL_MIN)")                                \
     {                                                                                          \
+        long nth_ = omp_get_num_threads(), me_ = omp_get_thread_num();                         \
         for (int c = 0; c < (b)->n_colors && c < CF_BARS_COLORS; c++) {                        \
             int c0 = (b)->color_start[c], c1 = (b)->color_start[c + 1];                        \
-            _Pragma("omp for schedule(static)")                                                \
-            for (int j = 0; j < (c1 - c0 + (W)-1) / (W); j++) {                                \
-                int i = c0 + (W) * j, n = c1 - i < (W) ? c1 - i : (W);                         \
-                (void)n;                                                                       \
-                CALL;                                                                          \
-            }                                                                                  \
+            long nb_ = (c1 - c0 + (W)-1) / (W);                                                \
+            int i0 = c0 + (W) * (int)(nb_ * me_ / nth_);                                       \
+            int i1 = c0 + (W) * (int)(nb_ * (me_ + 1) / nth_);                                 \
+            i0 = i0 < c1 ? i0 : c1, i1 = i1 < c1 ? i1 : c1;                                   \
+            RUN;                                                                               \
+            _Pragma("omp barrier")                                                             \
         }                                                                                      \
         _Pragma("omp single")                                                                  \
-        for (int i = (b)->color_start[CF_BARS_COLORS]; i < (b)->n; i++) {                      \
-            int n = 1;                                                                         \
-            (void)n;                                                                           \
-            CALL;                                                                              \
-        }                                                                                      \
+        for (int i = (b)->color_start[CF_BARS_COLORS]; i < (b)->n; i++)                        \
+            ONE;                                                                               \
     }
 
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
 {
     if (b->n > 0)
-        SWEEP(b, LANES, project_bars(b, s, k, i, n))
+        SWEEP(b, LANES, project_run(b, s, k, i0, i1), project_bar(b, s, k, i))
 }
 
 /* Bar i's two ends see each other's speed (a comparison, not fmax: the
@@ -499,13 +506,15 @@ static inline void neighbour_speed(const cf_bars *b, const double *speed, double
 void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
 {
     if (b->n > 0)
-        SWEEP(b, 1, neighbour_speed(b, speed, cap, i))
+        SWEEP(b, 1, for (int i = i0; i < i1; i++) neighbour_speed(b, speed, cap, i),
+              neighbour_speed(b, speed, cap, i))
 }
 
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
 {
     if (b->n > 0)
-        SWEEP(b, 1, project_bar_xpbd(b, s, dt, scale, i))
+        SWEEP(b, 1, for (int i = i0; i < i1; i++) project_bar_xpbd(b, s, dt, scale, i),
+              project_bar_xpbd(b, s, dt, scale, i))
 }
 
 void cf_bars_reset_lambda(cf_bars *b)
