@@ -36,7 +36,7 @@ bench: meshes
 
 # Step time and memory per tet from 15k to 800k tets.
 bench-scaling: meshes
-	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_50k --target-tets 50000
+	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_80k --target-tets 80000
 	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_800k --target-tets 800000
 	$(BUILD)/cohfrac bench --scaling -m $(MESHES)
 

@@ -119,7 +119,7 @@ static const struct {
      "      --criterion none|source|traction  insertion rule (default source)\n"
      "      --peer                          also step Bullet's btSoftBody on the same mesh\n"
      "      --scaling[=M1,M2,...]           step time and memory per tet over meshes (default\n"
-     "                                      bunny_small,bunny_50k,bunny,bunny_800k)\n"
+     "                                      bunny_small,bunny_80k,bunny,bunny_800k)\n"
      "      -m, --mesh-dir DIR              as for 'run'\n"},
 };
 
@@ -554,7 +554,7 @@ static int cmd_bench(int argc, char **argv)
             else return usage_error("--criterion is none, source or traction");
             break;
         case O_PEER: peer = 1; break;
-        case O_SCALING: scaling = optarg ? optarg : "bunny_small,bunny_50k,bunny,bunny_800k"; break;
+        case O_SCALING: scaling = optarg ? optarg : "bunny_small,bunny_80k,bunny,bunny_800k"; break;
         case 'm': o.mesh_dir = optarg; break;
         default: return usage_error("bad option for 'bench'");
         }

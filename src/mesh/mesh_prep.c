@@ -358,11 +358,13 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, c
 }
 
 /* Decimate a copy of `full` to about `tris` triangles, without
- * self-intersections (retrying with more triangles if needed). */
+ * self-intersections or folds: retried with 15 % more triangles each time
+ * (meshoptimizer does not promise either), up to the full surface, which
+ * is clean (load_clean_surface) and is then what `out` gets. */
 static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int verbose,
                          cf_error *err)
 {
-    for (int attempt = 0; attempt < 4; attempt++) {
+    for (; tris < full->n_tris; tris = (int)(tris * 1.15) & ~1) {
         cf_status st = copy_surface(full, out, err);
         if (st != CF_OK)
             return st;
@@ -378,19 +380,20 @@ static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int 
         if (verbose)
             fprintf(stderr,
                     "  decimated to %d triangles, %d vertices (asked %d) in %.2f s; volume "
-                    "%.9g; %d intersecting pairs\n",
-                    got, out->n_verts, tris, cf_wall_time() - t0, cf_surface_volume(out), n);
+                    "%.9g; %d intersecting pairs%s\n",
+                    got, out->n_verts, tris, cf_wall_time() - t0, cf_surface_volume(out), n,
+                    closed == 0 ? "; folded (not a closed manifold)" : "");
         if (n == 0 && closed == 1)
             return CF_OK;
         cf_surface_free(out);
         if (n < 0 || closed < 0)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-        tris = (int)(tris * 1.15) & ~1;
     }
-    return cf_error_set(err, CF_ERR_SURFACE_INTERSECT,
-                        "decimating the surface to about %d triangles keeps making it intersect "
-                        "itself: ask for more tets (--target-tets) or give a coarser surface",
-                        tris);
+    if (verbose)
+        fprintf(stderr, "  no decimation without intersections or folds: the full surface (%d "
+                        "triangles) is used\n",
+                full->n_tris);
+    return copy_surface(full, out, err);
 }
 
 /* One tetgen run on `s` written to <dir>/surf.off. */
