@@ -96,7 +96,8 @@ static void test_scatter_equals_the_tet_order_sum(void **state)
     cf_mesh m;
     cf_solid s;
     strained_box(&s, &m);
-    int *all = malloc((size_t)s.n_tets * sizeof(int)), *nodes = malloc((size_t)s.n_nodes * sizeof(int));
+    int *all = malloc((size_t)s.n_tets * sizeof(int));
+    int *nodes = malloc((size_t)s.n_nodes * sizeof(int));
     for (int t = 0; t < s.n_tets; t++)
         all[t] = t;
     for (int i = 0; i < s.n_nodes; i++)

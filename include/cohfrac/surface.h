@@ -143,8 +143,9 @@ typedef struct cf_mesh_prep_opts {
  * Errors: as cf_surface_load, CF_ERR_USAGE (missing paths, N < 0, N not
  * reachable within 25 %),
  * CF_ERR_MESH_PARSE (surface not closed or encloses no volume: names the
- * edge/vertex), CF_ERR_SURFACE_INTERSECT (intersections left after repair,
- * or made by decimation: lists face pairs), CF_ERR_EXTERNAL (tetgen missing
+ * edge/vertex), CF_ERR_SURFACE_INTERSECT (intersections left after repair:
+ * lists face pairs; a decimation that folds the surface is retried with
+ * more triangles, up to the full surface), CF_ERR_EXTERNAL (tetgen missing
  * or failed: its output is quoted; or its tets do not fill the surface),
  * CF_ERR_MESH_INVERTED (degenerate tet in tetgen's output), CF_ERR_OUTPUT,
  * CF_ERR_NOMEM, CF_ERR_INTERRUPTED (opts->stop raised).  Temporary files are

@@ -469,7 +469,8 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
  * parallel and in any order with the same result.  Each thread takes one
  * run i0..i1-1 of the colour's bars (cut at multiples of W) and does RUN;
  * then all wait.  The last group holds bars no colour could take: one
- * thread, one bar i at a time in order (ONE). */
+ * thread, one bar i at a time in order (ONE).  SWEEP_EACH: ONE for every
+ * bar, colours included. */
 #define SWEEP(b, W, RUN, ONE)                                                                  \
     _Pragma("omp parallel if ((b)->n >= CF_BARS_PARALLEL_MIN)")                                \
     {                                                                                          \
@@ -487,6 +488,7 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
         for (int i = (b)->color_start[CF_BARS_COLORS]; i < (b)->n; i++)                        \
             ONE;                                                                               \
     }
+#define SWEEP_EACH(b, ONE) SWEEP(b, 1, for (int i = i0; i < i1; i++) ONE, ONE)
 
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
 {
@@ -506,15 +508,13 @@ static inline void neighbour_speed(const cf_bars *b, const double *speed, double
 void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
 {
     if (b->n > 0)
-        SWEEP(b, 1, for (int i = i0; i < i1; i++) neighbour_speed(b, speed, cap, i),
-              neighbour_speed(b, speed, cap, i))
+        SWEEP_EACH(b, neighbour_speed(b, speed, cap, i))
 }
 
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
 {
     if (b->n > 0)
-        SWEEP(b, 1, for (int i = i0; i < i1; i++) project_bar_xpbd(b, s, dt, scale, i),
-              project_bar_xpbd(b, s, dt, scale, i))
+        SWEEP_EACH(b, project_bar_xpbd(b, s, dt, scale, i))
 }
 
 void cf_bars_reset_lambda(cf_bars *b)

@@ -260,7 +260,8 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
                                 nt);
         }
     }
-    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->w_inv || !s->speed || !s->origin || !s->tet ||
+    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->w_inv ||
+        !s->speed || !s->origin || !s->tet ||
         !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
@@ -306,7 +307,8 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 
 void cf_solid_free(cf_solid *s)
 {
-    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->w_inv, s->speed, s->origin, s->tet, s->tet0,
+    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->w_inv, s->speed,
+                    s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->tf, s->tw, s->ep, s->wp, s->bc, s->tet_frag, s->facet, s->tet_facet,
                     s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};

@@ -95,7 +95,9 @@ static inline void lanes_quat_to_mat(vd q[4], lane9 R)
  * updated.  All lanes evaluate the update until none still turns: a lane
  * whose update fell below tol keeps q, so evaluating it again gives the
  * same R and the same stop, and R is always that of the final q. */
-static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, vd q[4], int max_iter, double tol, lane9 R)
+static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, vd q[4],
+                                                                       int max_iter, double tol,
+                                                                       lane9 R)
 {
     lanes_quat_normalize(q);
     for (int it = 0; it < max_iter; it++) {
@@ -154,8 +156,9 @@ typedef struct {
  * when crushing) and energy densities of tets t[0..LANES-1] at the current
  * positions, from the warm starts s->rq and plastic strains s->ep, which
  * it reads only: the new ones are in L. */
-static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid *s, const int t[LANES], cf_elasticity kind,
-                                  tet_lanes *L)
+static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid *s,
+                                                                 const int t[LANES],
+                                                                 cf_elasticity kind, tet_lanes *L)
 {
     lane9 Ds;
     for (int l = 0; l < LANES; l++) {

@@ -10,8 +10,9 @@
 
 #include "solid.h"
 
-/* Gradients of the 4 shape functions of tet t, [4][3], 1/m (inline: the
- * force kernel calls it for every tet at every step). */
+/* Gradients of the 4 shape functions of tet t, [4][3], 1/m: the formula
+ * the force kernel applies four tets at a time (tet_block), one tet here
+ * (the tests' reference). */
 static inline void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3])
 {
     const double *Di = &s->Dm_inv[9 * t];
