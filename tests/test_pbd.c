@@ -20,8 +20,9 @@
 static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0};
 
 /* A box of 12 x 10 x 10 hexahedra in Tet4 (above the parallel thresholds of
- * bars and tets), its nodes moved off the rest shape by up to 5 %. */
-static void strained_box(cf_solid *s, cf_mesh *m)
+ * bars and tets), its nodes moved off the rest shape by up to 5 %.  Returns
+ * the list of all its tets, ascending (free it). */
+static int *strained_box(cf_solid *s, cf_mesh *m)
 {
     fixture_box(m, 12, 10, 10, 0.6, 0.5, 0.5);
     int *body = calloc((size_t)m->n_tets, sizeof(int));
@@ -33,6 +34,10 @@ static void strained_box(cf_solid *s, cf_mesh *m)
         s->x[i] = s->X[i] * (1 + 0.05 * ((double)(r >> 11) / 9007199254740992.0 - 0.5));
     }
     assert_true(s->n_tets >= CF_TET4_PARALLEL_MIN);
+    int *all = malloc((size_t)s->n_tets * sizeof(int));
+    for (int t = 0; t < s->n_tets; t++)
+        all[t] = t;
+    return all;
 }
 
 /* Bar i projected alone (docs/physics.md §7): C = |p1 - p2| - rest, moved
@@ -58,10 +63,7 @@ static void test_sweep_equals_one_bar_at_a_time(void **state)
     (void)state;
     cf_mesh m;
     cf_solid s;
-    strained_box(&s, &m);
-    int *all = malloc((size_t)s.n_tets * sizeof(int));
-    for (int t = 0; t < s.n_tets; t++)
-        all[t] = t;
+    int *all = strained_box(&s, &m);
     cf_bars b = {0};
     assert_int_equal(cf_bars_build(&b, &s, all, s.n_tets), 0);
     assert_true(b.n >= CF_BARS_PARALLEL_MIN);
@@ -95,11 +97,7 @@ static void test_scatter_equals_the_tet_order_sum(void **state)
     (void)state;
     cf_mesh m;
     cf_solid s;
-    strained_box(&s, &m);
-    int *all = malloc((size_t)s.n_tets * sizeof(int));
-    int *nodes = malloc((size_t)s.n_nodes * sizeof(int));
-    for (int t = 0; t < s.n_tets; t++)
-        all[t] = t;
+    int *all = strained_box(&s, &m), *nodes = malloc((size_t)s.n_nodes * sizeof(int));
     for (int i = 0; i < s.n_nodes; i++)
         nodes[i] = (5 * i) % s.n_nodes; /* the list in no particular order */
     assert_int_equal(s.n_nodes % 5 != 0, 1);
