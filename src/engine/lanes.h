@@ -31,6 +31,50 @@ static inline vd v_sqrt(vd a)
     return a;
 }
 
+/* The 4x4 transpose: r[i][j] <- r[j][i]. */
+static inline void lanes_transpose(vd r[4])
+{
+    vd t0 = __builtin_shuffle(r[0], r[1], (vm){0, 4, 2, 6}),
+       t1 = __builtin_shuffle(r[0], r[1], (vm){1, 5, 3, 7}),
+       t2 = __builtin_shuffle(r[2], r[3], (vm){0, 4, 2, 6}),
+       t3 = __builtin_shuffle(r[2], r[3], (vm){1, 5, 3, 7});
+    r[0] = __builtin_shuffle(t0, t2, (vm){0, 1, 4, 5});
+    r[1] = __builtin_shuffle(t1, t3, (vm){0, 1, 4, 5});
+    r[2] = __builtin_shuffle(t0, t2, (vm){2, 3, 6, 7});
+    r[3] = __builtin_shuffle(t1, t3, (vm){2, 3, 6, 7});
+}
+
+/* out[k] = (p[0][k], ..., p[LANES-1][k]) for k < n: n consecutive doubles
+ * at each of LANES addresses, as n vectors. */
+static inline void lanes_load(const double *const p[LANES], int n, vd *out)
+{
+    int k = 0;
+    for (; k + LANES <= n; k += LANES) {
+        for (int l = 0; l < LANES; l++)
+            __builtin_memcpy(&out[k + l], p[l] + k, sizeof(vd));
+        lanes_transpose(&out[k]);
+    }
+    for (; k < n; k++)
+        out[k] = (vd){p[0][k], p[1][k], p[2][k], p[3][k]};
+}
+
+/* p[l][k] = in[k][l] for k < n, l < nl: lanes_load's inverse, for the
+ * first nl lanes. */
+static inline void lanes_store(const vd *in, int n, double *const p[LANES], int nl)
+{
+    int k = 0;
+    if (nl == LANES)
+        for (; k + LANES <= n; k += LANES) {
+            vd r[4] = {in[k], in[k + 1], in[k + 2], in[k + 3]};
+            lanes_transpose(r);
+            for (int l = 0; l < LANES; l++)
+                __builtin_memcpy(p[l] + k, &r[l], sizeof(vd));
+        }
+    for (; k < n; k++)
+        for (int l = 0; l < nl; l++)
+            p[l][k] = in[k][l];
+}
+
 /* With GCC on x86-64 a lane kernel is compiled twice, for AVX2 (four lanes
  * in one register) and for the baseline (two), and the loader picks the
  * one the processor runs: the same operations either way, so the same bits. */

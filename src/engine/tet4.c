@@ -160,24 +160,26 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
                                                                  const int t[LANES],
                                                                  cf_elasticity kind, tet_lanes *L)
 {
-    lane9 Ds;
-    for (int l = 0; l < LANES; l++) {
-        const int *T = &s->tet[4 * t[l]];
-        const double *x0 = &s->x[3 * T[0]];
-        for (int j = 0; j < 3; j++) {
-            const double *xj = &s->x[3 * T[j + 1]];
-            for (int r = 0; r < 3; r++)
-                Ds[3 * r + j][l] = xj[r] - x0[r];
-        }
-        for (int k = 0; k < 9; k++)
-            L->Di[k][l] = s->Dm_inv[9 * t[l] + k];
+    const double *p[LANES];
+    vd X[4][3]; /* the tets' nodes' positions */
+    for (int j = 0; j < 4; j++) {
+        for (int l = 0; l < LANES; l++)
+            p[l] = &s->x[3 * s->tet[4 * t[l] + j]];
+        lanes_load(p, 3, X[j]);
     }
+    lane9 Ds;
+    for (int j = 0; j < 3; j++)
+        for (int r = 0; r < 3; r++)
+            Ds[3 * r + j] = X[j + 1][r] - X[0][r];
+    for (int l = 0; l < LANES; l++)
+        p[l] = &s->Dm_inv[9 * t[l]];
+    lanes_load(p, 9, L->Di);
     lanes_mul(Ds, L->Di, L->F);
     lane9 S; /* the stretch whose symmetric part less I is the strain */
     if (kind == CF_ELASTICITY_COROTATIONAL) {
         for (int l = 0; l < LANES; l++)
-            for (int k = 0; k < 4; k++)
-                L->q[k][l] = s->rq[4 * t[l] + k];
+            p[l] = &s->rq[4 * t[l]];
+        lanes_load(p, 4, L->q);
         lanes_polar_rotation(L->F, L->q, 10, 1e-7, L->R);
         lanes_mul_tn(L->R, L->F, S);
     } else {
@@ -190,11 +192,14 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
         for (int j = 0; j < 3; j++)
             eps[3 * i + j] = 0.5 * (S[3 * i + j] + S[3 * j + i]) - (double)(i == j);
     L->wp = splat(0);
+    if (s->ep) {
+        for (int l = 0; l < LANES; l++)
+            p[l] = &s->ep[6 * t[l]];
+        lanes_load(p, 6, L->ep);
+    }
     if (s->ep)
         for (int v = 0; v < 6; v++) {
             int i = VOIGT[v][0], j = VOIGT[v][1];
-            for (int l = 0; l < LANES; l++)
-                L->ep[v][l] = s->ep[6 * t[l] + v];
             eps[3 * i + j] -= L->ep[v];
             if (i != j)
                 eps[3 * j + i] -= L->ep[v];
@@ -220,16 +225,27 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
         L->w += 0.5 * L->sig[k] * eps[k];
 }
 
-/* Gershgorin bounds of a symmetric 3x3 matrix's eigenvalues (lane l of
- * A): every one lies in [lo, hi].  The element-frame and world-frame
- * stresses are similar matrices, so these bound the world stress's
- * principal values too. */
-static inline void gershgorin(lane9 A, int l, double *lo, double *hi)
+/* fmax and fmin lane by lane: a NaN operand gives the other one. */
+static inline vd v_fmax(vd a, vd b) { return pick((vm)(a >= b) | (vm)(b != b), a, b); }
+static inline vd v_fmin(vd a, vd b) { return pick((vm)(a <= b) | (vm)(b != b), a, b); }
+
+/* Gershgorin bounds of a symmetric 3x3 matrix's eigenvalues: every one
+ * lies in [lo, hi].  The element-frame and world-frame stresses are
+ * similar matrices, so these bound the world stress's principal values
+ * too. */
+static inline void gershgorin(lane9 A, vd *lo, vd *hi)
 {
-    double r0 = fabs(A[1][l]) + fabs(A[2][l]), r1 = fabs(A[1][l]) + fabs(A[5][l]),
-           r2 = fabs(A[2][l]) + fabs(A[5][l]);
-    *hi = fmax(A[0][l] + r0, fmax(A[4][l] + r1, A[8][l] + r2));
-    *lo = fmin(A[0][l] - r0, fmin(A[4][l] - r1, A[8][l] - r2));
+    vd r0 = v_fabs(A[1]) + v_fabs(A[2]), r1 = v_fabs(A[1]) + v_fabs(A[5]),
+       r2 = v_fabs(A[2]) + v_fabs(A[5]);
+    *hi = v_fmax(A[0] + r0, v_fmax(A[4] + r1, A[8] + r2));
+    *lo = v_fmin(A[0] - r0, v_fmin(A[4] - r1, A[8] - r2));
+}
+
+/* det F (m3_det) */
+static inline vd lanes_det(lane9 A)
+{
+    return A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+           A[2] * (A[3] * A[7] - A[4] * A[6]);
 }
 
 /* cf_tet4_forces for tets t[0..n-1], n <= LANES (the missing lanes repeat
@@ -244,9 +260,7 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
     tet_lanes_eval(s, t, kind, &L);
     lane9 P, *G = &L.Di; /* P = R sigma; G: rows grad N1..N3 */
     lanes_mul(L.R, L.sig, P);
-    vd v;
-    for (int l = 0; l < LANES; l++)
-        v[l] = -s->vol[t[l]];
+    vd vol = {s->vol[t[0]], s->vol[t[1]], s->vol[t[2]], s->vol[t[3]]}, v = -vol;
     vd f[12]; /* f_a = -V P grad N_a, grad N0 = -(grad N1 + grad N2 + grad N3) */
     for (int a = 0; a < 4; a++) {
         vd g[3];
@@ -255,32 +269,40 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
         for (int r = 0; r < 3; r++)
             f[3 * a + r] = v * (P[3 * r] * g[0] + P[3 * r + 1] * g[1] + P[3 * r + 2] * g[2]);
     }
-    lane9 sigma;
-    if (check)
+    double *p[LANES];
+    for (int l = 0; l < LANES; l++)
+        p[l] = &s->tf[12 * t[l]];
+    lanes_store(f, 12, p, n);
+    if (kind == CF_ELASTICITY_COROTATIONAL) {
+        for (int l = 0; l < LANES; l++)
+            p[l] = &s->rq[4 * t[l]];
+        lanes_store(L.q, 4, p, n);
+    }
+    if (s->ep) {
+        for (int l = 0; l < LANES; l++)
+            p[l] = &s->ep[6 * t[l]];
+        lanes_store(L.ep, 6, p, n);
+    }
+    vd w = L.w * vol, wp = L.wp * vol, det = lanes_det(L.F);
+    vm is_hot = {0};
+    if (check) {
+        lane9 sigma;
         lanes_mul_nt(P, L.R, sigma); /* R sigma R^T */
+        for (int l = 0; l < LANES; l++)
+            p[l] = &s->sigma[9 * t[l]];
+        lanes_store(sigma, 9, p, n);
+        vd lo, hi;
+        gershgorin(L.sig, &lo, &hi);
+        is_hot = (vm)(hi >= splat(check->s1)) | (vm)(0.5 * (hi - lo) >= splat(check->tau));
+    }
     for (int l = 0; l < n; l++) {
         int e = t[l];
-        double Fl[9];
-        for (int k = 0; k < 9; k++)
-            Fl[k] = L.F[k][l];
-        *inverted += m3_det(Fl) <= 0;
-        for (int k = 0; k < 12; k++)
-            s->tf[12 * e + k] = f[k][l];
-        s->tw[e] = L.w[l] * s->vol[e];
-        if (kind == CF_ELASTICITY_COROTATIONAL)
-            for (int k = 0; k < 4; k++)
-                s->rq[4 * e + k] = L.q[k][l];
-        if (s->ep) {
-            for (int v = 0; v < 6; v++)
-                s->ep[6 * e + v] = L.ep[v][l];
-            s->wp[e] += L.wp[l] * s->vol[e];
-        }
+        *inverted += det[l] <= 0;
+        s->tw[e] = w[l];
+        if (s->ep)
+            s->wp[e] += wp[l];
         if (check) {
-            double lo, hi;
-            for (int k = 0; k < 9; k++)
-                s->sigma[9 * e + k] = sigma[k][l];
-            gershgorin(L.sig, l, &lo, &hi);
-            s->hot[e] = hi >= check->s1 || 0.5 * (hi - lo) >= check->tau;
+            s->hot[e] = is_hot[l] != 0;
             *hot += s->hot[e];
         }
     }
