@@ -444,14 +444,16 @@ static inline __attribute__((always_inline)) void project_lanes(const cf_bars *b
     vd dx = p1x - p2x, dy = p1y - p2y, dz = p1z - p2z;
     vd len = v_sqrt(dx * dx + dy * dy + dz * dz);
     vd c = splat(k) * (len - rest) / ((w1 + w2) * len), a1 = -w1 * c, a2 = w2 * c;
-    p1x += a1 * dx, p1y += a1 * dy, p1z += a1 * dz;
-    p2x += a2 * dx, p2y += a2 * dy, p2z += a2 * dz;
-    for (int l = 0; l < LANES; l++)
-        if (len[l] != 0) { /* project_bar leaves a bar of zero length alone */
-            double *y1 = &s->p[3 * e[2 * l]], *y2 = &s->p[3 * e[2 * l + 1]];
-            y1[0] = p1x[l], y1[1] = p1y[l], y1[2] = p1z[l];
-            y2[0] = p2x[l], y2[1] = p2y[l], y2[2] = p2z[l];
-        }
+    vm moves = (vm)(len != splat(0)); /* project_bar leaves a bar of zero length alone */
+    p1x = pick(moves, p1x + a1 * dx, p1x), p1y = pick(moves, p1y + a1 * dy, p1y);
+    p1z = pick(moves, p1z + a1 * dz, p1z);
+    p2x = pick(moves, p2x + a2 * dx, p2x), p2y = pick(moves, p2y + a2 * dy, p2y);
+    p2z = pick(moves, p2z + a2 * dz, p2z);
+    for (int l = 0; l < LANES; l++) {
+        double *y1 = &s->p[3 * e[2 * l]], *y2 = &s->p[3 * e[2 * l + 1]];
+        y1[0] = p1x[l], y1[1] = p1y[l], y1[2] = p1z[l];
+        y2[0] = p2x[l], y2[1] = p2y[l], y2[2] = p2z[l];
+    }
 }
 
 /* Bars i0..i1-1 of one colour: four at a time, the rest one by one (one
