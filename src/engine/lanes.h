@@ -31,17 +31,18 @@ static inline vd v_sqrt(vd a)
     return a;
 }
 
-/* The 4x4 transpose: r[i][j] <- r[j][i]. */
+/* The 4x4 transpose: r[i][j] <- r[j][i] (__builtin_shufflevector: GCC 12
+ * and clang alike). */
 static inline void lanes_transpose(vd r[4])
 {
-    vd t0 = __builtin_shuffle(r[0], r[1], (vm){0, 4, 2, 6}),
-       t1 = __builtin_shuffle(r[0], r[1], (vm){1, 5, 3, 7}),
-       t2 = __builtin_shuffle(r[2], r[3], (vm){0, 4, 2, 6}),
-       t3 = __builtin_shuffle(r[2], r[3], (vm){1, 5, 3, 7});
-    r[0] = __builtin_shuffle(t0, t2, (vm){0, 1, 4, 5});
-    r[1] = __builtin_shuffle(t1, t3, (vm){0, 1, 4, 5});
-    r[2] = __builtin_shuffle(t0, t2, (vm){2, 3, 6, 7});
-    r[3] = __builtin_shuffle(t1, t3, (vm){2, 3, 6, 7});
+    vd t0 = __builtin_shufflevector(r[0], r[1], 0, 4, 2, 6),
+       t1 = __builtin_shufflevector(r[0], r[1], 1, 5, 3, 7),
+       t2 = __builtin_shufflevector(r[2], r[3], 0, 4, 2, 6),
+       t3 = __builtin_shufflevector(r[2], r[3], 1, 5, 3, 7);
+    r[0] = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+    r[1] = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+    r[2] = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+    r[3] = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
 }
 
 /* out[k] = (p[0][k], ..., p[LANES-1][k]) for k < n: n consecutive doubles
