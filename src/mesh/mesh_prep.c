@@ -357,6 +357,15 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, c
     return CF_OK;
 }
 
+/* The next decimation's triangle count: 15 % more, even, and at least two
+ * more (below 14, 15 % more rounds back down to the same even count, and
+ * the retries would never reach the full surface). */
+static int more_tris(int tris)
+{
+    int n = (int)(tris * 1.15) & ~1;
+    return n > tris ? n : tris + 2;
+}
+
 /* Decimate a copy of `full` to about `tris` triangles, without
  * self-intersections or folds: retried with 15 % more triangles each time
  * (meshoptimizer does not promise either), up to the full surface, which
@@ -364,7 +373,7 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, c
 static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int verbose,
                          cf_error *err)
 {
-    for (; tris < full->n_tris; tris = (int)(tris * 1.15) & ~1) {
+    for (; tris < full->n_tris; tris = more_tris(tris)) {
         cf_status st = copy_surface(full, out, err);
         if (st != CF_OK)
             return st;
