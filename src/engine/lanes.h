@@ -45,33 +45,38 @@ static inline void lanes_transpose(vd r[4])
     r[3] = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
 }
 
-/* out[k] = (p[0][k], ..., p[LANES-1][k]) for k < n: n consecutive doubles
- * at each of LANES addresses, as n vectors. */
-static inline void lanes_load(const double *const p[LANES], int n, vd *out)
+/* out[k] = (base[w row[0] + k], ..., base[w row[LANES-1] + k]) for k < w:
+ * row row[l] of an array of rows of w doubles, lane by lane, as w vectors. */
+static inline void lanes_load(const double *base, int w, const int row[LANES], vd *out)
 {
+    const double *p[LANES];
+    for (int l = 0; l < LANES; l++)
+        p[l] = base + (long)w * row[l];
     int k = 0;
-    for (; k + LANES <= n; k += LANES) {
+    for (; k + LANES <= w; k += LANES) {
         for (int l = 0; l < LANES; l++)
             __builtin_memcpy(&out[k + l], p[l] + k, sizeof(vd));
         lanes_transpose(&out[k]);
     }
-    for (; k < n; k++)
+    for (; k < w; k++)
         out[k] = (vd){p[0][k], p[1][k], p[2][k], p[3][k]};
 }
 
-/* p[l][k] = in[k][l] for k < n, l < nl: lanes_load's inverse, for the
- * first nl lanes. */
-static inline void lanes_store(const vd *in, int n, double *const p[LANES], int nl)
+/* lanes_load's inverse for the first nl lanes: base[w row[l] + k] = in[k][l]. */
+static inline void lanes_store(const vd *in, int w, double *base, const int row[LANES], int nl)
 {
+    double *p[LANES];
+    for (int l = 0; l < LANES; l++)
+        p[l] = base + (long)w * row[l];
     int k = 0;
     if (nl == LANES)
-        for (; k + LANES <= n; k += LANES) {
+        for (; k + LANES <= w; k += LANES) {
             vd r[4] = {in[k], in[k + 1], in[k + 2], in[k + 3]};
             lanes_transpose(r);
             for (int l = 0; l < LANES; l++)
                 __builtin_memcpy(p[l] + k, &r[l], sizeof(vd));
         }
-    for (; k < n; k++)
+    for (; k < w; k++)
         for (int l = 0; l < nl; l++)
             p[l][k] = in[k][l];
 }

@@ -160,26 +160,22 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
                                                                  const int t[LANES],
                                                                  cf_elasticity kind, tet_lanes *L)
 {
-    const double *p[LANES];
     vd X[4][3]; /* the tets' nodes' positions */
     for (int j = 0; j < 4; j++) {
+        int node[LANES];
         for (int l = 0; l < LANES; l++)
-            p[l] = &s->x[3 * s->tet[4 * t[l] + j]];
-        lanes_load(p, 3, X[j]);
+            node[l] = s->tet[4 * t[l] + j];
+        lanes_load(s->x, 3, node, X[j]);
     }
     lane9 Ds;
     for (int j = 0; j < 3; j++)
         for (int r = 0; r < 3; r++)
             Ds[3 * r + j] = X[j + 1][r] - X[0][r];
-    for (int l = 0; l < LANES; l++)
-        p[l] = &s->Dm_inv[9 * t[l]];
-    lanes_load(p, 9, L->Di);
+    lanes_load(s->Dm_inv, 9, t, L->Di);
     lanes_mul(Ds, L->Di, L->F);
     lane9 S; /* the stretch whose symmetric part less I is the strain */
     if (kind == CF_ELASTICITY_COROTATIONAL) {
-        for (int l = 0; l < LANES; l++)
-            p[l] = &s->rq[4 * t[l]];
-        lanes_load(p, 4, L->q);
+        lanes_load(s->rq, 4, t, L->q);
         lanes_polar_rotation(L->F, L->q, 10, 1e-7, L->R);
         lanes_mul_tn(L->R, L->F, S);
     } else {
@@ -193,17 +189,14 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
             eps[3 * i + j] = 0.5 * (S[3 * i + j] + S[3 * j + i]) - (double)(i == j);
     L->wp = splat(0);
     if (s->ep) {
-        for (int l = 0; l < LANES; l++)
-            p[l] = &s->ep[6 * t[l]];
-        lanes_load(p, 6, L->ep);
-    }
-    if (s->ep)
+        lanes_load(s->ep, 6, t, L->ep);
         for (int v = 0; v < 6; v++) {
             int i = VOIGT[v][0], j = VOIGT[v][1];
             eps[3 * i + j] -= L->ep[v];
             if (i != j)
                 eps[3 * j + i] -= L->ep[v];
         }
+    }
     vd tr = eps[0] + eps[4] + eps[8];
     for (int k = 0; k < 9; k++)
         L->sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : splat(0));
@@ -269,28 +262,17 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
         for (int r = 0; r < 3; r++)
             f[3 * a + r] = v * (P[3 * r] * g[0] + P[3 * r + 1] * g[1] + P[3 * r + 2] * g[2]);
     }
-    double *p[LANES];
-    for (int l = 0; l < LANES; l++)
-        p[l] = &s->tf[12 * t[l]];
-    lanes_store(f, 12, p, n);
-    if (kind == CF_ELASTICITY_COROTATIONAL) {
-        for (int l = 0; l < LANES; l++)
-            p[l] = &s->rq[4 * t[l]];
-        lanes_store(L.q, 4, p, n);
-    }
-    if (s->ep) {
-        for (int l = 0; l < LANES; l++)
-            p[l] = &s->ep[6 * t[l]];
-        lanes_store(L.ep, 6, p, n);
-    }
+    lanes_store(f, 12, s->tf, t, n);
+    if (kind == CF_ELASTICITY_COROTATIONAL)
+        lanes_store(L.q, 4, s->rq, t, n);
+    if (s->ep)
+        lanes_store(L.ep, 6, s->ep, t, n);
     vd w = L.w * vol, wp = L.wp * vol, det = lanes_det(L.F);
     vm is_hot = {0};
     if (check) {
         lane9 sigma;
         lanes_mul_nt(P, L.R, sigma); /* R sigma R^T */
-        for (int l = 0; l < LANES; l++)
-            p[l] = &s->sigma[9 * t[l]];
-        lanes_store(sigma, 9, p, n);
+        lanes_store(sigma, 9, s->sigma, t, n);
         vd lo, hi;
         gershgorin(L.sig, &lo, &hi);
         is_hot = (vm)(hi >= splat(check->s1)) | (vm)(0.5 * (hi - lo) >= splat(check->tau));
