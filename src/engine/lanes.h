@@ -45,8 +45,15 @@ static inline void lanes_transpose(vd r[4])
     r[3] = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
 }
 
+/* LANES doubles at any address (one unaligned vector load or store). */
+typedef double vd_any
+    __attribute__((vector_size(LANES * sizeof(double)), aligned(sizeof(double)), may_alias));
+
 /* out[k] = (base[w row[0] + k], ..., base[w row[LANES-1] + k]) for k < w:
- * row row[l] of an array of rows of w doubles, lane by lane, as w vectors. */
+ * row row[l] of an array of rows of w doubles, lane by lane, as w vectors.
+ * Each group of four columns is four whole-row loads straight into
+ * registers and a transpose: no copy through memory, whose narrower stores
+ * the wide loads after them could not take forwarded. */
 static inline void lanes_load(const double *base, int w, const int row[LANES], vd *out)
 {
     const double *p[LANES];
@@ -54,9 +61,10 @@ static inline void lanes_load(const double *base, int w, const int row[LANES], v
         p[l] = base + (long)w * row[l];
     int k = 0;
     for (; k + LANES <= w; k += LANES) {
-        for (int l = 0; l < LANES; l++)
-            __builtin_memcpy(&out[k + l], p[l] + k, sizeof(vd));
-        lanes_transpose(&out[k]);
+        vd r[4] = {*(const vd_any *)(p[0] + k), *(const vd_any *)(p[1] + k),
+                   *(const vd_any *)(p[2] + k), *(const vd_any *)(p[3] + k)};
+        lanes_transpose(r);
+        out[k] = r[0], out[k + 1] = r[1], out[k + 2] = r[2], out[k + 3] = r[3];
     }
     for (; k < w; k++)
         out[k] = (vd){p[0][k], p[1][k], p[2][k], p[3][k]};
@@ -73,8 +81,8 @@ static inline void lanes_store(const vd *in, int w, double *base, const int row[
         for (; k + LANES <= w; k += LANES) {
             vd r[4] = {in[k], in[k + 1], in[k + 2], in[k + 3]};
             lanes_transpose(r);
-            for (int l = 0; l < LANES; l++)
-                __builtin_memcpy(p[l] + k, &r[l], sizeof(vd));
+            *(vd_any *)(p[0] + k) = r[0], *(vd_any *)(p[1] + k) = r[1];
+            *(vd_any *)(p[2] + k) = r[2], *(vd_any *)(p[3] + k) = r[3];
         }
     for (; k < w; k++)
         for (int l = 0; l < nl; l++)
