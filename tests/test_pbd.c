@@ -79,15 +79,18 @@ static void test_sweep_equals_one_bar_at_a_time(void **state)
     memcpy(&s.p[3 * b.ends[2 * z]], &s.p[3 * b.ends[2 * z + 1]], 3 * sizeof(double));
     double *want = malloc((size_t)s.n_nodes * 3 * sizeof(double));
     memcpy(want, s.p, (size_t)s.n_nodes * 3 * sizeof(double));
+    int *nodes = malloc((size_t)s.n_nodes * sizeof(int));
+    for (int i = 0; i < s.n_nodes; i++)
+        nodes[i] = s.n_nodes - 1 - i; /* the bars' ends, in any order */
     for (int it = 0; it < 3; it++) {
         for (int i = 0; i < b.n; i++) /* colour by colour, each colour in order */
             one_bar(&b, want, s.w_inv, 0.9, i);
-        cf_bars_project(&b, &s, 0.9);
+        cf_bars_project(&b, &s, 0.9, nodes, s.n_nodes);
         assert_memory_equal(s.p, want, (size_t)s.n_nodes * 3 * sizeof(double));
     }
     /* The sweep moved the nodes: the comparison is not of untouched arrays. */
     assert_memory_not_equal(s.p, s.x, (size_t)s.n_nodes * 3 * sizeof(double));
-    free(want), free(all);
+    free(want), free(all), free(nodes);
     cf_bars_free(&b);
     cf_solid_free(&s), cf_mesh_free(&m);
 }

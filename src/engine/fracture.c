@@ -331,9 +331,9 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
     for (int it = 0; it < iterations; it++) {
         if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
-            cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
+            cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale, nodes, nn);
         else if (bars)
-            cf_bars_project(&f->bars, s, k);
+            cf_bars_project(&f->bars, s, k, nodes, nn);
         if (fracture && bars)
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
         /* Obstacles node by node in parallel (each writes its own p and

@@ -385,15 +385,36 @@ double cf_pbd_effective_stiffness(double k, int iterations, int iteration_indepe
     return 1.0 - pow(1.0 - k, 1.0 / iterations);
 }
 
-/* Bar i now: its ends' predictions and inverse masses, d = p1 - p2 and |d|. */
+/* The sweeps work on s->pw: one row of 4 doubles per node, its prediction
+ * and inverse mass (x y z 1/m), so that the four bars of a lane block load
+ * their ends as two 4x4 transposes instead of 32 scalar loads. */
+static void rows_pack(cf_solid *s, const int *nodes, int nn)
+{
+#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
+    for (int i = 0; i < nn; i++) {
+        int a = nodes[i];
+        double *r = &s->pw[4 * a];
+        r[0] = s->p[3 * a], r[1] = s->p[3 * a + 1], r[2] = s->p[3 * a + 2], r[3] = s->w_inv[a];
+    }
+}
+
+static void rows_unpack(cf_solid *s, const int *nodes, int nn)
+{
+#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
+    for (int i = 0; i < nn; i++) {
+        int a = nodes[i];
+        memcpy(&s->p[3 * a], &s->pw[4 * a], 3 * sizeof(double));
+    }
+}
+
+/* Bar i now: its ends' rows (prediction, inverse mass), d = p1 - p2 and |d|. */
 typedef struct {
-    double *p1, *p2, w1, w2, d[3], len;
+    double *p1, *p2, d[3], len;
 } bar_now;
 
 static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
 {
-    int i1 = b->ends[2 * i], i2 = b->ends[2 * i + 1];
-    bar_now r = {&s->p[3 * i1], &s->p[3 * i2], s->w_inv[i1], s->w_inv[i2], {0, 0, 0}, 0};
+    bar_now r = {&s->pw[4 * b->ends[2 * i]], &s->pw[4 * b->ends[2 * i + 1]], {0, 0, 0}, 0};
     v3_sub(r.p1, r.p2, r.d);
     r.len = v3_norm(r.d);
     return r;
@@ -405,9 +426,9 @@ static inline void project_bar(const cf_bars *b, cf_solid *s, double k, int i)
     bar_now r = bar_at(b, s, i);
     if (r.len == 0)
         return;
-    double c = k * (r.len - b->rest[i]) / ((r.w1 + r.w2) * r.len);
-    v3_axpy(-r.w1 * c, r.d, r.p1);
-    v3_axpy(r.w2 * c, r.d, r.p2);
+    double w1 = r.p1[3], w2 = r.p2[3], c = k * (r.len - b->rest[i]) / ((w1 + w2) * r.len);
+    v3_axpy(-w1 * c, r.d, r.p1);
+    v3_axpy(w2 * c, r.d, r.p2);
 }
 
 /* One bar of the XPBD sweep. */
@@ -416,11 +437,11 @@ static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double s
     bar_now r = bar_at(b, s, i);
     if (r.len == 0)
         return;
-    double at = scale * b->compliance[i] / (dt * dt);
-    double dl = (-(r.len - b->rest[i]) - at * b->lambda[i]) / (r.w1 + r.w2 + at);
+    double w1 = r.p1[3], w2 = r.p2[3], at = scale * b->compliance[i] / (dt * dt);
+    double dl = (-(r.len - b->rest[i]) - at * b->lambda[i]) / (w1 + w2 + at);
     b->lambda[i] += dl;
-    v3_axpy(r.w1 * dl / r.len, r.d, r.p1);
-    v3_axpy(-r.w2 * dl / r.len, r.d, r.p2);
+    v3_axpy(w1 * dl / r.len, r.d, r.p1);
+    v3_axpy(-w2 * dl / r.len, r.d, r.p2);
 }
 
 /* Bars i..i+LANES-1, of one colour: project_bar on each lane, all lanes
@@ -430,30 +451,23 @@ static inline void project_bar_xpbd(cf_bars *b, cf_solid *s, double dt, double s
 static inline __attribute__((always_inline)) void project_lanes(const cf_bars *b, cf_solid *s,
                                                                 double k, int i)
 {
-    const int *e = &b->ends[2 * i];
-    const double *x1[LANES], *x2[LANES];
-    vd w1, w2, rest;
-    for (int l = 0; l < LANES; l++) {
-        x1[l] = &s->p[3 * e[2 * l]], x2[l] = &s->p[3 * e[2 * l + 1]];
-        w1[l] = s->w_inv[e[2 * l]], w2[l] = s->w_inv[e[2 * l + 1]], rest[l] = b->rest[i + l];
-    }
-#define LANES_OF(x, c) ((vd){x[0][c], x[1][c], x[2][c], x[3][c]})
-    vd p1x = LANES_OF(x1, 0), p1y = LANES_OF(x1, 1), p1z = LANES_OF(x1, 2);
-    vd p2x = LANES_OF(x2, 0), p2y = LANES_OF(x2, 1), p2z = LANES_OF(x2, 2);
-#undef LANES_OF
-    vd dx = p1x - p2x, dy = p1y - p2y, dz = p1z - p2z;
+    int r1[LANES], r2[LANES];
+    for (int l = 0; l < LANES; l++)
+        r1[l] = b->ends[2 * (i + l)], r2[l] = b->ends[2 * (i + l) + 1];
+    vd p1[4], p2[4], rest; /* x y z w of each end */
+    lanes_load(s->pw, 4, r1, p1);
+    lanes_load(s->pw, 4, r2, p2);
+    __builtin_memcpy(&rest, &b->rest[i], sizeof rest);
+    vd dx = p1[0] - p2[0], dy = p1[1] - p2[1], dz = p1[2] - p2[2];
     vd len = v_sqrt(dx * dx + dy * dy + dz * dz);
-    vd c = splat(k) * (len - rest) / ((w1 + w2) * len), a1 = -w1 * c, a2 = w2 * c;
+    vd c = splat(k) * (len - rest) / ((p1[3] + p2[3]) * len), a1 = -p1[3] * c, a2 = p2[3] * c;
     vm moves = (vm)(len != splat(0)); /* project_bar leaves a bar of zero length alone */
-    p1x = pick(moves, p1x + a1 * dx, p1x), p1y = pick(moves, p1y + a1 * dy, p1y);
-    p1z = pick(moves, p1z + a1 * dz, p1z);
-    p2x = pick(moves, p2x + a2 * dx, p2x), p2y = pick(moves, p2y + a2 * dy, p2y);
-    p2z = pick(moves, p2z + a2 * dz, p2z);
-    for (int l = 0; l < LANES; l++) {
-        double *y1 = &s->p[3 * e[2 * l]], *y2 = &s->p[3 * e[2 * l + 1]];
-        y1[0] = p1x[l], y1[1] = p1y[l], y1[2] = p1z[l];
-        y2[0] = p2x[l], y2[1] = p2y[l], y2[2] = p2z[l];
-    }
+    p1[0] = pick(moves, p1[0] + a1 * dx, p1[0]), p1[1] = pick(moves, p1[1] + a1 * dy, p1[1]);
+    p1[2] = pick(moves, p1[2] + a1 * dz, p1[2]);
+    p2[0] = pick(moves, p2[0] + a2 * dx, p2[0]), p2[1] = pick(moves, p2[1] + a2 * dy, p2[1]);
+    p2[2] = pick(moves, p2[2] + a2 * dz, p2[2]);
+    lanes_store(p1, 4, s->pw, r1, LANES);
+    lanes_store(p2, 4, s->pw, r2, LANES);
 }
 
 /* Bars i0..i1-1 of one colour: four at a time, the rest one by one (one
@@ -492,10 +506,13 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
     }
 #define SWEEP_EACH(b, ONE) SWEEP(b, 1, for (int i = i0; i < i1; i++) ONE, ONE)
 
-void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
+void cf_bars_project(const cf_bars *b, cf_solid *s, double k, const int *nodes, int nn)
 {
-    if (b->n > 0)
-        SWEEP(b, LANES, project_run(b, s, k, i0, i1), project_bar(b, s, k, i))
+    if (b->n == 0)
+        return;
+    rows_pack(s, nodes, nn);
+    SWEEP(b, LANES, project_run(b, s, k, i0, i1), project_bar(b, s, k, i))
+    rows_unpack(s, nodes, nn);
 }
 
 /* Bar i's two ends see each other's speed (a comparison, not fmax: the
@@ -513,10 +530,14 @@ void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
         SWEEP_EACH(b, neighbour_speed(b, speed, cap, i))
 }
 
-void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
+void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale, const int *nodes,
+                          int nn)
 {
-    if (b->n > 0)
-        SWEEP_EACH(b, project_bar_xpbd(b, s, dt, scale, i))
+    if (b->n == 0)
+        return;
+    rows_pack(s, nodes, nn);
+    SWEEP_EACH(b, project_bar_xpbd(b, s, dt, scale, i))
+    rows_unpack(s, nodes, nn);
 }
 
 void cf_bars_reset_lambda(cf_bars *b)

@@ -224,6 +224,14 @@ double cf_solid_crack_area(const cf_solid *s)
     return area;
 }
 
+/* Rows of 4 doubles for cap nodes, each row in one cache line (64-byte
+ * aligned), or NULL. */
+static double *node_rows(int cap)
+{
+    size_t bytes = ((size_t)cap * 4 * sizeof(double) + 63) & ~(size_t)63;
+    return aligned_alloc(64, bytes);
+}
+
 cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat,
                         const int *tet_body, cf_error *err)
 {
@@ -241,6 +249,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->vcap = calloc((size_t)s->cap_nodes, sizeof(double));
     s->w_inv = calloc((size_t)s->cap_nodes, sizeof(double));
     s->speed = calloc((size_t)s->cap_nodes, sizeof(double));
+    s->pw = node_rows(s->cap_nodes);
     s->origin = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet = malloc((size_t)nt * 4 * sizeof(int));
     s->tet0 = malloc((size_t)nt * 4 * sizeof(int));
@@ -261,7 +270,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
         }
     }
     if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->w_inv ||
-        !s->speed || !s->origin || !s->tet ||
+        !s->speed || !s->pw || !s->origin || !s->tet ||
         !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
@@ -307,7 +316,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 
 void cf_solid_free(cf_solid *s)
 {
-    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->w_inv, s->speed,
+    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->w_inv, s->speed, s->pw,
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->tf, s->tw, s->ep, s->wp, s->bc, s->tet_frag, s->facet, s->tet_facet,
@@ -331,6 +340,10 @@ int cf_solid_copy_node(cf_solid *s, int n)
     if (s->n_nodes == s->cap_nodes) {
         int cap = s->cap_nodes * 3 / 2 + 16;
         size_t v3 = 3 * sizeof(double);
+        double *pw = node_rows(cap); /* scratch: its contents need not move */
+        if (!pw)
+            return -1;
+        free(s->pw), s->pw = pw;
         if (grow((void **)&s->X, v3, cap) || grow((void **)&s->x, v3, cap) ||
             grow((void **)&s->v, v3, cap) || grow((void **)&s->p, v3, cap) ||
             grow((void **)&s->f, v3, cap) || grow((void **)&s->m, sizeof(double), cap) ||

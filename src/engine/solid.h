@@ -54,6 +54,10 @@ typedef struct cf_solid {
     double *w_inv;            /* [n] scratch of the projection: 1/m of the projected
                                  fragment's nodes, 1/kg (one division per node and
                                  step instead of two per bar and iteration) */
+    double *pw;               /* [n][4] scratch of the bar sweeps: prediction and 1/m
+                                 of a node in one 32-byte row (x y z w), so that
+                                 four bars load their ends as whole rows; 64-byte
+                                 aligned */
     int *origin;              /* [n] original vertex of each copy */
     int *bc;                  /* [n] boundary condition of the node (scene index), -1 none */
 
