@@ -14,14 +14,14 @@ static void pair_nodes(const cf_solid *s, const cf_cohesive *ce, int i, int *a, 
 }
 
 /* Unit normal (A -> B) and area of element ce's mid-surface at positions pos. */
-static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double *pos, int a[3],
-                         int b[3], double n[3])
+static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double *pos, int stride,
+                         int a[3], int b[3], double n[3])
 {
     double mid[3][3];
     for (int i = 0; i < 3; i++) {
         pair_nodes(s, ce, i, &a[i], &b[i]);
         for (int k = 0; k < 3; k++)
-            mid[i][k] = 0.5 * (pos[3 * a[i] + k] + pos[3 * b[i] + k]);
+            mid[i][k] = 0.5 * (pos[stride * a[i] + k] + pos[stride * b[i] + k]);
     }
     double e1[3], e2[3];
     v3_sub(mid[1], mid[0], e1), v3_sub(mid[2], mid[0], e2), v3_cross(e1, e2, n);
@@ -55,7 +55,7 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
     double nrm[3];
     for (int i = 0; i < 3; i++)
         out[i].a = -1;
-    double area = mid_normal(s, ce, s->x, a, b, nrm);
+    double area = mid_normal(s, ce, s->x, 3, a, b, nrm);
     if (area == 0)
         return 0;
     /* The law of the facet's strength (material.strength). */
@@ -167,22 +167,22 @@ void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
     for (int e = 0; e < n; e++) {
         int a[3], b[3];
         double nrm[3];
-        double area = mid_normal(s, &s->coh[elems[e]], s->p, a, b, nrm);
+        double area = mid_normal(s, &s->coh[elems[e]], s->p, 4, a, b, nrm);
         if (area == 0)
             continue;
         for (int i = 0; i < 3; i++) {
             if (a[i] == b[i])
                 continue;
             double d[3];
-            v3_sub(&s->p[3 * b[i]], &s->p[3 * a[i]], d);
+            v3_sub(&s->p[4 * b[i]], &s->p[4 * a[i]], d);
             double dn = v3_dot(d, nrm);
             /* Only faces still facing each other: once the sides have moved
              * apart by more than the facet's size the mid-surface means nothing. */
             if (dn >= 0 || v3_dot(d, d) > 0.25 * area)
                 continue;
             double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]], c = dn / (wa + wb);
-            v3_axpy(wa * c, nrm, &s->p[3 * a[i]]);
-            v3_axpy(-wb * c, nrm, &s->p[3 * b[i]]);
+            v3_axpy(wa * c, nrm, &s->p[4 * a[i]]);
+            v3_axpy(-wb * c, nrm, &s->p[4 * b[i]]);
         }
     }
 }
@@ -192,7 +192,7 @@ void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double norm
 {
     const cf_cohesive *ce = &s->coh[e];
     int a[3], b[3];
-    *area = mid_normal(s, ce, s->x, a, b, normal);
+    *area = mid_normal(s, ce, s->x, 3, a, b, normal);
     *opening = *sliding = 0;
     *failed = ce->failed[0] && ce->failed[1] && ce->failed[2];
     centroid[0] = centroid[1] = centroid[2] = 0;

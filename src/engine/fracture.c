@@ -157,8 +157,8 @@ static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
         if (bc->axes & (1 << k)) {
             if (on_p) {
                 double target = s->x[3 * a + k] + dt * bc->velocity[k];
-                work += s->m[a] * (target - s->p[3 * a + k]) / dt * bc->velocity[k];
-                s->p[3 * a + k] = target;
+                work += s->m[a] * (target - s->p[4 * a + k]) / dt * bc->velocity[k];
+                s->p[4 * a + k] = target;
             } else {
                 s->v[3 * a + k] = bc->velocity[k];
             }
@@ -246,11 +246,11 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
          * below then starts from.  (The velocities before damping wait in p,
          * free until the prediction.) */
         for (int i = 0; i < nn; i++)
-            memcpy(&s->p[3 * nodes[i]], &s->v[3 * nodes[i]], 3 * sizeof(double));
+            memcpy(&s->p[4 * nodes[i]], &s->v[3 * nodes[i]], 3 * sizeof(double));
         cf_global_damping(s, nodes, nn, sim->def.solver.k_damping);
         for (int i = 0; i < nn; i++) {
             int a = nodes[i];
-            sim->flow.damping += impulse_removes(s, f, i, &s->p[3 * a], &s->v[3 * a], 0);
+            sim->flow.damping += impulse_removes(s, f, i, &s->p[4 * a], &s->v[3 * a], 0);
             for (int k = 0; k < 3; k++)
                 f->v_old[3 * i + k] = s->v[3 * a + k] - dt * s->f[3 * a + k] / s->m[a];
         }
@@ -273,9 +273,9 @@ static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next,
     cf_solid *s = &sim->solid;
     int a = f->nodes.v[i];
     double n[3], before[3], w = 0;
-    memcpy(before, &s->p[3 * a], sizeof before);
+    memcpy(before, &s->p[4 * a], sizeof before);
     int hit =
-        cf_obstacles_project(&sim->obs, t_next - dt, &s->x[3 * a], t_next, &s->p[3 * a], n);
+        cf_obstacles_project(&sim->obs, t_next - dt, &s->x[3 * a], t_next, &s->p[4 * a], n);
     if (hit >= 0 && f->contact[i] < 0) {
         double u[3], vr[3];
         cf_obstacle_velocity(&sim->obs.o[hit], u);
@@ -286,11 +286,11 @@ static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next,
         double u[3], dp[3];
         f->contact[i] = hit;
         cf_obstacle_velocity(&sim->obs.o[hit], u);
-        v3_sub(&s->p[3 * a], before, dp);
+        v3_sub(&s->p[4 * a], before, dp);
         w = s->m[a] * v3_dot(dp, u) / dt;
     }
     if (f->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
-        double *pa = &s->p[3 * a], dJ[3];
+        double *pa = &s->p[4 * a], dJ[3];
         memcpy(before, pa, sizeof before);
         int h = cf_hull_set_project(&f->near, &s->x[3 * a], pa);
         if (h >= 0) {
@@ -317,8 +317,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         for (int k = 0; k < 3; k++)
-            s->p[3 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
-        s->w_inv[a] = 1.0 / s->m[a];
+            s->p[4 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
+        s->p[4 * a + 3] = 1.0 / s->m[a];
         f->contact[i] = -1;
         f->vn_pre[i] = 0;
     }
@@ -331,9 +331,9 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
     for (int it = 0; it < iterations; it++) {
         if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
-            cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale, nodes, nn);
+            cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
         else if (bars)
-            cf_bars_project(&f->bars, s, k, nodes, nn);
+            cf_bars_project(&f->bars, s, k);
         if (fracture && bars)
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
         /* Obstacles node by node in parallel (each writes its own p and
@@ -374,7 +374,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         int a = nodes[i];
         double *va = &s->v[3 * a], vnew[3];
         for (int c = 0; c < 3; c++)
-            vnew[c] = (s->p[3 * a + c] - s->x[3 * a + c]) / dt;
+            vnew[c] = (s->p[4 * a + c] - s->x[3 * a + c]) / dt;
         double cap = s->vcap[a];
         if (f->contact[i] >= 0) { /* a moving wall: |v' - u| <= |v - u| */
             double u[3], vr[3];
@@ -390,8 +390,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
             impulse_removes(s, f, i, va, vnew, 1) + impulse_removes(s, f, i, vnew, vout, 0);
         for (int c = 0; c < 3; c++) {
             va[c] = vout[c];
-            s->x[3 * a + c] = s->p[3 * a + c];
-            s->p[3 * a + c] = s->m[a] * (1.0 - scale) * vnew[c]; /* momentum the cap took */
+            s->x[3 * a + c] = s->p[4 * a + c];
+            s->p[4 * a + c] = s->m[a] * (1.0 - scale) * vnew[c]; /* momentum the cap took */
         }
     }
     /* The momentum the cap took goes back to the whole fragment, so that the
@@ -400,7 +400,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     double dP[3] = {0, 0, 0};
     for (int i = 0; i < nn; i++) { /* node order: the same sums for any thread count */
         removed += f->term[i];
-        v3_axpy(1.0, &s->p[3 * nodes[i]], dP);
+        v3_axpy(1.0, &s->p[4 * nodes[i]], dP);
     }
     if (v3_dot(dP, dP) > 0) {
         double mass = 0;

@@ -385,36 +385,15 @@ double cf_pbd_effective_stiffness(double k, int iterations, int iteration_indepe
     return 1.0 - pow(1.0 - k, 1.0 / iterations);
 }
 
-/* The sweeps work on s->pw: one row of 4 doubles per node, its prediction
- * and inverse mass (x y z 1/m), so that the four bars of a lane block load
- * their ends as two 4x4 transposes instead of 32 scalar loads. */
-static void rows_pack(cf_solid *s, const int *nodes, int nn)
-{
-#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
-    for (int i = 0; i < nn; i++) {
-        int a = nodes[i];
-        double *r = &s->pw[4 * a];
-        r[0] = s->p[3 * a], r[1] = s->p[3 * a + 1], r[2] = s->p[3 * a + 2], r[3] = s->w_inv[a];
-    }
-}
-
-static void rows_unpack(cf_solid *s, const int *nodes, int nn)
-{
-#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
-    for (int i = 0; i < nn; i++) {
-        int a = nodes[i];
-        memcpy(&s->p[3 * a], &s->pw[4 * a], 3 * sizeof(double));
-    }
-}
-
-/* Bar i now: its ends' rows (prediction, inverse mass), d = p1 - p2 and |d|. */
+/* Bar i now: its ends' rows of s->p (prediction, inverse mass), d = p1 - p2
+ * and |d|. */
 typedef struct {
     double *p1, *p2, d[3], len;
 } bar_now;
 
 static inline bar_now bar_at(const cf_bars *b, cf_solid *s, int i)
 {
-    bar_now r = {&s->pw[4 * b->ends[2 * i]], &s->pw[4 * b->ends[2 * i + 1]], {0, 0, 0}, 0};
+    bar_now r = {&s->p[4 * b->ends[2 * i]], &s->p[4 * b->ends[2 * i + 1]], {0, 0, 0}, 0};
     v3_sub(r.p1, r.p2, r.d);
     r.len = v3_norm(r.d);
     return r;
@@ -455,8 +434,8 @@ static inline __attribute__((always_inline)) void project_lanes(const cf_bars *b
     for (int l = 0; l < LANES; l++)
         r1[l] = b->ends[2 * (i + l)], r2[l] = b->ends[2 * (i + l) + 1];
     vd p1[4], p2[4], rest; /* x y z w of each end */
-    lanes_load(s->pw, 4, r1, p1);
-    lanes_load(s->pw, 4, r2, p2);
+    lanes_load(s->p, 4, r1, p1);
+    lanes_load(s->p, 4, r2, p2);
     __builtin_memcpy(&rest, &b->rest[i], sizeof rest);
     vd dx = p1[0] - p2[0], dy = p1[1] - p2[1], dz = p1[2] - p2[2];
     vd len = v_sqrt(dx * dx + dy * dy + dz * dz);
@@ -466,8 +445,8 @@ static inline __attribute__((always_inline)) void project_lanes(const cf_bars *b
     p1[2] = pick(moves, p1[2] + a1 * dz, p1[2]);
     p2[0] = pick(moves, p2[0] + a2 * dx, p2[0]), p2[1] = pick(moves, p2[1] + a2 * dy, p2[1]);
     p2[2] = pick(moves, p2[2] + a2 * dz, p2[2]);
-    lanes_store(p1, 4, s->pw, r1, LANES);
-    lanes_store(p2, 4, s->pw, r2, LANES);
+    lanes_store(p1, 4, s->p, r1, LANES);
+    lanes_store(p2, 4, s->p, r2, LANES);
 }
 
 /* Bars i0..i1-1 of one colour: four at a time, the rest one by one (one
@@ -506,13 +485,10 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
     }
 #define SWEEP_EACH(b, ONE) SWEEP(b, 1, for (int i = i0; i < i1; i++) ONE, ONE)
 
-void cf_bars_project(const cf_bars *b, cf_solid *s, double k, const int *nodes, int nn)
+void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
 {
-    if (b->n == 0)
-        return;
-    rows_pack(s, nodes, nn);
-    SWEEP(b, LANES, project_run(b, s, k, i0, i1), project_bar(b, s, k, i))
-    rows_unpack(s, nodes, nn);
+    if (b->n > 0)
+        SWEEP(b, LANES, project_run(b, s, k, i0, i1), project_bar(b, s, k, i))
 }
 
 /* Bar i's two ends see each other's speed (a comparison, not fmax: the
@@ -530,14 +506,10 @@ void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
         SWEEP_EACH(b, neighbour_speed(b, speed, cap, i))
 }
 
-void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale, const int *nodes,
-                          int nn)
+void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
 {
-    if (b->n == 0)
-        return;
-    rows_pack(s, nodes, nn);
-    SWEEP_EACH(b, project_bar_xpbd(b, s, dt, scale, i))
-    rows_unpack(s, nodes, nn);
+    if (b->n > 0)
+        SWEEP_EACH(b, project_bar_xpbd(b, s, dt, scale, i))
 }
 
 void cf_bars_reset_lambda(cf_bars *b)

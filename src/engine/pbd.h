@@ -63,14 +63,12 @@ int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touch
  * order and with its colour.  Returns 0, or -1 when out of memory. */
 int cf_bars_split(const cf_bars *src, const int *piece_of_node, int k, cf_bars *const *dst);
 
-/* One Gauss-Seidel sweep over the bars on s->p, colour after colour (in
- * parallel within a colour; the same bits for any thread count), with the
- * inverse masses w = 1/m from s->w_inv (set by the caller for the bars' nodes):
- * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k.
- * nodes[0..nn-1]: every end of the bars (the fragment's nodes), whose
- * predictions and inverse masses the sweep reads into its rows s->pw and
- * whose predictions it writes back. */
-void cf_bars_project(const cf_bars *b, cf_solid *s, double k, const int *nodes, int nn);
+/* One Gauss-Seidel sweep over the bars on the predictions s->p, colour
+ * after colour (in parallel within a colour; the same bits for any thread
+ * count), with the inverse masses w = 1/m from slot 3 of s->p's rows (set
+ * by the caller for the bars' nodes):
+ * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
+void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
 
 /* cap[a] = max(cap[a], speed[c]) for every bar (a, c), both ways (m/s):
  * the fastest neighbour of each node.  Colour by colour, like the sweep. */
@@ -81,13 +79,11 @@ void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
  * stiffness after all iterations does not depend on their number. */
 double cf_pbd_effective_stiffness(double k, int iterations, int iteration_independent);
 
-/* One XPBD sweep (Macklin, Müller, Chentanez 2016, eq. 18; w from s->w_inv): with
+/* One XPBD sweep (Macklin, Müller, Chentanez 2016, eq. 18; w as for cf_bars_project): with
  * alpha~ = scale compliance / dt^2, dlambda = (-C - alpha~ lambda)/(w1 + w2 +
- * alpha~), p1 += w1 dlambda n, p2 -= w2 dlambda n; nodes as for
- * cf_bars_project.  Reset lambda with
+ * alpha~), p1 += w1 dlambda n, p2 -= w2 dlambda n.  Reset lambda with
  * cf_bars_reset_lambda at the start of every step. */
-void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale, const int *nodes,
-                          int nn);
+void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale);
 void cf_bars_reset_lambda(cf_bars *b);
 
 #endif

@@ -225,11 +225,17 @@ double cf_solid_crack_area(const cf_solid *s)
 }
 
 /* Rows of 4 doubles for cap nodes, each row in one cache line (64-byte
- * aligned), or NULL. */
-static double *node_rows(int cap)
+ * aligned), holding the first n rows of old, which it frees; NULL (old
+ * kept) when out of memory. */
+static double *node_rows(double *old, int n, int cap)
 {
     size_t bytes = ((size_t)cap * 4 * sizeof(double) + 63) & ~(size_t)63;
-    return aligned_alloc(64, bytes);
+    double *r = aligned_alloc(64, bytes);
+    if (r && old)
+        memcpy(r, old, (size_t)n * 4 * sizeof(double));
+    if (r)
+        free(old);
+    return r;
 }
 
 cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat,
@@ -244,12 +250,11 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->cap_nodes = nn + nn / 4 + 16;
     s->n_tets = nt;
     size_t c3 = (size_t)s->cap_nodes * 3 * sizeof(double);
-    s->X = malloc(c3), s->x = malloc(c3), s->v = calloc(1, c3), s->p = malloc(c3), s->f = calloc(1, c3);
+    s->X = malloc(c3), s->x = malloc(c3), s->v = calloc(1, c3), s->f = calloc(1, c3);
+    s->p = node_rows(NULL, 0, s->cap_nodes);
     s->m = calloc((size_t)s->cap_nodes, sizeof(double));
     s->vcap = calloc((size_t)s->cap_nodes, sizeof(double));
-    s->w_inv = calloc((size_t)s->cap_nodes, sizeof(double));
     s->speed = calloc((size_t)s->cap_nodes, sizeof(double));
-    s->pw = node_rows(s->cap_nodes);
     s->origin = malloc((size_t)s->cap_nodes * sizeof(int));
     s->tet = malloc((size_t)nt * 4 * sizeof(int));
     s->tet0 = malloc((size_t)nt * 4 * sizeof(int));
@@ -269,15 +274,16 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
                                 nt);
         }
     }
-    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap || !s->w_inv ||
-        !s->speed || !s->pw || !s->origin || !s->tet ||
+    if (!s->X || !s->x || !s->v || !s->p || !s->f || !s->m || !s->vcap ||
+        !s->speed || !s->origin || !s->tet ||
         !s->tet0 || !s->Dm_inv || !s->vol || !s->rq || !s->tf || !s->tw || !s->bc || !s->tet_frag) {
         cf_solid_free(s);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for a solid of %d tets", nt);
     }
     memcpy(s->X, mesh->x, (size_t)nn * 3 * sizeof(double));
     memcpy(s->x, mesh->x, (size_t)nn * 3 * sizeof(double));
-    memcpy(s->p, mesh->x, (size_t)nn * 3 * sizeof(double));
+    for (int i = 0; i < nn; i++)
+        memcpy(&s->p[4 * i], &mesh->x[3 * i], 3 * sizeof(double)), s->p[4 * i + 3] = 0;
     for (int i = 0; i < nn; i++)
         s->origin[i] = i, s->bc[i] = -1;
     memcpy(s->tet, mesh->tets, (size_t)nt * 4 * sizeof(int));
@@ -316,7 +322,7 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
 
 void cf_solid_free(cf_solid *s)
 {
-    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->w_inv, s->speed, s->pw,
+    void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->speed,
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->tf, s->tw, s->ep, s->wp, s->bc, s->tet_frag, s->facet, s->tet_facet,
@@ -340,15 +346,14 @@ int cf_solid_copy_node(cf_solid *s, int n)
     if (s->n_nodes == s->cap_nodes) {
         int cap = s->cap_nodes * 3 / 2 + 16;
         size_t v3 = 3 * sizeof(double);
-        double *pw = node_rows(cap); /* scratch: its contents need not move */
-        if (!pw)
+        double *p = node_rows(s->p, s->n_nodes, cap);
+        if (!p)
             return -1;
-        free(s->pw), s->pw = pw;
+        s->p = p;
         if (grow((void **)&s->X, v3, cap) || grow((void **)&s->x, v3, cap) ||
-            grow((void **)&s->v, v3, cap) || grow((void **)&s->p, v3, cap) ||
+            grow((void **)&s->v, v3, cap) ||
             grow((void **)&s->f, v3, cap) || grow((void **)&s->m, sizeof(double), cap) ||
             grow((void **)&s->vcap, sizeof(double), cap) ||
-            grow((void **)&s->w_inv, sizeof(double), cap) ||
             grow((void **)&s->speed, sizeof(double), cap) ||
             grow((void **)&s->origin, sizeof(int), cap) || grow((void **)&s->bc, sizeof(int), cap))
             return -1;
@@ -363,7 +368,7 @@ int cf_solid_copy_node(cf_solid *s, int n)
     memcpy(&s->X[3 * k], &s->X[3 * n], 3 * sizeof(double));
     memcpy(&s->x[3 * k], &s->x[3 * n], 3 * sizeof(double));
     memcpy(&s->v[3 * k], &s->v[3 * n], 3 * sizeof(double));
-    memcpy(&s->p[3 * k], &s->p[3 * n], 3 * sizeof(double));
+    memcpy(&s->p[4 * k], &s->p[4 * n], 4 * sizeof(double));
     s->f[3 * k] = s->f[3 * k + 1] = s->f[3 * k + 2] = 0;
     s->m[k] = 0;
     s->origin[k] = s->origin[n];

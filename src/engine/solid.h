@@ -44,20 +44,17 @@ typedef struct cf_solid {
 
     int n_nodes, cap_nodes;
     double *X;                /* [n][3] rest positions, m */
-    double *x, *v, *p, *f;    /* [n][3] position m, velocity m/s, PBD prediction m, force N */
+    double *x, *v, *f;        /* [n][3] position m, velocity m/s, force N */
+    double *p;                /* [n][4] PBD prediction m (x y z) and, while the
+                                 fragment is projected, 1/m in kg^-1 (slot 3): one
+                                 32-byte row per node, 64-byte aligned, so that the
+                                 bar sweep loads four bars' ends as whole rows */
     double *m;                /* [n] lumped mass, kg */
     double *vcap;             /* [n] scratch of the projection: the fastest bar
                                  neighbour's predicted speed, m/s */
     double *speed;            /* [n] scratch of the projection: |v| of the projected
                                  fragment's nodes, m/s (one square root per node
                                  instead of two per bar) */
-    double *w_inv;            /* [n] scratch of the projection: 1/m of the projected
-                                 fragment's nodes, 1/kg (one division per node and
-                                 step instead of two per bar and iteration) */
-    double *pw;               /* [n][4] scratch of the bar sweeps: prediction and 1/m
-                                 of a node in one 32-byte row (x y z w), so that
-                                 four bars load their ends as whole rows; 64-byte
-                                 aligned */
     int *origin;              /* [n] original vertex of each copy */
     int *bc;                  /* [n] boundary condition of the node (scene index), -1 none */
 

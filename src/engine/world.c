@@ -1214,7 +1214,8 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
     const unsigned long long D = sizeof(double), I = sizeof(int);
     unsigned long long cn = (unsigned long long)s->cap_nodes, nt = (unsigned long long)s->n_tets;
     memset(m, 0, sizeof *m);
-    m->solid = cn * (18 * D + 2 * I) + nt * (27 * D + 9 * I) +
+    /* per node: X x v f, the row p, m vcap speed; origin bc */
+    m->solid = cn * (19 * D + 2 * I) + nt * (27 * D + 9 * I) +
                ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I + (s->ep ? nt * 7 * D : 0);
     if (s->facet)
         m->fracture = nt * (9 * D + 2 + 20 * I) + cn * (1 + D) +
