@@ -16,9 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define STORED_HASH 0xc36ecb17cb257b60ull
-#define STORED_HASH_COLOURED 0x47acaec4acd4f6dcull
-#define STORED_HASH_COLOURED_SOURCE 0x3c583d769990102cull
+#define STORED_HASH 0x25d1459154df9f70ull
+#define STORED_HASH_COLOURED 0x4cd2aa5de3a991c5ull
+#define STORED_HASH_COLOURED_SOURCE 0x217758c6c3fd3b13ull
 
 static char dir[256];
 

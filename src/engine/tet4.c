@@ -120,18 +120,14 @@ static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, 
             turning |= turn[l] != 0;
         if (!turning)
             return;
-        /* q <- exp(omega / 2) q where the lane turns (polar_turn); a
-         * finished lane turns by nothing, and the result is dropped */
-        vd half = pick(turn, 0.5 * angle, splat(0)), sn, dq[4];
-        for (int l = 0; l < LANES; l++)
-            dq[0][l] = cos(half[l]), sn[l] = sin(half[l]);
-        vd sh = sn / angle;
-        for (int k = 0; k < 3; k++)
-            dq[k + 1] = om[k] * sh;
-        vd nq[4] = {dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
-                    dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
-                    dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
-                    dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]};
+        /* q <- (1, omega/2) q where the lane turns (polar_turn: no sine
+         * or cosine, whose library calls made the kernel spill every
+         * vector register); a finished lane's result is dropped */
+        vd h[3] = {0.5 * om[0], 0.5 * om[1], 0.5 * om[2]};
+        vd nq[4] = {q[0] - h[0] * q[1] - h[1] * q[2] - h[2] * q[3],
+                    q[1] + h[0] * q[0] + h[1] * q[3] - h[2] * q[2],
+                    q[2] - h[0] * q[3] + h[1] * q[0] + h[2] * q[1],
+                    q[3] + h[0] * q[2] - h[1] * q[1] + h[2] * q[0]};
         lanes_quat_normalize(nq);
         for (int k = 0; k < 4; k++)
             q[k] = pick(turn, nq[k], q[k]);

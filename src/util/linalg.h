@@ -125,16 +125,17 @@ static inline double polar_axis(const double F[9], const double q[4], double R[9
     return v3_norm(om);
 }
 
-/* q <- exp(omega / 2) q, normalised: the rotation by omega (angle |omega|
- * > 0) applied to q. */
-static inline void polar_turn(double q[4], const double om[3], double angle)
+/* q <- (1, omega/2) q, normalised: a turn about omega by 2 atan(|omega|/2),
+ * which is |omega| less |omega|^3/12, where the paper turns by exactly
+ * |omega| (q <- exp(omega/2) q).  The iteration stops at the same fixed
+ * point (omega = 0, to within tol), and the update needs no sine or cosine. */
+static inline void polar_turn(double q[4], const double om[3])
 {
-    double half = 0.5 * angle, sh = sin(half) / angle;
-    double dq[4] = {cos(half), om[0] * sh, om[1] * sh, om[2] * sh};
-    double nq[4] = {dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
-                    dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
-                    dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
-                    dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]};
+    double h[3] = {0.5 * om[0], 0.5 * om[1], 0.5 * om[2]};
+    double nq[4] = {q[0] - h[0] * q[1] - h[1] * q[2] - h[2] * q[3],
+                    q[1] + h[0] * q[0] + h[1] * q[3] - h[2] * q[2],
+                    q[2] - h[0] * q[3] + h[1] * q[0] + h[2] * q[1],
+                    q[3] + h[0] * q[2] - h[1] * q[1] + h[2] * q[0]};
     memcpy(q, nq, sizeof nq);
     quat_normalize(q);
 }
@@ -151,7 +152,7 @@ static inline void polar_rotation(const double F[9], double q[4], int max_iter, 
         double om[3], angle = polar_axis(F, q, R, om);
         if (angle < tol)
             return; /* R already holds q */
-        polar_turn(q, om, angle);
+        polar_turn(q, om);
     }
     quat_to_mat(q, R);
 }
