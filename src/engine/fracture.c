@@ -218,16 +218,18 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
     cf_solid *s = &sim->solid;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n;
-#pragma omp parallel for schedule(static) if (nn >= CF_NODES_PARALLEL_MIN)
+    int n_bc = 0; /* prescribed nodes: most fragments have none */
+#pragma omp parallel for schedule(static) reduction(+ : n_bc) if (nn >= CF_NODES_PARALLEL_MIN)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         memcpy(&f->v_old[3 * i], &s->v[3 * a], 3 * sizeof(double));
         v3_axpy(dt / s->m[a], &s->f[3 * a], &s->v[3 * a]);
+        n_bc += s->bc[a] >= 0;
     }
     /* Work of the boundary: the reaction R = m (v_bc - v_free)/dt over
      * dt (v_old + v_new)/2, the leapfrog work of a force. */
     double w_bc = 0;
-    for (int i = 0; i < nn; i++) {
+    for (int i = 0; n_bc > 0 && i < nn; i++) {
         int a = nodes[i];
         if (s->bc[a] < 0)
             continue;
@@ -310,12 +312,13 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
     const int *nodes = f->nodes.v;
-    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, mesh_obstacles = 0;
+    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, mesh_obstacles = 0, n_bc = 0;
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++) /* FCL queries: one thread */
         mesh_obstacles |= sim->obs.mesh[j] != NULL;
-#pragma omp parallel for schedule(static) if (par)
+#pragma omp parallel for schedule(static) reduction(+ : n_bc) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
+        n_bc += s->bc[a] >= 0;
         for (int k = 0; k < 3; k++)
             s->p[4 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
         s->p[4 * a + 3] = 1.0 / s->m[a];
@@ -344,7 +347,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
             f->term[i] = obstacle_node(sim, f, i, t_next, dt);
         for (int i = 0; i < nn; i++)
             w_obs += f->term[i];
-        for (int i = 0; i < nn; i++)
+        for (int i = 0; n_bc > 0 && i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
                 w_bc += impose_boundary(sim, nodes[i], dt, 1);
     }
