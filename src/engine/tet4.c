@@ -37,7 +37,7 @@ static inline double crush(const cf_solid *s, double sig[9], double eps[9], doub
 
 /* The kernel below runs LANES tets side by side (lanes.h): every per-tet
  * number is a vector, so the core overlaps the lanes' long dependent chains
- * (the rotation's square roots, divisions, sine and cosine).  Each lane does
+ * (the rotation's square roots and divisions).  Each lane does
  * exactly the operations of the scalar formulas (linalg.h: m3_mul,
  * polar_rotation, ...) in the same order: the bits are those of one tet at
  * a time (test_tet4.c compares them). */
