@@ -6,12 +6,16 @@
 
 #include "check.h"
 
+#include "chunks.h"
+
 #include "fixtures.h"
 #include "linalg.h"
 #include "solid.h"
 #include "tet4.h"
 
 #include <math.h>
+#include <omp.h>
+#include <stdlib.h>
 #include <string.h>
 
 static cf_material material(double E, double nu, double rho)
@@ -314,6 +318,44 @@ static void test_cfl_of_regular_tet(void **state)
     cf_solid_free(&s);
 }
 
+/* The strain energy of many tets is summed on the threads in chunks cut by
+ * the count alone (chunks.h): the same bits for 1, 2 and 3 threads, with
+ * terms whose sum depends on the order (magnitudes 2^-30 to 2^30: the halves'
+ * sums added give other bits than the list order, checked here, so a sum
+ * that followed the threads would fail), and the list-order sum itself
+ * for a list of one chunk. */
+static void test_strain_energy_same_bits_for_any_thread_count(void **state)
+{
+    (void)state;
+    int n = 100003;
+    double *tw = malloc((size_t)n * sizeof(double));
+    int *tets = malloc((size_t)n * sizeof(int));
+    assert_non_null(tw);
+    assert_non_null(tets);
+    for (int i = 0; i < n; i++) {
+        tw[i] = ldexp(1.0 + (i % 1000) * 1e-3, (i * 37) % 60 - 30) * (i % 3 ? 1 : -1);
+        tets[i] = n - 1 - i; /* the list order is not the tet order */
+    }
+    cf_solid s;
+    memset(&s, 0, sizeof s);
+    s.tw = tw;
+    double e[3], halves[2] = {0, 0}, in_order = 0;
+    for (int k = 0; k < 3; k++) {
+        omp_set_num_threads(k + 1);
+        e[k] = cf_tet4_strain_energy(&s, tets, n);
+    }
+    assert_memory_equal(&e[0], &e[1], sizeof(double));
+    assert_memory_equal(&e[0], &e[2], sizeof(double));
+    for (int i = 0; i < n; i++)
+        halves[i >= n / 2] += tw[tets[i]];
+    assert_true(halves[0] + halves[1] != e[0]);
+    for (int i = 0; i < CF_CHUNK_MIN; i++)
+        in_order += tw[tets[i]];
+    double one_chunk = cf_tet4_strain_energy(&s, tets, CF_CHUNK_MIN);
+    assert_memory_equal(&one_chunk, &in_order, sizeof(double));
+    free(tw), free(tets);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -326,6 +368,7 @@ int main(void)
         cmocka_unit_test(test_no_crushing_no_plastic_state),
         cmocka_unit_test(test_lanes_equal_one_tet_at_a_time),
         cmocka_unit_test(test_cfl_of_regular_tet),
+        cmocka_unit_test(test_strain_energy_same_bits_for_any_thread_count),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,7 @@
 /* The in-house solver step (source Table 6.2, docs/physics.md §4), per fragment. */
 #include "world_impl.h"
 
+#include "chunks.h"
 #include "linalg.h"
 #include "tet4.h"
 
@@ -211,6 +212,27 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
     return CF_OK;
 }
 
+/* What the chunk sums of a step read (chunks.h). */
+typedef struct {
+    cf_world *sim;
+    cf_fragment *f;
+    double t_next, dt, dv[3];
+} step_sums;
+
+/* The ledger's kinetic energy, the leapfrog product 1/2 m v_old . v, and
+ * the mass moment m x (3 terms). */
+static void kinetic_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const step_sums *c = ctx;
+    const cf_solid *s = &c->sim->solid;
+    const cf_fragment *f = c->f;
+    for (int i = i0; i < i1; i++) {
+        int a = f->nodes.v[i];
+        acc[0] += 0.5 * s->m[a] * v3_dot(&f->v_old[3 * i], &s->v[3 * a]);
+        v3_axpy(s->m[a], &s->x[3 * a], &acc[1]);
+    }
+}
+
 /* v <- v + dt M^-1 f, prescribed velocities, global damping (pbd rigid
  * mode); the ledger's kinetic energy and the boundary and damping work. */
 static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int fracture)
@@ -257,14 +279,11 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
                 f->v_old[3 * i + k] = s->v[3 * a + k] - dt * s->f[3 * a + k] / s->m[a];
         }
     }
-    double ke = 0, mx[3] = {0, 0, 0};
-    for (int i = 0; i < nn; i++) {
-        int a = nodes[i];
-        ke += 0.5 * s->m[a] * v3_dot(&f->v_old[3 * i], &s->v[3 * a]);
-        v3_axpy(s->m[a], &s->x[3 * a], mx);
-    }
-    f->e_kin = ke;
-    memcpy(f->mx, mx, sizeof mx);
+    step_sums c = {sim, f, 0, dt, {0, 0, 0}};
+    double sums[4];
+    cf_sum_chunks(nn, 4, 1, kinetic_chunk, &c, sums);
+    f->e_kin = sums[0];
+    memcpy(f->mx, &sums[1], sizeof f->mx);
 }
 
 /* The obstacles and rigid neighbours' hulls on node i's prediction at
@@ -305,6 +324,36 @@ static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next,
     return w;
 }
 
+/* The obstacles on nodes i0..i1-1 (obstacle_node), and their work. */
+static void obstacle_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const step_sums *c = ctx;
+    for (int i = i0; i < i1; i++)
+        acc[0] += obstacle_node(c->sim, c->f, i, c->t_next, c->dt);
+}
+
+/* The energy terms a node loop left in f->term. */
+static void term_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const step_sums *c = ctx;
+    for (int i = i0; i < i1; i++)
+        acc[0] += c->f->term[i];
+}
+
+/* Every node's velocity shifted by dv, and the energy that takes. */
+static void shift_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const step_sums *c = ctx;
+    cf_solid *s = &c->sim->solid;
+    for (int i = i0; i < i1; i++) {
+        double *va = &s->v[3 * c->f->nodes.v[i]], to[3];
+        for (int k = 0; k < 3; k++)
+            to[k] = va[k] + c->dv[k];
+        acc[0] += impulse_removes(s, c->f, i, va, to, 0);
+        memcpy(va, to, sizeof to);
+    }
+}
+
 /* Prediction p = x + dt v, then the constraint projection: bars (PBD or
  * XPBD), crack-face contact, obstacles, prescribed nodes. */
 static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int fracture)
@@ -332,6 +381,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     if (set->constraints == CF_CONSTRAINTS_XPBD)
         cf_bars_reset_lambda(&f->bars);
     double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
+    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}};
     for (int it = 0; it < iterations; it++) {
         if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
             cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
@@ -339,14 +389,13 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
             cf_bars_project(&f->bars, s, k);
         if (fracture && bars)
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
-        /* Obstacles node by node in parallel (each writes its own p and
-         * term); the hull pushes of rigid neighbours append to one list:
-         * one thread then.  The work terms are added in node order. */
-#pragma omp parallel for schedule(static) if (par && f->near.n == 0 && !mesh_obstacles)
-        for (int i = 0; i < nn; i++)
-            f->term[i] = obstacle_node(sim, f, i, t_next, dt);
-        for (int i = 0; i < nn; i++)
-            w_obs += f->term[i];
+        /* Obstacles node by node in parallel (each writes its own p); the
+         * hull pushes of rigid neighbours append to one list: one thread
+         * then. */
+        double w;
+        cf_sum_chunks(nn, 1, par && f->near.n == 0 && !mesh_obstacles, obstacle_chunk, &sums,
+                      &w);
+        w_obs += w;
         for (int i = 0; n_bc > 0 && i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
                 w_bc += impose_boundary(sim, nodes[i], dt, 1);
@@ -371,8 +420,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         }
         cf_bars_neighbour_speed(&f->bars, s->speed, s->vcap);
     }
-    double removed = 0;
-#pragma omp parallel for schedule(static) if (par)
+    int n_capped = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n_capped) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         double *va = &s->v[3 * a], vnew[3];
@@ -387,7 +436,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         }
         double speed = v3_norm(vnew), scale = 1.0;
         if (bars && speed > cap && (f->near.n == 0 || f->push.frag[i] < 0))
-            scale = cap / speed;
+            scale = cap / speed, n_capped++;
         double vout[3] = {scale * vnew[0], scale * vnew[1], scale * vnew[2]};
         f->term[i] =
             impulse_removes(s, f, i, va, vnew, 1) + impulse_removes(s, f, i, vnew, vout, 0);
@@ -400,26 +449,19 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     /* The momentum the cap took goes back to the whole fragment, so that the
      * projection keeps linear momentum (bars act in equal and opposite pairs;
      * the cap does not). */
-    double dP[3] = {0, 0, 0};
-    for (int i = 0; i < nn; i++) { /* node order: the same sums for any thread count */
-        removed += f->term[i];
+    double removed;
+    cf_sum_chunks(nn, 1, par, term_chunk, &sums, &removed);
+    double dP[3] = {0, 0, 0}; /* zero unless the cap took some (then in node order) */
+    for (int i = 0; n_capped > 0 && i < nn; i++)
         v3_axpy(1.0, &s->p[4 * nodes[i]], dP);
-    }
     if (v3_dot(dP, dP) > 0) {
-        double mass = 0;
+        double mass = 0, shift;
         for (int i = 0; i < nn; i++)
             mass += s->m[nodes[i]];
-        double dv[3] = {dP[0] / mass, dP[1] / mass, dP[2] / mass};
-#pragma omp parallel for schedule(static) if (par)
-        for (int i = 0; i < nn; i++) {
-            double *va = &s->v[3 * nodes[i]], to[3];
-            for (int c = 0; c < 3; c++)
-                to[c] = va[c] + dv[c];
-            f->term[i] = impulse_removes(s, f, i, va, to, 0);
-            memcpy(va, to, sizeof to);
-        }
-        for (int i = 0; i < nn; i++)
-            removed += f->term[i];
+        for (int c = 0; c < 3; c++)
+            sums.dv[c] = dP[c] / mass;
+        cf_sum_chunks(nn, 1, par, shift_chunk, &sums, &shift);
+        removed += shift;
     }
     /* The kinetic change includes what moving obstacles and prescribed nodes
      * put in (a prescribed node that the bars push back and the projection

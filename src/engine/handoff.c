@@ -2,6 +2,7 @@
  * fracture mode (docs/physics.md §9). */
 #include "world_impl.h"
 
+#include "chunks.h"
 #include "linalg.h"
 #include "tet4.h"
 
@@ -160,6 +161,25 @@ void cf_body_momenta(const cf_fragment *f, const cfb_state *st, double P[3], dou
     }
 }
 
+typedef struct {
+    const cf_solid *s;
+    const int *nodes;
+} node_list;
+
+/* Linear and angular momentum about the origin, m v and x cross m v. */
+static void momenta_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const node_list *c = ctx;
+    const cf_solid *s = c->s;
+    for (int i = i0; i < i1; i++) {
+        int a = c->nodes[i];
+        double x_v[3];
+        v3_axpy(s->m[a], &s->v[3 * a], acc);
+        v3_cross(&s->x[3 * a], &s->v[3 * a], x_v);
+        v3_axpy(s->m[a], x_v, &acc[3]);
+    }
+}
+
 void cf_fragment_momenta(const cf_world *sim, int fi, double P[3], double L[3])
 {
     const cf_fragment *f = &sim->frag[fi];
@@ -170,14 +190,11 @@ void cf_fragment_momenta(const cf_world *sim, int fi, double P[3], double L[3])
         cf_body_momenta(f, &st, P, L);
         return;
     }
-    P[0] = P[1] = P[2] = L[0] = L[1] = L[2] = 0;
-    for (int i = 0; i < f->nodes.n; i++) {
-        int a = f->nodes.v[i];
-        double c[3];
-        v3_axpy(s->m[a], &s->v[3 * a], P);
-        v3_cross(&s->x[3 * a], &s->v[3 * a], c);
-        v3_axpy(s->m[a], c, L);
-    }
+    node_list c = {s, f->nodes.v};
+    double PL[6];
+    cf_sum_chunks(f->nodes.n, 6, 1, momenta_chunk, &c, PL);
+    memcpy(P, PL, 3 * sizeof(double));
+    memcpy(L, &PL[3], 3 * sizeof(double));
 }
 
 /* Log a hand-off of fragment fi: momenta before (P0, L0) and after (P1, L1). */

@@ -88,10 +88,13 @@ static void clear_marks(cf_solid *s, const cf_int_list *marked)
 }
 
 /* Marks the nodes of hot tets, listing each once in `marked`; out of
- * memory: -1, with no mark left set. */
-static int mark_hot_nodes(cf_solid *s, const int *tets, int nt, cf_int_list *marked)
+ * memory: -1, with no mark left set.  The hot tets lie between positions
+ * first and last of the list: the serial scan for them (whose order the
+ * list keeps) starts and ends there. */
+static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
+                          cf_int_list *marked)
 {
-    for (int i = 0; i < nt; i++)
+    for (int i = first; i <= last; i++)
         if (s->hot[tets[i]])
             for (int j = 0; j < 4; j++) {
                 int n = s->tet[4 * tets[i] + j];
@@ -171,19 +174,27 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
         return 0;
     /* The nodes of hot tets, marked; `out` lists them until the faces are
      * tested.  The source's rule needs their nodal values. */
-    if (mark_hot_nodes(s, tets, nt, out))
+    int first = nt, last = -1, par = nt >= CF_TET4_PARALLEL_MIN;
+#pragma omp parallel for schedule(static) reduction(min : first) reduction(max : last) if (par)
+    for (int i = 0; i < nt; i++)
+        if (s->hot[tets[i]])
+            first = i < first ? i : first, last = i;
+    if (mark_hot_nodes(s, tets, first, last, out))
         return -1;
     if (rule == CF_CRITERION_SOURCE)
         nodal_values(s, out);
     /* Each tet's faces in parallel (reads only, one byte written per tet),
-     * then the facets in list order: the same list for any thread count. */
-#pragma omp parallel for schedule(static) if (nt >= CF_TET4_PARALLEL_MIN)
+     * then the facets in list order, between the first and last tet with
+     * one: the same list for any thread count. */
+    first = nt, last = -1;
+#pragma omp parallel for schedule(static) reduction(min : first) reduction(max : last) if (par)
     for (int i = 0; i < nt; i++)
-        s->qualify[tets[i]] = qualifying_faces(s, tets[i], rule);
+        if ((s->qualify[tets[i]] = qualifying_faces(s, tets[i], rule)))
+            first = i < first ? i : first, last = i;
     clear_marks(s, out);
     out->n = 0;
     int rc = 0;
-    for (int i = 0; i < nt && rc == 0; i++)
+    for (int i = first; i <= last && rc == 0; i++)
         for (int k = 0; k < 4 && rc == 0; k++)
             if (s->qualify[tets[i]] >> k & 1)
                 rc = cf_int_list_push(out, s->tet_facet[4 * tets[i] + k]);

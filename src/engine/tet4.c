@@ -1,5 +1,6 @@
 #include "tet4.h"
 
+#include "chunks.h"
 #include "lanes.h"
 #include "linalg.h"
 
@@ -356,10 +357,22 @@ void cf_tet4_scatter(cf_solid *s, const int *tets, int nt, const int *nodes, int
     }
 }
 
+typedef struct {
+    const cf_solid *s;
+    const int *tets;
+} tet_list;
+
+static void energy_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const tet_list *c = ctx;
+    for (int i = i0; i < i1; i++)
+        acc[0] += c->s->tw[c->tets[i]];
+}
+
 double cf_tet4_strain_energy(const cf_solid *s, const int *tets, int nt)
 {
-    double e = 0;
-    for (int i = 0; i < nt; i++) /* list order: the same sum for any thread count */
-        e += s->tw[tets[i]];
+    tet_list c = {s, tets};
+    double e;
+    cf_sum_chunks(nt, 1, 1, energy_chunk, &c, &e); /* the same sum for any thread count */
     return e;
 }

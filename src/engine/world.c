@@ -781,12 +781,13 @@ double cf_world_crack_area(const cf_world *sim) { return cf_solid_crack_area(&si
 /* Divergence: a non-finite position or a node faster than 1e5 m/s. */
 static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 {
+    int insane = 0;
+#pragma omp parallel for schedule(static) reduction(+ : insane) if (f->nodes.n >= CF_NODES_PARALLEL_MIN)
     for (int i = 0; i < f->nodes.n; i++) {
         const double *x = &s->x[3 * f->nodes.v[i]], *v = &s->v[3 * f->nodes.v[i]];
-        if (!isfinite(x[0] + x[1] + x[2]) || !(v3_dot(v, v) < 1e10))
-            return 0;
+        insane += !isfinite(x[0] + x[1] + x[2]) || !(v3_dot(v, v) < 1e10);
     }
-    return 1;
+    return insane == 0;
 }
 
 /* A fragment with no uncracked interior facet (a single tet, say) cannot
@@ -929,7 +930,8 @@ static cf_status diverged(const cf_world *sim, cf_error *err, const char *what)
 static double contact_pad(const cf_world *sim, int fi, double dt)
 {
     const cf_fragment *f = &sim->frag[fi];
-    double v2 = 0;
+    double v2 = 0; /* a maximum: the same for any thread count */
+#pragma omp parallel for schedule(static) reduction(max : v2) if (f->nodes.n >= CF_NODES_PARALLEL_MIN)
     for (int i = 0; i < f->nodes.n; i++) {
         const double *v = &sim->solid.v[3 * f->nodes.v[i]];
         v2 = fmax(v2, v3_dot(v, v));
