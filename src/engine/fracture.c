@@ -94,6 +94,23 @@ static double impulse_removes(const cf_solid *s, const cf_fragment *f, int i, co
     return -m * v3_dot(dv, mid);
 }
 
+/* What the chunk sums of a step read (chunks.h). */
+typedef struct {
+    cf_world *sim;
+    cf_fragment *f;
+    double t_next, dt, dv[3];
+    int leapfrog; /* contact_velocities: explicit friction moves the node */
+} step_sums;
+
+/* Whether an obstacle is a triangle mesh: its FCL queries run on one thread. */
+static int mesh_obstacles(const cf_world *sim)
+{
+    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
+        if (sim->obs.mesh[j])
+            return 1;
+    return 0;
+}
+
 /* Friction and restitution of nodes in contact, relative to the obstacle.
  * In explicit runs (`leapfrog`) the position moves with friction's velocity
  * change, x += dt dv_t, so that x_n+1 = x_n + dt v_n+1/2 still holds: a node that
@@ -101,22 +118,24 @@ static double impulse_removes(const cf_solid *s, const cf_fragment *f, int i, co
  * slip while its velocity reads zero let the tangential force do work that
  * no term counted (a corner pivoting on the ground lost 20 % of a box's
  * energy so).  With PBD or XPBD friction acts on the velocity alone, as in
- * position based dynamics.  Returns the energy this removes, J
- * (impulse_removes). */
-static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog)
+ * position based dynamics.  Adds the energy this removes (J,
+ * impulse_removes) into acc[0], and the moving obstacles' work in it into
+ * acc[1]; each node changes only its own velocity and position. */
+static void contact_chunk(void *ctx, int i0, int i1, double *acc)
 {
-    cf_solid *s = &sim->solid;
-    double removed = 0;
-    for (int i = 0; i < f->nodes.n; i++) {
+    const step_sums *c = ctx;
+    cf_solid *s = &c->sim->solid;
+    cf_fragment *f = c->f;
+    for (int i = i0; i < i1; i++) {
         int j = f->contact[i];
         if (j < 0)
             continue;
-        double mu = s->mat.friction * sim->obs.o[j].friction;
-        double e = s->mat.restitution * sim->obs.o[j].restitution;
+        const cf_obstacle *o = &c->sim->obs.o[j];
+        double mu = s->mat.friction * o->friction, e = s->mat.restitution * o->restitution;
         int a = f->nodes.v[i];
         double n[3], u[3], vr[3], *va = &s->v[3 * a];
-        cf_obstacle_distance(&sim->obs, j, t, &s->x[3 * a], n);
-        cf_obstacle_velocity(&sim->obs.o[j], u);
+        cf_obstacle_distance(&c->sim->obs, j, c->t_next, &s->x[3 * a], n);
+        cf_obstacle_velocity(o, u);
         v3_sub(va, u, vr);
         double vn = v3_dot(vr, n), vt[3];
         for (int k = 0; k < 3; k++)
@@ -133,16 +152,24 @@ static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double
             vnew[k] = u[k] + vn_new * n[k] + scale * vt[k];
             dv[k] = vnew[k] - va[k];
         }
-        removed += impulse_removes(s, f, i, va, vnew, leapfrog);
+        acc[0] += impulse_removes(s, f, i, va, vnew, c->leapfrog);
         memcpy(va, vnew, sizeof vnew);
-        if (leapfrog) /* friction's part; the projection already placed it normally */
-            v3_axpy(-dt * (1.0 - scale), vt, &s->x[3 * a]);
+        if (c->leapfrog) /* friction's part; the projection already placed it normally */
+            v3_axpy(-c->dt * (1.0 - scale), vt, &s->x[3 * a]);
         /* A moving obstacle's work: the impulse it gives times its velocity. */
         double w = s->m[a] * v3_dot(dv, u);
-        f->pending.obstacles += w;
-        removed += w;
+        acc[0] += w;
+        acc[1] += w;
     }
-    return removed;
+}
+
+static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog)
+{
+    step_sums c = {sim, f, t, dt, {0, 0, 0}, leapfrog};
+    double sums[2]; /* removed, of which the obstacles' work */
+    cf_sum_chunks(f->nodes.n, 2, !mesh_obstacles(sim), contact_chunk, &c, sums);
+    f->pending.obstacles += sums[1];
+    return sums[0];
 }
 
 /* The prescribed velocity components of boundary node a: into v (m/s), or
@@ -212,13 +239,6 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
     return CF_OK;
 }
 
-/* What the chunk sums of a step read (chunks.h). */
-typedef struct {
-    cf_world *sim;
-    cf_fragment *f;
-    double t_next, dt, dv[3];
-} step_sums;
-
 /* The ledger's kinetic energy, the leapfrog product 1/2 m v_old . v, and
  * the mass moment m x (3 terms). */
 static void kinetic_chunk(void *ctx, int i0, int i1, double *acc)
@@ -279,7 +299,7 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
                 f->v_old[3 * i + k] = s->v[3 * a + k] - dt * s->f[3 * a + k] / s->m[a];
         }
     }
-    step_sums c = {sim, f, 0, dt, {0, 0, 0}};
+    step_sums c = {sim, f, 0, dt, {0, 0, 0}, 0};
     double sums[4];
     cf_sum_chunks(nn, 4, 1, kinetic_chunk, &c, sums);
     f->e_kin = sums[0];
@@ -361,9 +381,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
     const int *nodes = f->nodes.v;
-    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, mesh_obstacles = 0, n_bc = 0;
-    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++) /* FCL queries: one thread */
-        mesh_obstacles |= sim->obs.mesh[j] != NULL;
+    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, n_bc = 0;
 #pragma omp parallel for schedule(static) reduction(+ : n_bc) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
@@ -381,7 +399,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     if (set->constraints == CF_CONSTRAINTS_XPBD)
         cf_bars_reset_lambda(&f->bars);
     double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
-    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}};
+    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}, 0};
     for (int it = 0; it < iterations; it++) {
         if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
             cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
@@ -393,8 +411,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
          * hull pushes of rigid neighbours append to one list: one thread
          * then. */
         double w;
-        cf_sum_chunks(nn, 1, par && f->near.n == 0 && !mesh_obstacles, obstacle_chunk, &sums,
-                      &w);
+        cf_sum_chunks(nn, 1, par && f->near.n == 0 && !mesh_obstacles(sim), obstacle_chunk,
+                      &sums, &w);
         w_obs += w;
         for (int i = 0; n_bc > 0 && i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
