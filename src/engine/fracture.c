@@ -382,6 +382,9 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     const cf_solver_settings *set = &sim->def.solver;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, n_bc = 0;
+    /* The obstacle pass on the threads unless hull pushes of rigid
+     * neighbours (one list) or FCL queries need one thread. */
+    int obstacles_par = par && f->near.n == 0 && !mesh_obstacles(sim);
 #pragma omp parallel for schedule(static) reduction(+ : n_bc) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
@@ -407,12 +410,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
             cf_bars_project(&f->bars, s, k);
         if (fracture && bars)
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
-        /* Obstacles node by node in parallel (each writes its own p); the
-         * hull pushes of rigid neighbours append to one list: one thread
-         * then. */
-        double w;
-        cf_sum_chunks(nn, 1, par && f->near.n == 0 && !mesh_obstacles(sim), obstacle_chunk,
-                      &sums, &w);
+        double w; /* obstacles node by node, each writing its own p */
+        cf_sum_chunks(nn, 1, obstacles_par, obstacle_chunk, &sums, &w);
         w_obs += w;
         for (int i = 0; n_bc > 0 && i < nn; i++)
             if (s->bc[nodes[i]] >= 0)
