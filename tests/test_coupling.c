@@ -16,9 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define STORED_HASH 0x25d1459154df9f70ull
-#define STORED_HASH_COLOURED 0x4cd2aa5de3a991c5ull
-#define STORED_HASH_COLOURED_SOURCE 0x217758c6c3fd3b13ull
+#define STORED_HASH 0xc7ca79b4f4fd95cbull
+#define STORED_HASH_COLOURED 0x60c14a253da2578dull
+#define STORED_HASH_COLOURED_SOURCE 0x66ca6bb524dcb901ull
 
 static char dir[256];
 

@@ -91,18 +91,31 @@ static inline void lanes_quat_to_mat(vd q[4], lane9 R)
     R[6] = 2 * (x * z - w * y), R[7] = 2 * (y * z + w * x), R[8] = 1 - 2 * (x * x + y * y);
 }
 
+/* |q|^2 R of q of any length (quat_to_mat_scaled). */
+static inline void lanes_quat_to_mat_scaled(vd q[4], lane9 R)
+{
+    vd w = q[0], x = q[1], y = q[2], z = q[3], ww = w * w, xx = x * x, yy = y * y, zz = z * z;
+    R[0] = ww + xx - yy - zz, R[1] = 2 * (x * y - w * z), R[2] = 2 * (x * z + w * y);
+    R[3] = 2 * (x * y + w * z), R[4] = ww - xx + yy - zz, R[5] = 2 * (y * z - w * x);
+    R[6] = 2 * (x * z - w * y), R[7] = 2 * (y * z + w * x), R[8] = ww - xx - yy + zz;
+}
+
 /* The rotation part R of F by the quaternion iteration (polar_rotation in
  * linalg.h: Müller, Bender, Chentanez, Macklin 2016), q the warm start,
  * updated.  All lanes evaluate the update until none still turns: a lane
  * whose update fell below tol keeps q, so evaluating it again gives the
- * same R and the same stop, and R is always that of the final q. */
+ * same update and the same stop.  The turns leave q's length as it comes
+ * (the update does not depend on it): one square root and normalisation at
+ * the end, none per turn. */
 static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, vd q[4],
                                                                        int max_iter, double tol,
                                                                        lane9 R)
 {
-    lanes_quat_normalize(q);
+    vm zero = (vm)(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] == splat(0.0));
+    for (int k = 0; k < 4; k++)
+        q[k] = pick(zero, splat(k == 0), q[k]);
     for (int it = 0; it < max_iter; it++) {
-        lanes_quat_to_mat(q, R);
+        lanes_quat_to_mat_scaled(q, R);
         vd om[3] = {splat(0), splat(0), splat(0)}, dot = splat(0);
         for (int c = 0; c < 3; c++) {
             vd r0 = R[c], r1 = R[3 + c], r2 = R[6 + c], f0 = F[c], f1 = F[3 + c], f2 = F[6 + c];
@@ -114,25 +127,24 @@ static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, 
         vd s = 1.0 / (v_fabs(dot) + 1e-9);
         for (int k = 0; k < 3; k++)
             om[k] *= s;
-        vd angle = v_sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
-        vm turn = ~(vm)(angle < splat(tol)); /* NaN turns, as in the scalar loop */
+        vd angle2 = om[0] * om[0] + om[1] * om[1] + om[2] * om[2];
+        vm turn = ~(vm)(angle2 < splat(tol * tol)); /* NaN turns, as in the scalar loop */
         int turning = 0;
         for (int l = 0; l < LANES; l++)
             turning |= turn[l] != 0;
         if (!turning)
-            return;
-        /* q <- (1, omega/2) q where the lane turns (polar_turn: no sine
-         * or cosine, whose library calls made the kernel spill every
-         * vector register); a finished lane's result is dropped */
+            break;
+        /* q <- (1, omega/2) q where the lane turns (polar_turn); a finished
+         * lane's result is dropped */
         vd h[3] = {0.5 * om[0], 0.5 * om[1], 0.5 * om[2]};
         vd nq[4] = {q[0] - h[0] * q[1] - h[1] * q[2] - h[2] * q[3],
                     q[1] + h[0] * q[0] + h[1] * q[3] - h[2] * q[2],
                     q[2] - h[0] * q[3] + h[1] * q[0] + h[2] * q[1],
                     q[3] + h[0] * q[2] - h[1] * q[1] + h[2] * q[0]};
-        lanes_quat_normalize(nq);
         for (int k = 0; k < 4; k++)
             q[k] = pick(turn, nq[k], q[k]);
     }
+    lanes_quat_normalize(q);
     lanes_quat_to_mat(q, R);
 }
 

@@ -106,13 +106,26 @@ static inline void quat_normalize(double q[4])
         q[i] /= n;
 }
 
-/* One step of the polar iteration below: R from the current q, and the
- * update omega = sum r_i x f_i / (|sum r_i . f_i| + eps) over the columns
- * of R and F; returns its angle |omega| (rad). */
-static inline double polar_axis(const double F[9], const double q[4], double R[9], double om[3])
+/* |q|^2 times the rotation of q/|q|, for a quaternion q of any length (the
+ * homogeneous form of quat_to_mat: no normalisation needed). */
+static inline void quat_to_mat_scaled(const double q[4], double R[9])
 {
-    quat_to_mat(q, R);
-    double dotsum = 0;
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    double ww = w * w, xx = x * x, yy = y * y, zz = z * z;
+    R[0] = ww + xx - yy - zz, R[1] = 2 * (x * y - w * z), R[2] = 2 * (x * z + w * y);
+    R[3] = 2 * (x * y + w * z), R[4] = ww - xx + yy - zz, R[5] = 2 * (y * z - w * x);
+    R[6] = 2 * (x * z - w * y), R[7] = 2 * (y * z + w * x), R[8] = ww - xx - yy + zz;
+}
+
+/* One step of the polar iteration below: the update
+ * omega = sum r_i x f_i / (|sum r_i . f_i| + eps) over the columns of F
+ * and of R = quat_to_mat_scaled(q) (omega does not depend on the length of
+ * q, which stays near 1: eps is for an F with no rotation part);
+ * returns |omega|^2 (rad^2). */
+static inline double polar_axis(const double F[9], const double q[4], double om[3])
+{
+    double R[9], dotsum = 0;
+    quat_to_mat_scaled(q, R);
     om[0] = om[1] = om[2] = 0;
     for (int c = 0; c < 3; c++) {
         double r[3] = {R[c], R[3 + c], R[6 + c]}, f[3] = {F[c], F[3 + c], F[6 + c]}, rf[3];
@@ -122,13 +135,15 @@ static inline double polar_axis(const double F[9], const double q[4], double R[9
     }
     double s = 1.0 / (fabs(dotsum) + 1e-9);
     om[0] *= s, om[1] *= s, om[2] *= s;
-    return v3_norm(om);
+    return v3_dot(om, om);
 }
 
-/* q <- (1, omega/2) q, normalised: a turn about omega by 2 atan(|omega|/2),
- * which is |omega| less |omega|^3/12, where the paper turns by exactly
- * |omega| (q <- exp(omega/2) q).  The iteration stops at the same fixed
- * point (omega = 0, to within tol), and the update needs no sine or cosine. */
+/* q <- (1, omega/2) q: a turn about omega by 2 atan(|omega|/2), which is
+ * |omega| less |omega|^3/12, where the paper turns by exactly |omega|
+ * (q <- exp(omega/2) q).  The iteration stops at the same fixed point
+ * (omega = 0, to within tol), and the update needs no sine or cosine.  The
+ * length of q grows by sqrt(1 + |omega|^2/4) and is left so: the iteration
+ * does not depend on it, and it is normalised once at the end. */
 static inline void polar_turn(double q[4], const double om[3])
 {
     double h[3] = {0.5 * om[0], 0.5 * om[1], 0.5 * om[2]};
@@ -137,23 +152,26 @@ static inline void polar_turn(double q[4], const double om[3])
                     q[2] - h[0] * q[3] + h[1] * q[0] + h[2] * q[1],
                     q[3] + h[0] * q[2] - h[1] * q[1] + h[2] * q[0]};
     memcpy(q, nq, sizeof nq);
-    quat_normalize(q);
 }
 
 /* Rotation part R of F = R S (polar decomposition), by the quaternion
  * iteration of Müller, Bender, Chentanez, Macklin 2016 ("A robust method to
- * extract the rotational part of deformations"); q is the warm start and is
- * updated (w,x,y,z).  Stops when the update angle falls below tol (rad).
- * Robust for inverted F (returns a proper rotation). */
+ * extract the rotational part of deformations"); q is the warm start (a
+ * unit quaternion to rounding, such as the last answer; zero: the
+ * identity) and is updated to a unit quaternion (w,x,y,z).  Stops when the
+ * update angle falls below tol (rad).  Robust for inverted F (returns a
+ * proper rotation). */
 static inline void polar_rotation(const double F[9], double q[4], int max_iter, double tol, double R[9])
 {
-    quat_normalize(q);
+    if (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] == 0)
+        q[0] = 1, q[1] = q[2] = q[3] = 0;
     for (int it = 0; it < max_iter; it++) {
-        double om[3], angle = polar_axis(F, q, R, om);
-        if (angle < tol)
-            return; /* R already holds q */
+        double om[3];
+        if (polar_axis(F, q, om) < tol * tol)
+            break;
         polar_turn(q, om);
     }
+    quat_normalize(q);
     quat_to_mat(q, R);
 }
 
