@@ -7,7 +7,7 @@
 #ifndef COHFRAC_CHUNKS_H
 #define COHFRAC_CHUNKS_H
 
-#define CF_CHUNK_MIN 4096 /* items per chunk at least: fewer items are one chunk,
+#define CF_CHUNK_MIN 1024 /* items per chunk at least: fewer items are one chunk,
                              the plain sum in item order */
 #define CF_CHUNKS_MAX 64  /* chunks at most */
 #define CF_SUMS_MAX 6     /* sums per call at most */

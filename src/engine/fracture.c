@@ -253,6 +253,24 @@ static void kinetic_chunk(void *ctx, int i0, int i1, double *acc)
     }
 }
 
+/* The kick v <- v + dt M^-1 f on nodes i0..i1-1 (v_old keeps v), then
+ * kinetic_chunk's sums of the new velocities, and the count of prescribed
+ * nodes in acc[4]: one pass over the nodes where no prescribed node or
+ * damping changes v after the kick. */
+static void kick_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const step_sums *c = ctx;
+    cf_solid *s = &c->sim->solid;
+    const cf_fragment *f = c->f;
+    for (int i = i0; i < i1; i++) {
+        int a = f->nodes.v[i];
+        memcpy(&f->v_old[3 * i], &s->v[3 * a], 3 * sizeof(double));
+        v3_axpy(c->dt / s->m[a], &s->f[3 * a], &s->v[3 * a]);
+        acc[4] += s->bc[a] >= 0;
+    }
+    kinetic_chunk(ctx, i0, i1, acc);
+}
+
 /* v <- v + dt M^-1 f, prescribed velocities, global damping (pbd rigid
  * mode); the ledger's kinetic energy and the boundary and damping work. */
 static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int fracture)
@@ -260,14 +278,10 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
     cf_solid *s = &sim->solid;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n;
-    int n_bc = 0; /* prescribed nodes: most fragments have none */
-#pragma omp parallel for schedule(static) reduction(+ : n_bc) if (nn >= CF_NODES_PARALLEL_MIN)
-    for (int i = 0; i < nn; i++) {
-        int a = nodes[i];
-        memcpy(&f->v_old[3 * i], &s->v[3 * a], 3 * sizeof(double));
-        v3_axpy(dt / s->m[a], &s->f[3 * a], &s->v[3 * a]);
-        n_bc += s->bc[a] >= 0;
-    }
+    step_sums c = {sim, f, 0, dt, {0, 0, 0}, 0};
+    double sums[5];
+    cf_sum_chunks(nn, 5, 1, kick_chunk, &c, sums);
+    int n_bc = (int)sums[4]; /* prescribed nodes: most fragments have none */
     /* Work of the boundary: the reaction R = m (v_bc - v_free)/dt over
      * dt (v_old + v_new)/2, the leapfrog work of a force. */
     double w_bc = 0;
@@ -299,9 +313,8 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
                 f->v_old[3 * i + k] = s->v[3 * a + k] - dt * s->f[3 * a + k] / s->m[a];
         }
     }
-    step_sums c = {sim, f, 0, dt, {0, 0, 0}, 0};
-    double sums[4];
-    cf_sum_chunks(nn, 4, 1, kinetic_chunk, &c, sums);
+    if (n_bc > 0 || !fracture) /* v changed after the kick: the sums anew */
+        cf_sum_chunks(nn, 4, 1, kinetic_chunk, &c, sums);
     f->e_kin = sums[0];
     memcpy(f->mx, &sums[1], sizeof f->mx);
 }

@@ -53,6 +53,18 @@ cf_status cf_obstacles_create(cf_obstacles *obs, const cf_world_def *def, cfb_wo
                               int *body, cf_error *err);
 void cf_obstacles_free(cf_obstacles *obs);
 
+/* Signed distance of point p from the static plane o (m, negative behind
+ * it) and its outward normal: obstacle_plane.c's distance, here inline
+ * because the projection asks it for every node at every iteration. */
+static inline double cf_plane_distance(const cf_obstacle *o, const double p[3],
+                                       double normal[3])
+{
+    for (int k = 0; k < 3; k++)
+        normal[k] = o->normal[k];
+    return (p[0] - o->point[0]) * o->normal[0] + (p[1] - o->point[1]) * o->normal[1] +
+           (p[2] - o->point[2]) * o->normal[2];
+}
+
 /* Keep a node's prediction p (at time t) out of every obstacle, moving it
  * along the obstacle's normal: to the surface, or, when the node was already
  * inside at x (at time t0, the step's start), no deeper than it was then.

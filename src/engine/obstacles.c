@@ -91,7 +91,8 @@ int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], 
     int hit = -1;
     for (int j = 0; j < obs->n; j++) {
         double nrm[3], nx[3];
-        double dist = cf_obstacle_distance(obs, j, t, p, nrm);
+        double dist = obs->o[j].type == CF_OBSTACLE_PLANE ? cf_plane_distance(&obs->o[j], p, nrm)
+                                                          : cf_obstacle_distance(obs, j, t, p, nrm);
         if (dist < 0) {
             double allowed = fmin(0.0, cf_obstacle_distance(obs, j, t0, x, nx));
             if (dist < allowed)
