@@ -449,13 +449,22 @@ static inline __attribute__((always_inline)) void project_lanes(const cf_bars *b
     lanes_store(p2, 4, s->p, r2, LANES);
 }
 
+/* A colour's bars reach their ends' rows all over the prediction (1.6 MB
+ * on the 203k-tet bunny: more than a core's L2), in an order the hardware
+ * cannot guess: each block asks for the rows of the bars this many ahead
+ * (the PBD stage x1.07 on one thread; 32 ahead was no better). */
+enum { PREFETCH = 16 };
+
 /* Bars i0..i1-1 of one colour: four at a time, the rest one by one (one
  * call per thread and colour, so the clone is chosen once per run). */
 CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, int i0, int i1)
 {
     int i = i0;
-    for (; i + LANES <= i1; i += LANES)
+    for (; i + LANES <= i1; i += LANES) {
+        for (int j = 2 * (i + PREFETCH); j < 2 * (i + PREFETCH + LANES) && j < 2 * i1; j++)
+            __builtin_prefetch(&s->p[4 * b->ends[j]], 1);
         project_lanes(b, s, k, i);
+    }
     for (; i < i1; i++)
         project_bar(b, s, k, i);
 }
