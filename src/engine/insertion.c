@@ -166,6 +166,64 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule)
     return c;
 }
 
+/* Whether the node at corner j of tet t owns t: no corner before j holds a
+ * marked node.  Every tet with a marked node has exactly one owner. */
+static int owns(const cf_solid *s, int t, int j)
+{
+    for (int k = 0; k < j; k++)
+        if (s->node_mark[s->tet[4 * t + k]])
+            return 0;
+    return 1;
+}
+
+/* s->qualify (qualifying_faces) of the tets the marked nodes own, each
+ * visited from its owner's star: the only tets that may qualify, since a
+ * qualifying face needs three marked nodes, so the rest of the fragment's
+ * tets are never read.  In parallel over the nodes (a tet has one owner,
+ * so one thread writes its byte).  Returns how many tets qualify. */
+static int qualify_near_marks(cf_solid *s, const cf_int_list *marked, cf_criterion rule)
+{
+    int count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count) if (marked->n >= CF_NODES_PARALLEL_MIN)
+    for (int i = 0; i < marked->n; i++) {
+        int n = marked->v[i], o = s->origin[n];
+        for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
+            int slot = s->vt_slot[j], t = slot / 4;
+            if (s->tet[slot] == n && owns(s, t, slot % 4))
+                count += (s->qualify[t] = qualifying_faces(s, t, rule)) != 0;
+        }
+    }
+    return count;
+}
+
+/* Pushes onto `list` the tets that node n owns and that qualify; 0, or -1
+ * out of memory. */
+static int push_qualified(const cf_solid *s, int n, cf_int_list *list)
+{
+    int o = s->origin[n];
+    for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
+        int slot = s->vt_slot[j], t = slot / 4;
+        if (s->tet[slot] == n && s->qualify[t] && owns(s, t, slot % 4) &&
+            cf_int_list_push(list, t))
+            return -1;
+    }
+    return 0;
+}
+
+/* Clears s->qualify of every tet holding node n. */
+static void star_unqualify(cf_solid *s, int n)
+{
+    int o = s->origin[n];
+    for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++)
+        s->qualify[s->vt_slot[j] / 4] = 0;
+}
+
+static int by_int(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return (a > b) - (a < b);
+}
+
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
                             cf_int_list *out)
 {
@@ -183,22 +241,45 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
         return -1;
     if (rule == CF_CRITERION_SOURCE)
         nodal_values(s, out);
-    /* Each tet's faces in parallel (reads only, one byte written per tet),
-     * then the facets in list order, between the first and last tet with
-     * one: the same list for any thread count. */
-    first = nt, last = -1;
-#pragma omp parallel for schedule(static) reduction(min : first) reduction(max : last) if (par)
-    for (int i = 0; i < nt; i++)
-        if ((s->qualify[tets[i]] = qualifying_faces(s, tets[i], rule)))
-            first = i < first ? i : first, last = i;
-    clear_marks(s, out);
-    out->n = 0;
-    int rc = 0;
-    for (int i = first; i <= last && rc == 0; i++)
-        for (int k = 0; k < 4 && rc == 0; k++)
-            if (s->qualify[tets[i]] >> k & 1)
-                rc = cf_int_list_push(out, s->tet_facet[4 * tets[i] + k]);
-    return rc ? -1 : out->n;
+    /* The faces of the tets that may have a qualifying one, then those
+     * tets listed after the nodes. */
+    int m = out->n, rc = 0;
+    if (qualify_near_marks(s, out, rule) > 0)
+        for (int i = 0; rc == 0 && i < m; i++)
+            rc = push_qualified(s, out->v[i], out);
+    int nq = out->n - m; /* the tets, after the nodes */
+    for (int i = 0; i < m; i++) {
+        if (rc) /* out of memory: no qualify byte or mark left set */
+            star_unqualify(s, out->v[i]);
+        s->node_mark[out->v[i]] = 0;
+    }
+    if (rc)
+        return -1;
+    /* The tets in ascending order, as `tets` lists them; then each one's
+     * facets, written from the last back to the first (a tet has at least
+     * one, so no tet is overwritten before it is read). */
+    int nf = 0, *q = out->v;
+    memmove(q, q + m, (size_t)nq * sizeof(int));
+    out->n = nq;
+    qsort(q, (size_t)nq, sizeof(int), by_int);
+    for (int i = 0; i < nq; i++)
+        nf += __builtin_popcount(s->qualify[q[i]]);
+    while (out->n < nf)
+        if (cf_int_list_push(out, -1)) {
+            for (int i = 0; i < nq; i++)
+                s->qualify[out->v[i]] = 0;
+            return -1;
+        }
+    q = out->v;
+    for (int i = nq - 1, at = nf; i >= 0; i--) {
+        int t = q[i];
+        for (int k = 3; k >= 0; k--)
+            if (s->qualify[t] >> k & 1)
+                q[--at] = s->tet_facet[4 * t + k];
+        s->qualify[t] = 0;
+    }
+    out->n = nf;
+    return nf;
 }
 
 /* Slot of original vertex o in tet t, or -1. */

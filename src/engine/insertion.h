@@ -22,7 +22,9 @@ int cf_int_list_push(cf_int_list *l, int value); /* 0, or -1 out of memory */
  * never looked at. */
 cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
 
-/* Insertion criterion on the interior, uncracked facets of `tets` (in list
+/* Insertion criterion on the interior, uncracked facets of `tets` (a
+ * fragment's whole list, ascending: the facets are found from the stars of
+ * the hot tets' nodes, which hold no tet of another fragment; listed in tet
  * order, each facet seen from its lower tet), from the stresses s->sigma
  * and hot flags s->hot of the last check (n_hot of them set; 0 returns at
  * once):

@@ -68,8 +68,8 @@ typedef struct cf_solid {
     double *sigma;            /* [nt][9] Cauchy stress at the last check, Pa (fracture state) */
     unsigned char *hot;       /* [nt] may qualify for insertion at the last check
                                  (cf_stress_check; fracture state) */
-    unsigned char *qualify;   /* [nt] scratch of the criterion: bit k, face k qualifies
-                                 (fracture state) */
+    unsigned char *qualify;   /* [nt] scratch of the criterion: bit k, face k qualifies;
+                                 all zero between checks (fracture state) */
     double *tf;               /* [nt][12] internal force on each slot, N */
     double *tw;               /* [nt] strain energy at the last force pass, J */
     double *ep;               /* [nt][6] plastic strain in the element frame (xx yy zz
