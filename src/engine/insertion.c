@@ -109,10 +109,16 @@ static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
     return 0;
 }
 
+/* Loops that walk each marked node's star (some 16-24 tets, each read
+ * whole) go on the threads from this many nodes: a walk costs what some
+ * hundred plain node updates do, so they repay the fork and join sooner
+ * than CF_NODES_PARALLEL_MIN's loops. */
+enum { STAR_PARALLEL_MIN = 256 };
+
 /* The source's nodal values at the marked nodes; each node writes its own. */
 static void nodal_values(cf_solid *s, const cf_int_list *marked)
 {
-#pragma omp parallel for schedule(static) if (marked->n >= CF_NODES_PARALLEL_MIN)
+#pragma omp parallel for schedule(static) if (marked->n >= STAR_PARALLEL_MIN)
     for (int i = 0; i < marked->n; i++)
         s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i]);
 }
@@ -184,7 +190,7 @@ static int owns(const cf_solid *s, int t, int j)
 static int qualify_near_marks(cf_solid *s, const cf_int_list *marked, cf_criterion rule)
 {
     int count = 0;
-#pragma omp parallel for schedule(static) reduction(+ : count) if (marked->n >= CF_NODES_PARALLEL_MIN)
+#pragma omp parallel for schedule(static) reduction(+ : count) if (marked->n >= STAR_PARALLEL_MIN)
     for (int i = 0; i < marked->n; i++) {
         int n = marked->v[i], o = s->origin[n];
         for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
