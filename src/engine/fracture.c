@@ -249,8 +249,8 @@ static void kinetic_chunk(void *ctx, int i0, int i1, double *acc)
     for (int i = i0; i < i1; i++) {
         int a = f->nodes.v[i];
         acc[0] += 0.5 * s->m[a] * v3_dot(&f->v_old[3 * i], &s->v[3 * a]);
-        v3_axpy(s->m[a], &s->x[3 * a], &acc[1]);
     }
+    cf_nodes_mass_moment_add(s, f->nodes.v, i0, i1, &acc[1]);
 }
 
 /* The kick v <- v + dt M^-1 f on nodes i0..i1-1 (v_old keeps v), then
@@ -272,8 +272,9 @@ static void kick_chunk(void *ctx, int i0, int i1, double *acc)
 }
 
 /* v <- v + dt M^-1 f, prescribed velocities, global damping (pbd rigid
- * mode); the ledger's kinetic energy and the boundary and damping work. */
-static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int fracture)
+ * mode); the ledger's kinetic energy and the boundary and damping work.
+ * Returns the number of prescribed nodes. */
+static int update_velocities(cf_world *sim, cf_fragment *f, double dt, int fracture)
 {
     cf_solid *s = &sim->solid;
     const int *nodes = f->nodes.v;
@@ -317,6 +318,7 @@ static void update_velocities(cf_world *sim, cf_fragment *f, double dt, int frac
         cf_sum_chunks(nn, 4, 1, kinetic_chunk, &c, sums);
     f->e_kin = sums[0];
     memcpy(f->mx, &sums[1], sizeof f->mx);
+    return n_bc;
 }
 
 /* The obstacles and rigid neighbours' hulls on node i's prediction at
@@ -388,20 +390,20 @@ static void shift_chunk(void *ctx, int i0, int i1, double *acc)
 }
 
 /* Prediction p = x + dt v, then the constraint projection: bars (PBD or
- * XPBD), crack-face contact, obstacles, prescribed nodes. */
-static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int fracture)
+ * XPBD), crack-face contact, obstacles, the n_bc prescribed nodes. */
+static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int fracture,
+                    int n_bc)
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
     const int *nodes = f->nodes.v;
-    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN, n_bc = 0;
+    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
     /* The obstacle pass on the threads unless hull pushes of rigid
      * neighbours (one list) or FCL queries need one thread. */
     int obstacles_par = par && f->near.n == 0 && !mesh_obstacles(sim);
-#pragma omp parallel for schedule(static) reduction(+ : n_bc) if (par)
+#pragma omp parallel for schedule(static) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
-        n_bc += s->bc[a] >= 0;
         for (int k = 0; k < 3; k++)
             s->p[4 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
         s->p[4 * a + 3] = 1.0 / s->m[a];
@@ -521,10 +523,10 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
     if (st != CF_OK)
         return st;
     double t0 = cf_wall_time();
-    update_velocities(sim, f, dt, fracture);
+    int n_bc = update_velocities(sim, f, dt, fracture);
     double t1 = cf_wall_time();
     sim->prof.forces += t1 - t0;
-    project(sim, f, t + dt, dt, fracture);
+    project(sim, f, t + dt, dt, fracture, n_bc);
     f->pending.contact +=
         contact_velocities(sim, f, t + dt, dt, explicit_step(&sim->def.solver, fracture));
     sim->prof.pbd += cf_wall_time() - t1;

@@ -108,6 +108,12 @@ void cf_tet_mass_props(const cf_solid *s, const int *tets, int nt, const double 
         mp->inertia[k] = ((k % 4) == 0 ? tr : 0) - C[k];
 }
 
+void cf_nodes_mass_moment_add(const cf_solid *s, const int *nodes, int i0, int i1, double mx[3])
+{
+    for (int i = i0; i < i1; i++)
+        v3_axpy(s->m[nodes[i]], &s->x[3 * nodes[i]], mx);
+}
+
 void cf_nodes_momenta(const cf_solid *s, const int *nodes, int nn, cf_node_state *st)
 {
     memset(st, 0, sizeof *st);

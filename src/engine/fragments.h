@@ -45,6 +45,12 @@ void cf_nodes_state(const cf_solid *s, const int *nodes, int nn, double q[4], cf
 /* The same without the rotation (R left as zero): cheap momenta only. */
 void cf_nodes_momenta(const cf_solid *s, const int *nodes, int nn, cf_node_state *st);
 
+/* Adds m x of nodes[i0..i1-1], in that order, into mx[3] (kg m): the one
+ * formula of a fragment's mass moment, whose change is the ledger's
+ * gravity work, so that the step and the ledger's reset give the same bits
+ * for the same positions. */
+void cf_nodes_mass_moment_add(const cf_solid *s, const int *nodes, int i0, int i1, double mx[3]);
+
 /* Global damping (docs/physics.md §8, source Table 6.1, Müller et al. 2007):
  * v_i += k (v_cm + w x r_i - v_i), w = I^-1 L.  k = 1 keeps only the rigid
  * motion; linear and angular momentum are preserved. */

@@ -133,16 +133,15 @@ typedef struct {
     const int *nodes;
 } node_list;
 
-/* The mass moment, sum m x, term by term as the step's kinetic sums add it
- * (fracture.c), in the same chunks: the ledger's gravity work, the change
- * of this sum, then starts from the bits the step gives, not from M times
- * the centre of mass, which differs from them in the last bits (6e-12 J of
- * work that nothing did, at the first step of a resting plate). */
+/* The mass moment, sum m x, in the chunks the step's kinetic sums use
+ * (fracture.c): the ledger's gravity work, the change of this sum, then
+ * starts from the bits the step gives, not from M times the centre of
+ * mass, which differs from them in the last bits (6e-12 J of work that
+ * nothing did, at the first step of a resting plate). */
 static void mass_moment_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const node_list *c = ctx;
-    for (int i = i0; i < i1; i++)
-        v3_axpy(c->s->m[c->nodes[i]], &c->s->x[3 * c->nodes[i]], acc);
+    cf_nodes_mass_moment_add(c->s, c->nodes, i0, i1, acc);
 }
 
 void cf_fragment_ledger_reset(cf_world *sim, int fi)
