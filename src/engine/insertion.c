@@ -19,6 +19,14 @@ int cf_int_list_push(cf_int_list *l, int value)
     return 0;
 }
 
+static int by_int(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return (a > b) - (a < b);
+}
+
+void cf_ints_sort(int *v, int n) { qsort(v, (size_t)n, sizeof(int), by_int); }
+
 /* Current unit normal of face k of tet t (outward from t). */
 static void face_normal(const cf_solid *s, int t, int k, double n[3])
 {
@@ -80,11 +88,11 @@ static int source_rule(const cf_solid *s, int ta, int k, double threshold)
     return 1;
 }
 
-/* Clears the marks of the listed nodes. */
-static void clear_marks(cf_solid *s, const cf_int_list *marked)
+/* Clears the marks of nodes[0..n). */
+static void clear_marks(cf_solid *s, const int *nodes, int n)
 {
-    for (int i = 0; i < marked->n; i++)
-        s->node_mark[marked->v[i]] = 0;
+    for (int i = 0; i < n; i++)
+        s->node_mark[nodes[i]] = 0;
 }
 
 /* Marks the nodes of hot tets, listing each once in `marked`; out of
@@ -101,7 +109,7 @@ static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
                 if (s->node_mark[n])
                     continue;
                 if (cf_int_list_push(marked, n)) {
-                    clear_marks(s, marked);
+                    clear_marks(s, marked->v, marked->n);
                     return -1;
                 }
                 s->node_mark[n] = 1;
@@ -224,12 +232,6 @@ static void star_unqualify(cf_solid *s, int n)
         s->qualify[s->vt_slot[j] / 4] = 0;
 }
 
-static int by_int(const void *x, const void *y)
-{
-    int a = *(const int *)x, b = *(const int *)y;
-    return (a > b) - (a < b);
-}
-
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
                             cf_int_list *out)
 {
@@ -254,11 +256,9 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
         for (int i = 0; rc == 0 && i < m; i++)
             rc = push_qualified(s, out->v[i], out);
     int nq = out->n - m; /* the tets, after the nodes */
-    for (int i = 0; i < m; i++) {
-        if (rc) /* out of memory: no qualify byte or mark left set */
-            star_unqualify(s, out->v[i]);
-        s->node_mark[out->v[i]] = 0;
-    }
+    for (int i = 0; rc && i < m; i++) /* out of memory: no qualify byte left set */
+        star_unqualify(s, out->v[i]);
+    clear_marks(s, out->v, m);
     if (rc)
         return -1;
     /* The tets in ascending order, as `tets` lists them; then each one's
@@ -267,7 +267,7 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     int nf = 0, *q = out->v;
     memmove(q, q + m, (size_t)nq * sizeof(int));
     out->n = nq;
-    qsort(q, (size_t)nq, sizeof(int), by_int);
+    cf_ints_sort(q, nq);
     for (int i = 0; i < nq; i++)
         nf += __builtin_popcount(s->qualify[q[i]]);
     while (out->n < nf)

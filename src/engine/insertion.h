@@ -13,6 +13,8 @@ typedef struct cf_int_list {
 
 int cf_int_list_push(cf_int_list *l, int value); /* 0, or -1 out of memory */
 
+void cf_ints_sort(int *v, int n); /* v[0..n) ascending */
+
 /* The tet-level bound of `rule` for cf_tet4_forces: s1 = 0.9 sigma_max
  * (source) or sigma_max (traction), tau = tau_max (traction only), each
  * times the weakest facet's strength factor (s->strength_min).  Both

@@ -1,5 +1,6 @@
 #include "pbd.h"
 
+#include "insertion.h"
 #include "lanes.h"
 #include "linalg.h"
 
@@ -220,12 +221,6 @@ void cf_bars_scratch_free(cf_bars_scratch *w)
     memset(w, 0, sizeof *w);
 }
 
-static int by_int(const void *x, const void *y)
-{
-    int a = *(const int *)x, b = *(const int *)y;
-    return (a > b) - (a < b);
-}
-
 /* Room for n bars in b (amortised); 0 or -1. */
 static int bars_reserve(cf_bars *b, int n)
 {
@@ -258,7 +253,7 @@ int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touch
             w->flag[touched[i]] = TOUCHED, w->list[nd++] = touched[i];
             room += 3 * star_size(s, touched[i]); /* node_bars' bound */
         }
-    qsort(w->list, (size_t)nd, sizeof(int), by_int);
+    cf_ints_sort(w->list, nd);
     /* Their bars: every bar at a touched node, a pair of touched nodes once. */
     if (scratch_reserve(w, s->n_nodes, room))
         return -1;
