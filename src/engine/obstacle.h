@@ -55,7 +55,8 @@ void cf_obstacles_free(cf_obstacles *obs);
 
 /* Signed distance of point p from the static plane o (m, negative behind
  * it) and its outward normal: obstacle_plane.c's distance, here inline
- * because the projection asks it for every node at every iteration. */
+ * because the projection asks it for every node at every iteration
+ * (cf_obstacle_distance takes it without the table's call). */
 static inline double cf_plane_distance(const cf_obstacle *o, const double p[3],
                                        double normal[3])
 {

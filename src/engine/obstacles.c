@@ -27,7 +27,10 @@ void cf_obstacle_velocity(const cf_obstacle *o, double u[3])
 double cf_obstacle_distance(const cf_obstacles *obs, int j, double t, const double p[3],
                             double normal[3])
 {
-    return cf_obstacle_kind_of(obs->o[j].type)->distance(obs, j, t, p, normal);
+    const cf_obstacle *o = &obs->o[j];
+    if (o->type == CF_OBSTACLE_PLANE) /* the common case, without the table's call */
+        return cf_plane_distance(o, p, normal);
+    return cf_obstacle_kind_of(o->type)->distance(obs, j, t, p, normal);
 }
 
 void cf_obstacle_static_velocity(const cf_obstacle *o, double u[3])
@@ -91,8 +94,7 @@ int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], 
     int hit = -1;
     for (int j = 0; j < obs->n; j++) {
         double nrm[3], nx[3];
-        double dist = obs->o[j].type == CF_OBSTACLE_PLANE ? cf_plane_distance(&obs->o[j], p, nrm)
-                                                          : cf_obstacle_distance(obs, j, t, p, nrm);
+        double dist = cf_obstacle_distance(obs, j, t, p, nrm);
         if (dist < 0) {
             double allowed = fmin(0.0, cf_obstacle_distance(obs, j, t0, x, nx));
             if (dist < allowed)
