@@ -84,7 +84,7 @@ static void test_sweep_equals_one_bar_at_a_time(void **state)
     for (int it = 0; it < 3; it++) {
         for (int i = 0; i < b.n; i++) /* colour by colour, each colour in order */
             one_bar(&b, want, 0.9, i);
-        cf_bars_project(&b, &s, 0.9);
+        cf_bars_project(&b, &s, 0.9, NULL, NULL);
         assert_memory_equal(s.p, want, rows);
     }
     /* The sweep moved the nodes: the comparison is not of untouched arrays. */

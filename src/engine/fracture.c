@@ -94,6 +94,17 @@ static double impulse_removes(const cf_solid *s, const cf_fragment *f, int i, co
     return -m * v3_dot(dv, mid);
 }
 
+/* Node i's velocity shifted by dv; returns the energy that takes. */
+static double shift_node(cf_solid *s, const cf_fragment *f, int i, const double dv[3])
+{
+    double *va = &s->v[3 * f->nodes.v[i]], to[3];
+    for (int k = 0; k < 3; k++)
+        to[k] = va[k] + dv[k];
+    double removed = impulse_removes(s, f, i, va, to, 0);
+    memcpy(va, to, sizeof to);
+    return removed;
+}
+
 /* What the chunk sums of a step read (chunks.h). */
 typedef struct {
     cf_world *sim;
@@ -126,7 +137,10 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
     const step_sums *c = ctx;
     cf_solid *s = &c->sim->solid;
     cf_fragment *f = c->f;
+    int shift = c->dv[0] != 0 || c->dv[1] != 0 || c->dv[2] != 0;
     for (int i = i0; i < i1; i++) {
+        if (shift) /* the momentum the speed cap took, given back (project) */
+            acc[2] += shift_node(s, f, i, c->dv);
         int j = f->contact[i];
         if (j < 0)
             continue;
@@ -163,12 +177,17 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
     }
 }
 
-static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog)
+/* Friction and restitution (contact_chunk), after each node's velocity is
+ * shifted by dv (the speed cap's momentum, from project; zero: none); the
+ * shift's energy is booked with the projection's. */
+static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog,
+                                 const double dv[3])
 {
-    step_sums c = {sim, f, t, dt, {0, 0, 0}, leapfrog};
-    double sums[2]; /* removed, of which the obstacles' work */
-    cf_sum_chunks(f->nodes.n, 2, !mesh_obstacles(sim), contact_chunk, &c, sums);
+    step_sums c = {sim, f, t, dt, {dv[0], dv[1], dv[2]}, leapfrog};
+    double sums[3]; /* removed, of which the obstacles' work; the shift's */
+    cf_sum_chunks(f->nodes.n, 3, !mesh_obstacles(sim), contact_chunk, &c, sums);
     f->pending.obstacles += sums[1];
+    f->pending.pbd += sums[2];
     return sums[0];
 }
 
@@ -363,8 +382,13 @@ static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next,
 static void obstacle_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const step_sums *c = ctx;
-    for (int i = i0; i < i1; i++)
+    const cf_solid *s = &c->sim->solid;
+    int alone = c->f->near.n == 0; /* no rigid neighbour's hull to test */
+    for (int i = i0; i < i1; i++) {
+        if (alone && cf_obstacles_clear(&c->sim->obs, &s->p[4 * c->f->nodes.v[i]]))
+            continue; /* nothing to move, record or add */
         acc[0] += obstacle_node(c->sim, c->f, i, c->t_next, c->dt);
+    }
 }
 
 /* The energy terms a node loop left in f->term. */
@@ -375,24 +399,14 @@ static void term_chunk(void *ctx, int i0, int i1, double *acc)
         acc[0] += c->f->term[i];
 }
 
-/* Every node's velocity shifted by dv, and the energy that takes. */
-static void shift_chunk(void *ctx, int i0, int i1, double *acc)
-{
-    const step_sums *c = ctx;
-    cf_solid *s = &c->sim->solid;
-    for (int i = i0; i < i1; i++) {
-        double *va = &s->v[3 * c->f->nodes.v[i]], to[3];
-        for (int k = 0; k < 3; k++)
-            to[k] = va[k] + c->dv[k];
-        acc[0] += impulse_removes(s, c->f, i, va, to, 0);
-        memcpy(va, to, sizeof to);
-    }
-}
 
 /* Prediction p = x + dt v, then the constraint projection: bars (PBD or
- * XPBD), crack-face contact, obstacles, the n_bc prescribed nodes. */
+ * XPBD), crack-face contact, obstacles, the n_bc prescribed nodes.  dv
+ * receives the velocity every node must gain to give back the momentum the
+ * speed cap took (zero when it took none): contact_velocities adds it in
+ * its pass over the nodes. */
 static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int fracture,
-                    int n_bc)
+                    int n_bc, double dv[3])
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
@@ -401,6 +415,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     /* The obstacle pass on the threads unless hull pushes of rigid
      * neighbours (one list) or FCL queries need one thread. */
     int obstacles_par = par && f->near.n == 0 && !mesh_obstacles(sim);
+    int bars = !explicit_step(set, fracture);
 #pragma omp parallel for schedule(static) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
@@ -409,8 +424,9 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         s->p[4 * a + 3] = 1.0 / s->m[a];
         f->contact[i] = -1;
         f->vn_pre[i] = 0;
+        if (bars) /* the predicted speed, for the cap below (v stays until then) */
+            s->vcap[a] = s->speed[a] = v3_norm(&s->v[3 * a]);
     }
-    int bars = !explicit_step(set, fracture);
     int iterations = bars ? set->iterations : 1;
     double k = cf_pbd_effective_stiffness(set->k_stiffness, set->iterations,
                                           set->iteration_independent);
@@ -418,11 +434,14 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         cf_bars_reset_lambda(&f->bars);
     double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
     step_sums sums = {sim, f, t_next, dt, {0, 0, 0}, 0};
+    int caps = 0; /* the neighbours' speeds taken (below) in the first PBD sweep */
     for (int it = 0; it < iterations; it++) {
-        if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture)
+        if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture) {
             cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
-        else if (bars)
-            cf_bars_project(&f->bars, s, k);
+        } else if (bars) {
+            cf_bars_project(&f->bars, s, k, caps ? NULL : s->speed, caps ? NULL : s->vcap);
+            caps = 1;
+        }
         if (fracture && bars)
             cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
         double w; /* obstacles node by node, each writing its own p */
@@ -444,14 +463,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
      * as they are (their push is booked as an impulse on the body).  The
      * projection's energy is the work of its impulses m (v - v_pred)
      * (impulse_removes), booked when the next step starts. */
-    if (bars) {
-#pragma omp parallel for schedule(static) if (par)
-        for (int i = 0; i < nn; i++) {
-            int a = nodes[i];
-            s->vcap[a] = s->speed[a] = v3_norm(&s->v[3 * a]);
-        }
+    if (bars && !caps)
         cf_bars_neighbour_speed(&f->bars, s->speed, s->vcap);
-    }
     int n_capped = 0;
 #pragma omp parallel for schedule(static) reduction(+ : n_capped) if (par)
     for (int i = 0; i < nn; i++) {
@@ -486,14 +499,13 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     double dP[3] = {0, 0, 0}; /* zero unless the cap took some (then in node order) */
     for (int i = 0; n_capped > 0 && i < nn; i++)
         v3_axpy(1.0, &s->p[4 * nodes[i]], dP);
+    dv[0] = dv[1] = dv[2] = 0;
     if (v3_dot(dP, dP) > 0) {
-        double mass = 0, shift;
+        double mass = 0;
         for (int i = 0; i < nn; i++)
             mass += s->m[nodes[i]];
         for (int c = 0; c < 3; c++)
-            sums.dv[c] = dP[c] / mass;
-        cf_sum_chunks(nn, 1, par, shift_chunk, &sums, &shift);
-        removed += shift;
+            dv[c] = dP[c] / mass;
     }
     /* The kinetic change includes what moving obstacles and prescribed nodes
      * put in (a prescribed node that the bars push back and the projection
@@ -526,9 +538,10 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
     int n_bc = update_velocities(sim, f, dt, fracture);
     double t1 = cf_wall_time();
     sim->prof.forces += t1 - t0;
-    project(sim, f, t + dt, dt, fracture, n_bc);
+    double dv[3];
+    project(sim, f, t + dt, dt, fracture, n_bc, dv);
     f->pending.contact +=
-        contact_velocities(sim, f, t + dt, dt, explicit_step(&sim->def.solver, fracture));
+        contact_velocities(sim, f, t + dt, dt, explicit_step(&sim->def.solver, fracture), dv);
     sim->prof.pbd += cf_wall_time() - t1;
     f->steps++;
     return CF_OK;

@@ -20,6 +20,7 @@ typedef struct cf_obstacles {
     const cf_obstacle *o;
     cff_mesh **mesh;
     double *range;
+    int planes_only; /* every obstacle a static plane (or none) */
 } cf_obstacles;
 
 typedef struct cf_obstacle_kind {
@@ -76,6 +77,22 @@ static inline double cf_plane_distance(const cf_obstacle *o, const double p[3],
  * normal. */
 int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], double t,
                          double p[3], double normal[3]);
+
+/* Whether p lies on or outside every obstacle when all are static planes
+ * (planes_only), which cf_obstacles_project would then leave alone: its test
+ * inline, for the nodes far from the ground (most of them), without its
+ * calls.  0 when some obstacle is another kind or p is behind a plane. */
+static inline int cf_obstacles_clear(const cf_obstacles *obs, const double p[3])
+{
+    if (!obs->planes_only)
+        return 0;
+    for (int j = 0; j < obs->n; j++) {
+        double normal[3];
+        if (cf_plane_distance(&obs->o[j], p, normal) < 0)
+            return 0;
+    }
+    return 1;
+}
 
 /* Velocity of obstacle o, m/s. */
 void cf_obstacle_velocity(const cf_obstacle *o, double u[3]);

@@ -56,6 +56,9 @@ cf_status cf_obstacles_create(cf_obstacles *obs, const cf_world_def *def, cfb_wo
 {
     int n = def->n_obstacles;
     obs->n = n;
+    obs->planes_only = 1;
+    for (int j = 0; j < n; j++)
+        obs->planes_only &= def->obstacles[j].type == CF_OBSTACLE_PLANE;
     if (n == 0)
         return CF_OK;
     obs->mesh = calloc((size_t)n, sizeof *obs->mesh);

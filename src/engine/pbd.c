@@ -450,18 +450,34 @@ static inline __attribute__((always_inline)) void project_lanes(const cf_bars *b
  * (the PBD stage x1.07 on one thread; 32 ahead was no better). */
 enum { PREFETCH = 16 };
 
+/* Bar i's two ends see each other's speed (a comparison, not fmax: the
+ * library call cost more than the rest of the sweep; speeds are never NaN). */
+static inline void neighbour_speed(const cf_bars *b, const double *speed, double *cap, int i)
+{
+    int a = b->ends[2 * i], c = b->ends[2 * i + 1];
+    cap[a] = speed[c] > cap[a] ? speed[c] : cap[a];
+    cap[c] = speed[a] > cap[c] ? speed[a] : cap[c];
+}
+
 /* Bars i0..i1-1 of one colour: four at a time, the rest one by one (one
- * call per thread and colour, so the clone is chosen once per run). */
-CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, int i0, int i1)
+ * call per thread and colour, so the clone is chosen once per run); with
+ * cap, each bar's neighbour_speed too. */
+CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, const double *speed,
+                                       double *cap, int i0, int i1)
 {
     int i = i0;
     for (; i + LANES <= i1; i += LANES) {
         for (int j = 2 * (i + PREFETCH); j < 2 * (i + PREFETCH + LANES) && j < 2 * i1; j++)
             __builtin_prefetch(&s->p[4 * b->ends[j]], 1);
         project_lanes(b, s, k, i);
+        for (int l = 0; cap && l < LANES; l++)
+            neighbour_speed(b, speed, cap, i + l);
     }
-    for (; i < i1; i++)
+    for (; i < i1; i++) {
         project_bar(b, s, k, i);
+        if (cap)
+            neighbour_speed(b, speed, cap, i);
+    }
 }
 
 /* Colour by colour; the bars of one colour share no node, so they run in
@@ -489,19 +505,21 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
     }
 #define SWEEP_EACH(b, ONE) SWEEP(b, 1, for (int i = i0; i < i1; i++) ONE, ONE)
 
-void cf_bars_project(const cf_bars *b, cf_solid *s, double k)
+/* One bar of the last, serial group: project_bar, and with cap its
+ * neighbour_speed. */
+static void project_one(const cf_bars *b, cf_solid *s, double k, const double *speed,
+                        double *cap, int i)
 {
-    if (b->n > 0)
-        SWEEP(b, LANES, project_run(b, s, k, i0, i1), project_bar(b, s, k, i))
+    project_bar(b, s, k, i);
+    if (cap)
+        neighbour_speed(b, speed, cap, i);
 }
 
-/* Bar i's two ends see each other's speed (a comparison, not fmax: the
- * library call cost more than the rest of the sweep; speeds are never NaN). */
-static inline void neighbour_speed(const cf_bars *b, const double *speed, double *cap, int i)
+void cf_bars_project(const cf_bars *b, cf_solid *s, double k, const double *speed, double *cap)
 {
-    int a = b->ends[2 * i], c = b->ends[2 * i + 1];
-    cap[a] = speed[c] > cap[a] ? speed[c] : cap[a];
-    cap[c] = speed[a] > cap[c] ? speed[a] : cap[c];
+    if (b->n > 0)
+        SWEEP(b, LANES, project_run(b, s, k, speed, cap, i0, i1),
+              project_one(b, s, k, speed, cap, i))
 }
 
 void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)

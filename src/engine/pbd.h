@@ -67,8 +67,11 @@ int cf_bars_split(const cf_bars *src, const int *piece_of_node, int k, cf_bars *
  * after colour (in parallel within a colour; the same bits for any thread
  * count), with the inverse masses w = 1/m from slot 3 of s->p's rows (set
  * by the caller for the bars' nodes):
- * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k. */
-void cf_bars_project(const cf_bars *b, cf_solid *s, double k);
+ * C = |p1 - p2| - d, dp1 = -w1/(w1+w2) C n, dp2 = +w2/(w1+w2) C n, scaled by k.
+ * With speed and cap (else NULL) the same pass also does
+ * cf_bars_neighbour_speed's update at each bar: one pass over the bars
+ * instead of two, and the same caps (a maximum in any order is exact). */
+void cf_bars_project(const cf_bars *b, cf_solid *s, double k, const double *speed, double *cap);
 
 /* cap[a] = max(cap[a], speed[c]) for every bar (a, c), both ways (m/s):
  * the fastest neighbour of each node.  Colour by colour, like the sweep. */
