@@ -219,6 +219,103 @@ static void test_bound_never_misses_a_facet(void **state)
     cf_mesh_free(&m);
 }
 
+/* Largest eigenvalue of a symmetric 3x3 matrix by Jacobi rotations: a
+ * method of its own, not insertion.c's closed form. */
+static double jacobi_max_eigenvalue(const double S[9])
+{
+    double A[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            A[i][j] = S[3 * i + j];
+    for (int sweep = 0; sweep < 50; sweep++)
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (A[p][q] == 0)
+                    continue;
+                double th = 0.5 * atan2(2 * A[p][q], A[q][q] - A[p][p]);
+                double c = cos(th), sn = sin(th);
+                for (int k = 0; k < 3; k++) { /* A <- J^T A J */
+                    double akp = A[k][p], akq = A[k][q];
+                    A[k][p] = c * akp - sn * akq, A[k][q] = sn * akp + c * akq;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double apk = A[p][k], aqk = A[q][k];
+                    A[p][k] = c * apk - sn * aqk, A[q][k] = sn * apk + c * aqk;
+                }
+            }
+    return fmax(A[0][0], fmax(A[1][1], A[2][2]));
+}
+
+/* The source's rule found by brute force: every node's volume-averaged
+ * world stress over all its tets, its largest eigenvalue (Jacobi), and each
+ * interior facet whose three nodes all reach 0.9 sigma_max.  The insertion
+ * check, which computes the eigenvalue only where a bound does not already
+ * put it below the threshold and drops the other nodes, takes exactly those
+ * facets, in tet order.  Facets with a node within 1e-9 of the threshold
+ * (relative) would depend on rounding: none occur here (counted). */
+static void test_source_rule_equals_brute_force(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 3, 3, 3, 1, 1, 1);
+    int checked = 0;
+    for (int level = 0; level < 5; level++) {
+        cf_solid s;
+        init(&s, &m);
+        for (int i = 0; i < s.n_nodes; i++)
+            for (int k = 0; k < 3; k++)
+                s.x[3 * i + k] += 0.02 * sin(12.9898 * i + 78.233 * k);
+        s.mat.sigma_max = 0.15 * (1 << level) * 0.02 * s.mat.E;
+        int *all = malloc((size_t)s.n_tets * sizeof(int)), n_hot = 0;
+        for (int t = 0; t < s.n_tets; t++)
+            all[t] = t;
+        cf_stress_check bound = cf_insertion_bound(&s, CF_CRITERION_SOURCE);
+        cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, &bound, &n_hot);
+        double *avg = calloc((size_t)s.n_nodes * 10, sizeof(double)), *value =
+            malloc((size_t)s.n_nodes * sizeof(double));
+        for (int t = 0; t < s.n_tets; t++)
+            for (int j = 0; j < 4; j++) {
+                double *a = &avg[10 * s.tet[4 * t + j]];
+                for (int k = 0; k < 9; k++)
+                    a[k] += s.vol[t] * s.sigma[9 * t + k];
+                a[9] += s.vol[t];
+            }
+        double thr = 0.9 * s.mat.sigma_max;
+        int near = 0;
+        for (int n = 0; n < s.n_nodes; n++) {
+            double S[9];
+            for (int k = 0; k < 9; k++)
+                S[k] = avg[10 * n + k] / avg[10 * n + 9];
+            value[n] = jacobi_max_eigenvalue(S);
+            near += fabs(value[n] - thr) <= 1e-9 * thr;
+        }
+        assert_int_equal(near, 0);
+        cf_int_list want = {0}, got = {0};
+        for (int t = 0; t < s.n_tets; t++)
+            for (int k = 0; k < 4; k++) {
+                int f = s.tet_facet[4 * t + k], ok = 1;
+                if (s.facet[4 * f] != t || s.facet[4 * f + 2] < 0)
+                    continue; /* a boundary facet, or seen from its other tet */
+                for (int j = 0; j < 3; j++)
+                    ok &= value[s.tet[4 * t + CF_TET_FACE[k][j]]] >= thr;
+                if (ok)
+                    assert_int_equal(cf_int_list_push(&want, f), 0);
+            }
+        memset(s.hot, 1, (size_t)s.n_tets);
+        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &got);
+        printf("FIGURE source rule: level %d: %d facets by brute force, %d by the check\n", level,
+               want.n, n);
+        assert_int_equal(n, want.n);
+        for (int i = 0; i < n; i++)
+            assert_int_equal(got.v[i], want.v[i]);
+        checked += n > 0;
+        free(all), free(avg), free(value), free(want.v), free(got.v);
+        cf_solid_free(&s);
+    }
+    assert_true(checked >= 2); /* some levels really insert */
+    cf_mesh_free(&m);
+}
+
 /* Bars sorted by their ends, for comparing bar sets. */
 typedef struct {
     int a, b;
@@ -336,6 +433,7 @@ int main(void)
         cmocka_unit_test(test_bars_patched_after_insertion_equal_a_rebuild),
         cmocka_unit_test(test_criterion_selects_facets_normal_to_tension),
         cmocka_unit_test(test_bound_never_misses_a_facet),
+        cmocka_unit_test(test_source_rule_equals_brute_force),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -55,9 +55,25 @@ static double max_principal(const double A[9])
     return q + 2 * p * cos(acos(r) / 3);
 }
 
+/* An upper bound of the largest eigenvalue of a symmetric 3x3 matrix:
+ * the tighter of Gershgorin's and the deviator's (tet4.c,
+ * principal_bounds), widened by 1e-9 of the deviator bound's size so that
+ * rounding cannot bring it below the eigenvalue max_principal finds. */
+static double max_principal_bound(const double A[9])
+{
+    double g = fmax(A[0] + fabs(A[1]) + fabs(A[2]),
+                    fmax(A[4] + fabs(A[1]) + fabs(A[5]), A[8] + fabs(A[2]) + fabs(A[5])));
+    double q = (A[0] + A[4] + A[8]) / 3, d0 = A[0] - q, d1 = A[4] - q, d2 = A[8] - q;
+    double r = sqrt(2.0 / 3.0 * (d0 * d0 + d1 * d1 + d2 * d2 +
+                                 2 * (A[1] * A[1] + A[2] * A[2] + A[5] * A[5])));
+    return fmin(g, q + r) + 1e-9 * (fabs(q) + r);
+}
+
 /* Volume-averaged maximum principal stress at node n: over the tets that
- * hold n, in ascending tet order. */
-static double nodal_principal(const cf_solid *s, int n)
+ * hold n, in ascending tet order.  Where a bound shows it to lie below
+ * `floor` (Pa) the bound is returned instead (still below floor), without
+ * the eigenvalue's trigonometry. */
+static double nodal_principal(const cf_solid *s, int n, double floor)
 {
     int o = s->origin[n];
     double a[10] = {0};
@@ -72,7 +88,8 @@ static double nodal_principal(const cf_solid *s, int n)
     double sig[9];
     for (int k = 0; k < 9; k++)
         sig[k] = a[k] / a[9];
-    return max_principal(sig);
+    double bound = max_principal_bound(sig);
+    return bound < floor ? bound : max_principal(sig);
 }
 
 /* Whether facet (ta, face k) passes the source's rule: every one of its
@@ -123,12 +140,25 @@ static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
  * than CF_NODES_PARALLEL_MIN's loops. */
 enum { STAR_PARALLEL_MIN = 256 };
 
-/* The source's nodal values at the marked nodes; each node writes its own. */
-static void nodal_values(cf_solid *s, const cf_int_list *marked)
+/* The source's nodal values at the marked nodes (each node writes its
+ * own), exact from `floor` (Pa) up; then the nodes whose value lies below
+ * floor, which no facet's rule can take, unmarked and dropped from the
+ * list, in order.  Only the tets the rest own can then qualify: the same
+ * facets, from fewer stars. */
+static void nodal_values(cf_solid *s, cf_int_list *marked, double floor)
 {
 #pragma omp parallel for schedule(static) if (marked->n >= STAR_PARALLEL_MIN)
     for (int i = 0; i < marked->n; i++)
-        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i]);
+        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], floor);
+    int kept = 0;
+    for (int i = 0; i < marked->n; i++) {
+        int n = marked->v[i];
+        if (s->nodal[n] < floor) /* a NaN stays, as source_rule lets it pass */
+            s->node_mark[n] = 0;
+        else
+            marked->v[kept++] = n;
+    }
+    marked->n = kept;
 }
 
 /* The faces of tet ta that qualify, as bits 1 << k.  Either rule needs a
@@ -247,8 +277,8 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
             first = i < first ? i : first, last = i;
     if (mark_hot_nodes(s, tets, first, last, out))
         return -1;
-    if (rule == CF_CRITERION_SOURCE)
-        nodal_values(s, out);
+    if (rule == CF_CRITERION_SOURCE) /* no facet threshold lies below the bound's s1 */
+        nodal_values(s, out, cf_insertion_bound(s, rule).s1);
     /* The faces of the tets that may have a qualifying one, then those
      * tets listed after the nodes. */
     int m = out->n, rc = 0;

@@ -231,16 +231,28 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
 static inline vd v_fmax(vd a, vd b) { return pick((vm)(a >= b) | (vm)(b != b), a, b); }
 static inline vd v_fmin(vd a, vd b) { return pick((vm)(a <= b) | (vm)(b != b), a, b); }
 
-/* Gershgorin bounds of a symmetric 3x3 matrix's eigenvalues: every one
- * lies in [lo, hi].  The element-frame and world-frame stresses are
- * similar matrices, so these bound the world stress's principal values
- * too. */
-static inline void gershgorin(lane9 A, vd *lo, vd *hi)
+/* Bounds of a symmetric 3x3 matrix's eigenvalues: every one lies in
+ * [lo, hi].  Two bounds, the tighter taken: Gershgorin's discs, and the
+ * deviator's, |lambda - q| <= sqrt(2/3 |A - q I|^2) with q the mean of the
+ * diagonal (the deviator's eigenvalues sum to zero, so the largest of them
+ * in magnitude is at most sqrt(2/3) times their norm; equality for a
+ * uniaxial stress, which Gershgorin overestimates in a frame that is not
+ * its own).  The deviator's bound is widened by 1e-9 of its size so that
+ * rounding cannot bring it below an eigenvalue.  The element-frame and
+ * world-frame stresses are similar matrices, so these bound the world
+ * stress's principal values too. */
+static inline void principal_bounds(lane9 A, vd *lo, vd *hi)
 {
     vd r0 = v_fabs(A[1]) + v_fabs(A[2]), r1 = v_fabs(A[1]) + v_fabs(A[5]),
        r2 = v_fabs(A[2]) + v_fabs(A[5]);
-    *hi = v_fmax(A[0] + r0, v_fmax(A[4] + r1, A[8] + r2));
-    *lo = v_fmin(A[0] - r0, v_fmin(A[4] - r1, A[8] - r2));
+    vd g_hi = v_fmax(A[0] + r0, v_fmax(A[4] + r1, A[8] + r2));
+    vd g_lo = v_fmin(A[0] - r0, v_fmin(A[4] - r1, A[8] - r2));
+    vd q = (A[0] + A[4] + A[8]) / 3, d0 = A[0] - q, d1 = A[4] - q, d2 = A[8] - q;
+    vd dev2 = d0 * d0 + d1 * d1 + d2 * d2 + 2 * (A[1] * A[1] + A[2] * A[2] + A[5] * A[5]);
+    vd r = v_sqrt((2.0 / 3.0) * dev2);
+    r += 1e-9 * (r + v_fabs(q));
+    *hi = v_fmin(g_hi, q + r);
+    *lo = v_fmax(g_lo, q - r);
 }
 
 /* det F (m3_det) */
@@ -283,7 +295,7 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
         lanes_mul_nt(P, L.R, sigma); /* R sigma R^T */
         lanes_store(sigma, 9, s->sigma, t, n);
         vd lo, hi;
-        gershgorin(L.sig, &lo, &hi);
+        principal_bounds(L.sig, &lo, &hi);
         is_hot = (vm)(hi >= splat(check->s1)) | (vm)(0.5 * (hi - lo) >= splat(check->tau));
     }
     for (int l = 0; l < n; l++) {
