@@ -176,6 +176,26 @@ static void test_criterion_selects_facets_normal_to_tension(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* The box of m as a solid with every node moved by a fixed pseudo-random
+ * 2 % of its size, strengths sigma_max = tau_max = `strength` (Pa), and the
+ * stresses and hot flags of one check under `rule` (*n_hot of them hot).
+ * Returns the list of all tets, in order (the caller frees it). */
+static int *deformed_box(cf_solid *s, cf_mesh *m, cf_criterion rule, double strength, int *n_hot)
+{
+    init(s, m);
+    for (int i = 0; i < s->n_nodes; i++)
+        for (int k = 0; k < 3; k++)
+            s->x[3 * i + k] += 0.02 * sin(12.9898 * i + 78.233 * k);
+    s->mat.sigma_max = s->mat.tau_max = strength;
+    int *all = malloc((size_t)s->n_tets * sizeof(int));
+    for (int t = 0; t < s->n_tets; t++)
+        all[t] = t;
+    cf_stress_check bound = cf_insertion_bound(s, rule);
+    *n_hot = 0;
+    cf_tet4_forces(s, all, s->n_tets, CF_ELASTICITY_COROTATIONAL, &bound, n_hot);
+    return all;
+}
+
 /* The tet-level bound (Gershgorin, cf_insertion_bound) never drops a facet
  * that the full rule takes: under a random deformation, the candidates with
  * the hot flags of cf_tet4_forces equal those with every tet marked hot,
@@ -190,17 +210,9 @@ static void test_bound_never_misses_a_facet(void **state)
     for (int r = 0; r < 2; r++)
         for (int level = 0; level < 4; level++) {
             cf_solid s;
-            init(&s, &m);
-            for (int i = 0; i < s.n_nodes; i++)
-                for (int k = 0; k < 3; k++)
-                    s.x[3 * i + k] += 0.02 * sin(12.9898 * i + 78.233 * k);
+            int n_hot;
             /* strengths from a fifth to 1.6 times E times the displacement scale */
-            s.mat.sigma_max = s.mat.tau_max = 0.2 * (1 << level) * 0.02 * s.mat.E;
-            int *all = malloc((size_t)s.n_tets * sizeof(int)), n_hot = 0;
-            for (int t = 0; t < s.n_tets; t++)
-                all[t] = t;
-            cf_stress_check bound = cf_insertion_bound(&s, rules[r]);
-            cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, &bound, &n_hot);
+            int *all = deformed_box(&s, &m, rules[r], 0.2 * (1 << level) * 0.02 * mat.E, &n_hot);
             cf_int_list a = {0}, b = {0};
             int na = cf_insertion_candidates(&s, all, s.n_tets, rules[r], n_hot, &a);
             memset(s.hot, 1, (size_t)s.n_tets);
@@ -261,16 +273,9 @@ static void test_source_rule_equals_brute_force(void **state)
     int checked = 0;
     for (int level = 0; level < 5; level++) {
         cf_solid s;
-        init(&s, &m);
-        for (int i = 0; i < s.n_nodes; i++)
-            for (int k = 0; k < 3; k++)
-                s.x[3 * i + k] += 0.02 * sin(12.9898 * i + 78.233 * k);
-        s.mat.sigma_max = 0.15 * (1 << level) * 0.02 * s.mat.E;
-        int *all = malloc((size_t)s.n_tets * sizeof(int)), n_hot = 0;
-        for (int t = 0; t < s.n_tets; t++)
-            all[t] = t;
-        cf_stress_check bound = cf_insertion_bound(&s, CF_CRITERION_SOURCE);
-        cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, &bound, &n_hot);
+        int n_hot;
+        int *all =
+            deformed_box(&s, &m, CF_CRITERION_SOURCE, 0.15 * (1 << level) * 0.02 * mat.E, &n_hot);
         double *avg = calloc((size_t)s.n_nodes * 10, sizeof(double)), *value =
             malloc((size_t)s.n_nodes * sizeof(double));
         for (int t = 0; t < s.n_tets; t++)
