@@ -459,6 +459,16 @@ static inline void neighbour_speed(const cf_bars *b, const double *speed, double
     cap[c] = speed[a] > cap[c] ? speed[a] : cap[c];
 }
 
+/* One bar: project_bar, and with cap its neighbour_speed (a run's last
+ * bars and the serial group). */
+static inline void project_one(const cf_bars *b, cf_solid *s, double k, const double *speed,
+                               double *cap, int i)
+{
+    project_bar(b, s, k, i);
+    if (cap)
+        neighbour_speed(b, speed, cap, i);
+}
+
 /* Bars i0..i1-1 of one colour: four at a time, the rest one by one (one
  * call per thread and colour, so the clone is chosen once per run); with
  * cap, each bar's neighbour_speed too. */
@@ -473,11 +483,8 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
         for (int l = 0; cap && l < LANES; l++)
             neighbour_speed(b, speed, cap, i + l);
     }
-    for (; i < i1; i++) {
-        project_bar(b, s, k, i);
-        if (cap)
-            neighbour_speed(b, speed, cap, i);
-    }
+    for (; i < i1; i++)
+        project_one(b, s, k, speed, cap, i);
 }
 
 /* Colour by colour; the bars of one colour share no node, so they run in
@@ -504,16 +511,6 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
             ONE;                                                                               \
     }
 #define SWEEP_EACH(b, ONE) SWEEP(b, 1, for (int i = i0; i < i1; i++) ONE, ONE)
-
-/* One bar of the last, serial group: project_bar, and with cap its
- * neighbour_speed. */
-static void project_one(const cf_bars *b, cf_solid *s, double k, const double *speed,
-                        double *cap, int i)
-{
-    project_bar(b, s, k, i);
-    if (cap)
-        neighbour_speed(b, speed, cap, i);
-}
 
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k, const double *speed, double *cap)
 {
