@@ -294,35 +294,59 @@ cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes,
 {
     int nt = o->threads > 0 ? o->threads : omp_get_num_procs();
     int reps = o->repeats < 1 ? 1 : o->repeats > 64 ? 64 : o->repeats;
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
     FILE *log = o->log;
     *bytes_per_tet = 0;
-    if (log)
-        fprintf(log, "cohfrac bench --scaling: criterion none, %d threads, %d steps, min of %d\n"
-                     "  %-28s %9s %9s %11s %13s\n",
-                nt, o->steps, reps, "mesh", "tets", "step ms", "ns/tet-step", "memory B/tet");
-    for (int i = 0; i < n; i++) {
-        cf_world_def sc;
-        cf_status st = make_scene(o, meshes[i], CF_CRITERION_NONE, &sc, err);
-        double best = INFINITY;
-        sample s;
-        for (int k = 0; st == CF_OK && k < reps; k++) {
-            st = time_steps(o, &sc, nt, &s, err);
-            best = fmin(best, s.ms);
+    cf_world_def *sc = calloc((size_t)(n > 0 ? n : 1), sizeof *sc);
+    sample *last = calloc((size_t)(n > 0 ? n : 1), sizeof *last);
+    double *best = malloc((size_t)(n > 0 ? n : 1) * sizeof *best);
+    if (!sc || !last || !best) {
+        free(sc), free(last), free(best);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for the scaling bench");
+    }
+    int made = 0; /* scenes made (a failed one holds nothing) */
+    cf_status st = CF_OK;
+    while (made < n && st == CF_OK) {
+        best[made] = INFINITY;
+        st = make_scene(o, meshes[made], CF_CRITERION_NONE, &sc[made], err);
+        made += st == CF_OK;
+    }
+    if (st == CF_OK && log)
+        fprintf(log, "cohfrac bench --scaling: criterion none, %d threads, %d steps, min of %d "
+                     "(the meshes interleaved in each repeat)\n",
+                nt, o->steps, reps);
+    /* Each repeat runs every mesh, so that a load on the shared machine
+     * hits all of them alike and the exponent does not follow it. */
+    for (int k = 0; k < reps && st == CF_OK; k++) {
+        for (int i = 0; i < n && st == CF_OK; i++) {
+            st = time_steps(o, &sc[i], nt, &last[i], err);
+            best[i] = st == CF_OK ? fmin(best[i], last[i].ms) : best[i];
         }
-        cf_scene_free(&sc);
-        if (st != CF_OK)
-            return st;
-        double tets = s.stats.tets, bpt = s.memory / tets;
-        *bytes_per_tet = fmax(*bytes_per_tet, bpt);
-        double x = log10(tets), y = log10(best);
-        sx += x, sy += y, sxx += x * x, sxy += x * y;
-        if (log) {
-            fprintf(log, "  %-28s %9d %9.2f %11.1f %13.0f\n", meshes[i], s.stats.tets, best,
-                    1e6 * best / tets, bpt);
+        if (st == CF_OK && log) {
+            fprintf(log, "repeat %d/%d:", k + 1, reps);
+            for (int i = 0; i < n; i++)
+                fprintf(log, " %.2f", last[i].ms);
+            fprintf(log, " ms per step\n");
             fflush(log);
         }
     }
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    if (st == CF_OK && log)
+        fprintf(log, "  %-28s %9s %9s %11s %13s\n", "mesh", "tets", "step ms", "ns/tet-step",
+                "memory B/tet");
+    for (int i = 0; i < n && st == CF_OK; i++) {
+        double tets = last[i].stats.tets, bpt = last[i].memory / tets;
+        *bytes_per_tet = fmax(*bytes_per_tet, bpt);
+        double x = log10(tets), y = log10(best[i]);
+        sx += x, sy += y, sxx += x * x, sxy += x * y;
+        if (log)
+            fprintf(log, "  %-28s %9d %9.2f %11.1f %13.0f\n", meshes[i], last[i].stats.tets,
+                    best[i], 1e6 * best[i] / tets, bpt);
+    }
+    for (int i = 0; i < made; i++)
+        cf_scene_free(&sc[i]);
+    free(sc), free(last), free(best);
+    if (st != CF_OK)
+        return st;
     *exponent = n > 1 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 1;
     if (log)
         fprintf(log, "bench scaling: exponent=%.3f (ms ~ tets^b, least squares) bytes_per_tet=%.0f\n",
