@@ -277,8 +277,9 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
         if (np)
             fprintf(log,
                     "peer_ratio = %.2f (btSoftBody %.2f ms / cohfrac %.2f ms per step, both on 1 "
-                    "thread; min of %d)\n",
-                    r->peer_ratio, r->peer_ms, r->t1.ms_min, np);
+                    "thread; min of %d); btSoftBody steps on one thread only: against cohfrac on "
+                    "%d threads %.2f\n",
+                    r->peer_ratio, r->peer_ms, r->t1.ms_min, np, nt, r->peer_ms / r->tn.ms_min);
         fprintf(log, "bench: tets=%d step_ms=%.3f floor_ms=%.3f ratio=%.2f speedup_%dt=%.2f", r->tets,
                 r->tn.ms_min, r->floor_ms, r->ratio, nt, r->speedup);
         if (np)
