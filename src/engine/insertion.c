@@ -55,20 +55,6 @@ static double max_principal(const double A[9])
     return q + 2 * p * cos(acos(r) / 3);
 }
 
-/* An upper bound of the largest eigenvalue of a symmetric 3x3 matrix:
- * the tighter of Gershgorin's and the deviator's (tet4.c,
- * principal_bounds), widened by 1e-9 of the deviator bound's size so that
- * rounding cannot bring it below the eigenvalue max_principal finds. */
-static double max_principal_bound(const double A[9])
-{
-    double g = fmax(A[0] + fabs(A[1]) + fabs(A[2]),
-                    fmax(A[4] + fabs(A[1]) + fabs(A[5]), A[8] + fabs(A[2]) + fabs(A[5])));
-    double q = (A[0] + A[4] + A[8]) / 3, d0 = A[0] - q, d1 = A[4] - q, d2 = A[8] - q;
-    double r = sqrt(2.0 / 3.0 * (d0 * d0 + d1 * d1 + d2 * d2 +
-                                 2 * (A[1] * A[1] + A[2] * A[2] + A[5] * A[5])));
-    return fmin(g, q + r) + 1e-9 * (fabs(q) + r);
-}
-
 /* Volume-averaged maximum principal stress at node n: over the tets that
  * hold n, in ascending tet order.  Where a bound shows it to lie below
  * `floor` (Pa) the bound is returned instead (still below floor), without
@@ -88,7 +74,7 @@ static double nodal_principal(const cf_solid *s, int n, double floor)
     double sig[9];
     for (int k = 0; k < 9; k++)
         sig[k] = a[k] / a[9];
-    double bound = max_principal_bound(sig);
+    double bound = cf_tet4_max_principal_bound(sig);
     return bound < floor ? bound : max_principal(sig);
 }
 

@@ -237,8 +237,9 @@ static inline vd v_fmin(vd a, vd b) { return pick((vm)(a <= b) | (vm)(b != b), a
  * diagonal (the deviator's eigenvalues sum to zero, so the largest of them
  * in magnitude is at most sqrt(2/3) times their norm; equality for a
  * uniaxial stress, which Gershgorin overestimates in a frame that is not
- * its own).  The deviator's bound is widened by 1e-9 of its size so that
- * rounding cannot bring it below an eigenvalue.  The element-frame and
+ * its own).  Both ends are widened by 1e-9 of the deviator bound's size
+ * so that rounding cannot bring either inside an eigenvalue, or below the
+ * largest one max_principal (insertion.c) finds.  The element-frame and
  * world-frame stresses are similar matrices, so these bound the world
  * stress's principal values too. */
 static inline void principal_bounds(lane9 A, vd *lo, vd *hi)
@@ -249,10 +250,19 @@ static inline void principal_bounds(lane9 A, vd *lo, vd *hi)
     vd g_lo = v_fmin(A[0] - r0, v_fmin(A[4] - r1, A[8] - r2));
     vd q = (A[0] + A[4] + A[8]) / 3, d0 = A[0] - q, d1 = A[4] - q, d2 = A[8] - q;
     vd dev2 = d0 * d0 + d1 * d1 + d2 * d2 + 2 * (A[1] * A[1] + A[2] * A[2] + A[5] * A[5]);
-    vd r = v_sqrt((2.0 / 3.0) * dev2);
-    r += 1e-9 * (r + v_fabs(q));
-    *hi = v_fmin(g_hi, q + r);
-    *lo = v_fmax(g_lo, q - r);
+    vd r = v_sqrt((2.0 / 3.0) * dev2), w = 1e-9 * (r + v_fabs(q));
+    *hi = v_fmin(g_hi, q + r) + w;
+    *lo = v_fmax(g_lo, q - r) - w;
+}
+
+double cf_tet4_max_principal_bound(const double A[9])
+{
+    lane9 a;
+    for (int k = 0; k < 9; k++)
+        a[k] = splat(A[k]);
+    vd lo, hi;
+    principal_bounds(a, &lo, &hi);
+    return hi[0];
 }
 
 /* det F (m3_det) */

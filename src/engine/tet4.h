@@ -49,6 +49,12 @@ typedef struct cf_stress_check {
 int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
                    const cf_stress_check *check, int *n_hot);
 
+/* An upper bound of the largest eigenvalue of the symmetric 3x3 matrix A
+ * (Pa for a stress): the Tet4 kernel's hot-flag bound (the tighter of
+ * Gershgorin's and the deviator's), widened so that rounding cannot bring
+ * it below the eigenvalue. */
+double cf_tet4_max_principal_bound(const double A[9]);
+
 /* World-frame Cauchy stress of tet t at the current positions (Pa), from
  * the rotation warm start and the plastic strain (neither updated). */
 void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9]);
