@@ -399,7 +399,6 @@ static void term_chunk(void *ctx, int i0, int i1, double *acc)
         acc[0] += c->f->term[i];
 }
 
-
 /* Prediction p = x + dt v, then the constraint projection: bars (PBD or
  * XPBD), crack-face contact, obstacles, the n_bc prescribed nodes.  dv
  * receives the velocity every node must gain to give back the momentum the

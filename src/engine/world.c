@@ -621,8 +621,8 @@ static double body_energy(const cf_world *sim, const cf_fragment *f, const cfb_s
     return state_kinetic_energy(f, st) - f->mass * v3_dot(sim->def.gravity, st->pos);
 }
 
-/* The ledger; the momenta too with `momenta` (a pass over the nodes of
- * every fragment in fracture mode, which the energy guard does not need). */
+/* The ledger; the momenta too with `momenta` (for fragments in fracture
+ * mode a pass over their nodes, which the energy guard does not need). */
 static void ledger(const cf_world *sim, cf_ledger *l, int momenta)
 {
     const cf_solid *s = &sim->solid;
@@ -637,7 +637,8 @@ static void ledger(const cf_world *sim, cf_ledger *l, int momenta)
             cfb_get_state(sim->bullet, f->body, &st);
             l->kinetic += state_kinetic_energy(f, &st);
             v3_axpy(f->mass, st.pos, l->mass_moment);
-            cf_body_momenta(f, &st, P, L);
+            if (momenta)
+                cf_body_momenta(f, &st, P, L);
         } else {
             l->kinetic += f->e_kin;
             l->strain += f->e_strain;
