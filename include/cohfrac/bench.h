@@ -13,7 +13,9 @@
  * In the same run it measures the machine's memory bandwidth with a
  * STREAM-like triad a = b + s c over three arrays of CF_BENCH_TRIAD_MB MiB
  * each (far beyond the last-level cache), counting 24 bytes per element,
- * best of 5, at the step's thread count; the floor is the traffic model's
+ * best of 5, at 1 thread and at the step's thread count, in every repeat
+ * beside the steps and the best over the repeats kept (as the step's
+ * minimum is); the floor is the traffic model's
  * bytes (cf_sim_step_traffic in sim.h, docs/performance.md) over that
  * bandwidth.
  *
