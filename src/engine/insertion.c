@@ -57,9 +57,9 @@ static double max_principal(const double A[9])
 
 /* Volume-averaged maximum principal stress at node n: over the tets that
  * hold n, in ascending tet order.  Where a bound shows it to lie below
- * `floor` (Pa) the bound is returned instead (still below floor), without
+ * `lowest` (Pa) the bound is returned instead (still below it), without
  * the eigenvalue's trigonometry. */
-static double nodal_principal(const cf_solid *s, int n, double floor)
+static double nodal_principal(const cf_solid *s, int n, double lowest)
 {
     int o = s->origin[n];
     double a[10] = {0};
@@ -75,7 +75,7 @@ static double nodal_principal(const cf_solid *s, int n, double floor)
     for (int k = 0; k < 9; k++)
         sig[k] = a[k] / a[9];
     double bound = cf_tet4_max_principal_bound(sig);
-    return bound < floor ? bound : max_principal(sig);
+    return bound < lowest ? bound : max_principal(sig);
 }
 
 /* Whether facet (ta, face k) passes the source's rule: every one of its
@@ -127,19 +127,19 @@ static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
 enum { STAR_PARALLEL_MIN = 256 };
 
 /* The source's nodal values at the marked nodes (each node writes its
- * own), exact from `floor` (Pa) up; then the nodes whose value lies below
- * floor, which no facet's rule can take, unmarked and dropped from the
+ * own), exact from `lowest` (Pa) up; then the nodes whose value lies
+ * below it, which no facet's rule can take, unmarked and dropped from the
  * list, in order.  Only the tets the rest own can then qualify: the same
  * facets, from fewer stars. */
-static void nodal_values(cf_solid *s, cf_int_list *marked, double floor)
+static void nodal_values(cf_solid *s, cf_int_list *marked, double lowest)
 {
 #pragma omp parallel for schedule(static) if (marked->n >= STAR_PARALLEL_MIN)
     for (int i = 0; i < marked->n; i++)
-        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], floor);
+        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], lowest);
     int kept = 0;
     for (int i = 0; i < marked->n; i++) {
         int n = marked->v[i];
-        if (s->nodal[n] < floor) /* a NaN stays, as source_rule lets it pass */
+        if (s->nodal[n] < lowest) /* a NaN stays, as source_rule lets it pass */
             s->node_mark[n] = 0;
         else
             marked->v[kept++] = n;
