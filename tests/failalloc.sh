@@ -188,7 +188,7 @@ done
 # and one in the fracture loop): exit 5 with libgomp's message and
 # cohfrac's, not libgomp's exit 1 (which means a bad command line here).
 filter=COHFRAC_FAIL_ALLOC_ONLY=libgomp
-for at in 1 50000; do
+for at in 1 20000; do
     run box $at 1
     total=$((total + 1))
     if [ "$rc" -eq 5 ] && grep -q 'libgomp: Out of memory' "$tmp/err" &&

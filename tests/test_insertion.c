@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0};
+static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0};
 
 static void init(cf_solid *s, cf_mesh *m)
 {
@@ -430,6 +430,216 @@ static void test_bars_patched_after_insertion_equal_a_rebuild(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* The box of m as a solid under a uniform uniaxial stress `sy` (Pa) along
+ * y, every tet hot, the traction rule at strength sigma_max = tau_max =
+ * `strength`: the facets normal to y qualify with ratio sy / strength, the
+ * others (traction below the strength) do not.  The nucleation radius is
+ * set to `radius` (m).  Returns the list of all tets. */
+static int *stressed_box(cf_solid *s, cf_mesh *m, double sy, double strength, double radius)
+{
+    init(s, m);
+    s->mat.sigma_max = s->mat.tau_max = strength;
+    for (int t = 0; t < s->n_tets; t++) {
+        memset(&s->sigma[9 * t], 0, 9 * sizeof(double));
+        s->sigma[9 * t + 4] = sy;
+    }
+    memset(s->hot, 1, (size_t)s->n_tets);
+    s->nucleation_radius = radius;
+    cf_crack_grid_free(&s->cracks);
+    cf_crack_grid_init(&s->cracks, radius);
+    int *all = malloc((size_t)s->n_tets * sizeof(int));
+    for (int t = 0; t < s->n_tets; t++)
+        all[t] = t;
+    return all;
+}
+
+/* Checks at times 0, dt, 2 dt, ... under growth rule g, each inserting
+ * what cf_insertion_select takes, until a check takes nothing (at most
+ * `checks`).  Returns the facets inserted. */
+static int grow(cf_solid *s, const int *all, cf_growth g, double dt, int checks)
+{
+    cf_int_list cand = {0}, nodes = {0}, touched = {0};
+    int total = 0;
+    for (int c = 0; c < checks; c++) {
+        g.t = c * dt;
+        int n = cf_insertion_candidates(s, all, s->n_tets, CF_CRITERION_TRACTION, s->n_tets, &cand);
+        assert_true(n >= 0);
+        n = cf_insertion_select(s, &cand, CF_CRITERION_TRACTION, &g);
+        assert_true(n >= 0);
+        for (int i = 0; i < n; i++)
+            assert_int_equal(cf_crack_facet(s, cand.v[i], &nodes, &touched), 0);
+        total += n;
+        if (n == 0 && g.rule == CF_GROWTH_ALL)
+            break;
+    }
+    free(cand.v), free(nodes.v), free(touched.v);
+    return total;
+}
+
+/* Tets in the smallest piece that the crack faces and the boundary close
+ * (tets joined through uncracked interior facets). */
+static int smallest_closed_piece(const cf_solid *s)
+{
+    int *parent = malloc((size_t)s->n_tets * sizeof(int)), *size = calloc((size_t)s->n_tets, sizeof(int));
+    for (int t = 0; t < s->n_tets; t++)
+        parent[t] = t;
+    for (int f = 0; f < s->n_facets; f++) {
+        const int *F = &s->facet[4 * f];
+        if (F[2] < 0 || s->cracked[f])
+            continue;
+        int a = F[0], b = F[2];
+        while (parent[a] != a)
+            a = parent[a];
+        while (parent[b] != b)
+            b = parent[b];
+        parent[a > b ? a : b] = a < b ? a : b;
+    }
+    for (int t = 0; t < s->n_tets; t++) {
+        int r = t;
+        while (parent[r] != r)
+            r = parent[r];
+        size[r]++;
+    }
+    int least = s->n_tets;
+    for (int t = 0; t < s->n_tets; t++)
+        if (size[t] > 0 && size[t] < least)
+            least = size[t];
+    free(parent), free(size);
+    return least;
+}
+
+/* Every facet of a box overloaded in every direction qualifies at every
+ * check.  The source's rule (all) then cracks every one at once and cuts
+ * the box into single tets; the front rule, given all the time it wants,
+ * cracks many facets but never closes a piece of 4 tets or fewer. */
+static void test_fronts_close_no_small_piece(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 4, 4, 4, 1, 1, 1);
+    int least[2], cracked[2];
+    for (int rule = 0; rule < 2; rule++) {
+        cf_solid s;
+        int *all = stressed_box(&s, &m, 0, 1.0, 1e-9);
+        for (int t = 0; t < s.n_tets; t++) /* hydrostatic tension: every normal */
+            s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
+        cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4, 0};
+        cracked[rule] = grow(&s, all, g, 1.0, 200);
+        least[rule] = smallest_closed_piece(&s);
+        free(all);
+        cf_solid_free(&s);
+    }
+    printf("FIGURE fronts: all: %d facets, smallest piece %d tets; fronts: %d facets, smallest "
+           "piece %d tets\n", cracked[0], least[0], cracked[1], least[1]);
+    assert_int_equal(least[0], 1);
+    assert_true(least[1] > 4);
+    assert_true(cracked[1] > cracked[0] / 4); /* the front rule does crack */
+    cf_mesh_free(&m);
+}
+
+/* A bar 8 m long under tension across one plane: the facets of the plane
+ * y = 1 qualify (ratio 1.4), every other facet is below its strength.  A
+ * nucleation radius longer than the bar lets one crack start; it grows
+ * along the plane from facet to facet, and no cracked facet ever lies
+ * farther from the first than the front speed times the time since, plus
+ * one cell's diagonal (the step from a facet to the next).  The whole plane
+ * cracks in the end. */
+static void test_front_moves_no_faster_than_its_speed(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 8, 2, 2, 8, 2, 2); /* cubic cells: no diagonal facet qualifies */
+    cf_solid s;
+    int *all = stressed_box(&s, &m, 1.4, 1.0, 100.0);
+    double speed = 10.0, dt = 0.01, cell = sqrt(3.0);
+    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0};
+    cf_int_list cand = {0}, nodes = {0}, touched = {0};
+    double first[3] = {0, 0, 0}, worst = -INFINITY;
+    int nuclei = 0, total = 0;
+    for (int c = 0; c < 200; c++) {
+        g.t = c * dt;
+        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, &cand);
+        n = cf_insertion_select(&s, &cand, CF_CRITERION_TRACTION, &g);
+        for (int i = 0; i < n; i++) {
+            const int *F = &s.facet[4 * cand.v[i]];
+            double ctr[3] = {0, 0, 0};
+            for (int j = 0; j < 3; j++)
+                v3_axpy(1.0 / 3, &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][j]]], ctr);
+            if (total == 0)
+                memcpy(first, ctr, sizeof first), nuclei++;
+            double d[3];
+            v3_sub(ctr, first, d);
+            worst = fmax(worst, v3_norm(d) - (speed * g.t + cell));
+            assert_int_equal(cf_crack_facet(&s, cand.v[i], &nodes, &touched), 0);
+            total++;
+        }
+    }
+    printf("FIGURE front speed: %d facets cracked from %d nucleus, farthest beyond speed x time "
+           "+ one cell: %g m\n", total, nuclei, worst);
+    assert_int_equal(total, 2 * 8 * 2); /* the plane: 8 x 2 cells, 2 triangles each */
+    assert_true(worst <= 0);
+    free(cand.v), free(nodes.v), free(touched.v), free(all);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
+/* Weakest-link strength (Zhou and Molinari 2004): facet f of area A_f
+ * draws w_f with P(w > x) = exp(-(A_f / A0) x^m), so z_f = (A_f / A0) w_f^m
+ * is exponential with mean 1 and variance 1 whatever the facet's size.
+ * On a coarse and a fine box (facet areas 8 and 2 times apart from each
+ * other) the mean of z over the interior facets is 1 within four standard
+ * errors, and the mean strength factor falls with the facet size as
+ * (A_fine / A_coarse)^(-1/m) predicts: a mesh-independent strength of a
+ * surface, where a per-facet draw would make the fine mesh weaker. */
+static void test_weibull_strength_scales_with_facet_area(void **state)
+{
+    (void)state;
+    const double modulus = 6, A0 = 1e-3;
+    double mean_w[2];
+    for (int level = 0; level < 2; level++) {
+        int n = 4 << level; /* cells per edge: 4, then 8 */
+        cf_mesh m;
+        fixture_box(&m, n, n, n, 1, 1, 1);
+        cf_material mt = mat;
+        mt.weibull = 1, mt.weibull_modulus = modulus, mt.strength_seed = 7, mt.strength_area = A0;
+        int *body = calloc((size_t)m.n_tets, sizeof(int));
+        cf_solid s;
+        assert_int_equal(cf_solid_init(&s, &m, &mt, body, NULL), CF_OK);
+        assert_int_equal(cf_solid_init_facets(&s, NULL), CF_OK);
+        double z = 0, w = 0;
+        int count = 0;
+        for (int f = 0; f < s.n_facets; f++) {
+            const int *F = &s.facet[4 * f];
+            if (F[2] < 0)
+                continue;
+            const double *a = &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][0]]],
+                         *b = &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][1]]],
+                         *c = &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][2]]];
+            double e1[3], e2[3], nrm[3];
+            v3_sub(b, a, e1), v3_sub(c, a, e2), v3_cross(e1, e2, nrm);
+            double area = 0.5 * v3_norm(nrm);
+            z += area / A0 * pow(s.strength[f], modulus);
+            w += s.strength[f] * pow(area / A0, 1.0 / modulus); /* the size taken out */
+            count++;
+        }
+        z /= count, w /= count;
+        mean_w[level] = 0;
+        for (int f = 0; f < s.n_facets; f++)
+            mean_w[level] += s.facet[4 * f + 2] >= 0 ? s.strength[f] / count : 0;
+        printf("FIGURE weibull area: %d cells per edge, %d facets, mean (A/A0) w^m %.4f (1 +- %.4f), "
+               "mean size-free factor %.4f (Gamma(1 + 1/m) = %.4f), mean w %.4f\n",
+               n, count, z, 4 / sqrt(count), w, tgamma(1 + 1 / modulus), mean_w[level]);
+        assert_true(fabs(z - 1) <= 4 / sqrt(count));
+        /* the size-free factor is Weibull of scale 1: mean Gamma(1 + 1/m), sd about 0.2 */
+        assert_true(fabs(w - tgamma(1 + 1 / modulus)) <= 4 * 0.2 / sqrt(count));
+        free(body);
+        cf_solid_free(&s), cf_mesh_free(&m);
+    }
+    /* The fine mesh's facets are a quarter of the coarse ones' area: each is
+     * stronger by 4^(1/m), 1.26 at m = 6 (within 5 %: the draws scatter). */
+    double want = pow(4.0, 1.0 / modulus);
+    assert_true(fabs(mean_w[1] / mean_w[0] / want - 1) < 0.05);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -439,6 +649,9 @@ int main(void)
         cmocka_unit_test(test_criterion_selects_facets_normal_to_tension),
         cmocka_unit_test(test_bound_never_misses_a_facet),
         cmocka_unit_test(test_source_rule_equals_brute_force),
+        cmocka_unit_test(test_fronts_close_no_small_piece),
+        cmocka_unit_test(test_front_moves_no_faster_than_its_speed),
+        cmocka_unit_test(test_weibull_strength_scales_with_facet_area),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -74,8 +74,12 @@ static void damped_pbd_rigid_mode_ledger_closes(void **state)
 static void prescribed_nodes_work_counted_once(void **state)
 {
     (void)state;
+    /* The source's insertion rule: this figure is the booking of the
+     * prescribed nodes' work, measured as it was before the front rule
+     * (which sends the crack another way; residual 1.5e-3 there, see
+     * docs/physics.md §14.10). */
     const char *sets[] = {"solver.dt_fracture=1e-5", "duration=0.003",
-                          "bodies[1].mesh.mesh_size=0.012", NULL};
+                          "bodies[1].mesh.mesh_size=0.012", "solver.crack_growth=\"all\"", NULL};
     double w = worst_residual("verification/mixed_mode_beam.lua", sets);
     assert_true(verify_figure("pbd_ledger", "residual / input, striker through the projection",
                               w, 0, 1e-3, ""));

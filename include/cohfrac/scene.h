@@ -21,13 +21,23 @@
  *       (von Mises perfect plasticity at sigma_c in the element frame, the
  *       work booked as energy_plastic_dissipated; docs/physics.md §2.1);
  *       0 keeps them linear elastic,
+ *     nucleation_radius [0] m: R_n; with solver.crack_growth "fronts", no
+ *       crack nucleates within R_n / ratio^2 of a cracked facet (rest
+ *       centroids; ratio: how far the facet exceeds its strength, >= 1):
+ *       cracks closer than the cohesive zone would share it; 0: the
+ *       cohesive length l_ch = E G_I / sigma_max^2 (docs/physics.md §5.1)
  *     strength = { distribution ["uniform"] | "weibull",
- *                  modulus [10] (Weibull modulus m > 0), seed [1] (integer) } }
- *       per-facet strength scatter: with "weibull" each interior facet f gets
- *       sigma_max_f = sigma_max w_f, tau_max_f = tau_max w_f, w_f drawn from
- *       the Weibull distribution P(w <= x) = 1 - exp(-x^m) (scale 1: 63% of
- *       the facets are weaker than sigma_max), the same for a given seed and
- *       mesh on any thread count; the facet's cohesive law keeps G_I, G_II
+ *                  modulus [10] (Weibull modulus m > 0), seed [1] (integer),
+ *                  area [0] m^2 (Weibull reference area A0; 0: l_ch^2 with
+ *                  l_ch = E G_I / sigma_max^2, the cohesive length) } }
+ *       per-facet strength scatter: with "weibull" each interior facet f of
+ *       rest area A_f gets sigma_max_f = sigma_max w_f, tau_max_f = tau_max w_f,
+ *       w_f drawn from the Weibull distribution of a weakest-link area,
+ *       P(w <= x) = 1 - exp(-(A_f/A0) x^m) (Zhou and Molinari 2004: a surface
+ *       has the same strength statistics however the mesh divides it; a
+ *       facet of area A0 is weaker than sigma_max with probability 63%), the
+ *       same for a given seed and mesh on any thread count; the facet's
+ *       cohesive law keeps G_I, G_II
  *       (its final openings scale with 1/w_f).  Weibull 1951, J Appl Mech
  *       18:293; for dynamic fragmentation Zhou, Molinari, Ramesh 2006, IJIE
  *       33:880.
@@ -116,6 +126,16 @@
  *       (facet traction sigma_n >= sigma_max or tau >= tau_max; or the
  *       source's nodal-averaged max principal stress >= 0.9 sigma_max at all
  *       three facet nodes) | "none" (no insertion: elastic only)
+ *     crack_growth ["fronts"] | "all": which qualifying facets a check
+ *       inserts (docs/physics.md §5.1): "fronts" extends existing cracks
+ *       across the edges of their facets, no faster than the Rayleigh wave
+ *       speed, and nucleates a new crack only at a facet that touches no
+ *       crack and no other facet inserted in that check (a local maximum of
+ *       the criterion's ratio); "all" inserts every qualifying facet (the
+ *       source's rule)
+ *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
+ *       crack faces around a piece of at most this many tets (the mesh
+ *       cannot resolve such a piece; 0: no bound)
  *     crack_plane = {point={..}, normal={..}, tolerance [1e-6] m}: a
  *       pre-selected crack path: only interior facets whose three vertices
  *       lie within tolerance of the plane are candidates for insertion

@@ -45,6 +45,13 @@ typedef struct cf_material {
     int strength_seed;
     double compressive_strength;   /* sigma_c, Pa: von Mises crushing of the Tet4s
                                       (docs/physics.md §2.1); 0 none (linear elastic) */
+    double strength_area;          /* m^2: Weibull reference area A0; a facet of area A
+                                      draws its factor at scale (A0/A)^(1/m) (Zhou and
+                                      Molinari 2004); 0: the cohesive length squared,
+                                      (E G_I / sigma_max^2)^2 */
+    double nucleation_radius;      /* m, R_n: no crack nucleates within R_n / ratio^2 of
+                                      a cracked facet (rest centroids; crack_growth
+                                      "fronts"); 0: the cohesive length E G_I / sigma_max^2 */
 } cf_material;
 
 typedef struct cf_body_def {
@@ -113,6 +120,10 @@ typedef enum { CF_RIGID_BULLET, CF_RIGID_PBD } cf_rigid_backend;
 typedef enum { CF_ELASTICITY_COROTATIONAL, CF_ELASTICITY_LINEAR } cf_elasticity;
 typedef enum { CF_CRITERION_TRACTION, CF_CRITERION_SOURCE, CF_CRITERION_NONE } cf_criterion;
 typedef enum { CF_CONSTRAINTS_PBD, CF_CONSTRAINTS_XPBD, CF_CONSTRAINTS_NONE } cf_constraints;
+/* Which of the facets that meet the criterion at a check are inserted
+ * (docs/physics.md §5.1): those that extend a crack front or nucleate one
+ * at a local maximum, or every one (the source's rule). */
+typedef enum { CF_GROWTH_FRONTS, CF_GROWTH_ALL } cf_crack_growth;
 
 typedef struct cf_solver_settings {
     cf_run_mode mode;
@@ -129,6 +140,9 @@ typedef struct cf_solver_settings {
     double sleep_linear, sleep_angular; /* m/s, rad/s; 0, 0: no sleeping */
     cf_elasticity elasticity;
     cf_criterion criterion;
+    cf_crack_growth crack_growth;
+    int min_piece_tets;           /* no insertion encloses a piece of at most this many
+                                     tets in crack faces (fronts growth); 0: no bound */
     int has_crack_plane;
     double crack_plane_point[3], crack_plane_normal[3]; /* normal normalised */
     double crack_plane_tolerance;                    /* m */
@@ -176,6 +190,8 @@ typedef struct cf_world_def {
  * step.  A run that needs more is a scene to rethink, not to wait for. */
 #define CF_MAX_SUBSTEPS 1000000
 #define CF_MAX_ITERATIONS 1000
+/* The largest piece solver.min_piece_tets may name. */
+#define CF_MAX_PIECE_TETS 64
 
 /* Defaults of every setting, as documented in the scene schema
  * (cohfrac/scene.h); a scene key left out takes the same value. */

@@ -18,6 +18,7 @@ return {
   },
   solver = {
     mode = "fracture", constraints = "none", criterion = "traction",
+    crack_growth = "all",  -- the crack plane is prescribed: every facet on it that qualifies
     crack_plane = { point = {0, 0, 0}, normal = {0, 0, 1} },
     dt_rigid = 1e-3, cfl_fraction = 0.1,
   },

@@ -41,13 +41,26 @@ static int ensure_scratch(cf_fragment *f)
     return 0;
 }
 
-/* Extrinsic insertion on every facet that qualifies at this check. */
-static cf_status check_and_insert(cf_world *sim, cf_fragment *f, int n_hot, int *inserted)
+/* Rayleigh wave speed, m/s: the fastest a crack runs in a brittle solid
+ * (Freund 1990, the approximation c_R = c_s (0.862 + 1.14 nu) / (1 + nu)). */
+static double rayleigh_speed(const cf_solid *s)
+{
+    double nu = s->mat.nu;
+    return sqrt(s->mu / s->mat.rho) * (0.862 + 1.14 * nu) / (1.0 + nu);
+}
+
+/* Extrinsic insertion at this check (time t, s) on the facets that qualify
+ * and that the growth rule takes (cf_insertion_select). */
+static cf_status check_and_insert(cf_world *sim, cf_fragment *f, double t, int n_hot,
+                                  int *inserted)
 {
     cf_solid *s = &sim->solid;
+    const cf_solver_settings *set = &sim->def.solver;
     double t0 = cf_wall_time();
-    int nc = cf_insertion_candidates(s, f->tets, f->nt, sim->def.solver.criterion, n_hot,
-                                     &sim->cand);
+    int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, &sim->cand);
+    cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets, t};
+    if (nc > 0)
+        nc = cf_insertion_select(s, &sim->cand, set->criterion, &growth);
     if (nc < 0)
         return CF_ERR_NOMEM;
     sim->touched.n = 0;
@@ -214,7 +227,7 @@ static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
 }
 
 /* f = f_ext - f_int + f_coh at x_n; strain energy and inverted tets. */
-static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
+static cf_status forces(cf_world *sim, cf_fragment *f, double t, double dt, int fracture)
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
@@ -232,7 +245,7 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double dt, int fracture)
         sim->prof.stress += cf_wall_time() - t0;
         int inserted = 0;
         if (check) {
-            cf_status st = check_and_insert(sim, f, n_hot, &inserted);
+            cf_status st = check_and_insert(sim, f, t, n_hot, &inserted);
             if (st != CF_OK)
                 return st;
         }
@@ -530,7 +543,7 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
 {
     cf_fragment *f = &sim->frag[fi];
     cf_fragment_book_pending(sim, f);
-    cf_status st = forces(sim, f, dt, fracture);
+    cf_status st = forces(sim, f, t, dt, fracture);
     if (st != CF_OK)
         return st;
     double t0 = cf_wall_time();

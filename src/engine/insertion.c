@@ -55,17 +55,21 @@ static double max_principal(const double A[9])
     return q + 2 * p * cos(acos(r) / 3);
 }
 
-/* Volume-averaged maximum principal stress at node n: over the tets that
- * hold n, in ascending tet order.  Where a bound shows it to lie below
- * `lowest` (Pa) the bound is returned instead (still below it), without
- * the eigenvalue's trigonometry. */
-static double nodal_principal(const cf_solid *s, int n, double lowest)
+/* Volume-averaged maximum principal stress at node n: over the tets of
+ * fragment `frag` that hold a copy of n's original vertex, in ascending tet
+ * order.  The whole star, not the copy's own part of it: where node
+ * duplication has split a vertex beside a crack, a copy's part is a few
+ * tets on one side, and its average would read the stress of one tet
+ * instead of the material's around the vertex (docs/physics.md §5.1).
+ * Where a bound shows it to lie below `lowest` (Pa) the bound is returned
+ * instead (still below it), without the eigenvalue's trigonometry. */
+static double nodal_principal(const cf_solid *s, int n, int frag, double lowest)
 {
     int o = s->origin[n];
     double a[10] = {0};
     for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
         int slot = s->vt_slot[j], t = slot / 4;
-        if (s->tet[slot] != n)
+        if (s->tet_frag[t] != frag)
             continue;
         for (int k = 0; k < 9; k++)
             a[k] += s->vol[t] * s->sigma[9 * t + k];
@@ -76,6 +80,21 @@ static double nodal_principal(const cf_solid *s, int n, double lowest)
         sig[k] = a[k] / a[9];
     double bound = cf_tet4_max_principal_bound(sig);
     return bound < lowest ? bound : max_principal(sig);
+}
+
+/* Normal and shear traction (Pa) on face k of tet ta from the mean stress of
+ * the facet's two tets, across its current normal. */
+static void facet_traction(const cf_solid *s, int ta, int k, double *sn, double *tau)
+{
+    int tb = s->facet[4 * s->tet_facet[4 * ta + k] + 2];
+    double sig[9], n[3], t[3];
+    for (int j = 0; j < 9; j++)
+        sig[j] = 0.5 * (s->sigma[9 * ta + j] + s->sigma[9 * tb + j]);
+    face_normal(s, ta, k, n);
+    m3_mulv(sig, n, t);
+    *sn = v3_dot(n, t);
+    double tau2 = v3_dot(t, t) - *sn * *sn;
+    *tau = tau2 > 0 ? sqrt(tau2) : 0;
 }
 
 /* Whether facet (ta, face k) passes the source's rule: every one of its
@@ -131,11 +150,11 @@ enum { STAR_PARALLEL_MIN = 256 };
  * below it, which no facet's rule can take, unmarked and dropped from the
  * list, in order.  Only the tets the rest own can then qualify: the same
  * facets, from fewer stars. */
-static void nodal_values(cf_solid *s, cf_int_list *marked, double lowest)
+static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowest)
 {
 #pragma omp parallel for schedule(static) if (marked->n >= STAR_PARALLEL_MIN)
     for (int i = 0; i < marked->n; i++)
-        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], lowest);
+        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], frag, lowest);
     int kept = 0;
     for (int i = 0; i < marked->n; i++) {
         int n = marked->v[i];
@@ -169,17 +188,10 @@ static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion ru
             bits |= (unsigned char)(source_rule(s, ta, k, 0.9 * smax * w) << k);
             continue;
         }
-        int tb = F[2];
-        if (!s->hot[ta] && !s->hot[tb]) /* the mean stress is below both bounds */
+        if (!s->hot[ta] && !s->hot[F[2]]) /* the mean stress is below both bounds */
             continue;
-        double sig[9], n[3], t[3];
-        for (int j = 0; j < 9; j++)
-            sig[j] = 0.5 * (s->sigma[9 * ta + j] + s->sigma[9 * tb + j]);
-        face_normal(s, ta, k, n);
-        m3_mulv(sig, n, t);
-        double sn = v3_dot(n, t);
-        double tau2 = v3_dot(t, t) - sn * sn;
-        double tau = tau2 > 0 ? sqrt(tau2) : 0;
+        double sn, tau;
+        facet_traction(s, ta, k, &sn, &tau);
         bits |= (unsigned char)((sn >= smax * w || tau >= tmax * w) << k);
     }
     return bits;
@@ -264,7 +276,7 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     if (mark_hot_nodes(s, tets, first, last, out))
         return -1;
     if (rule == CF_CRITERION_SOURCE) /* no facet threshold lies below the bound's s1 */
-        nodal_values(s, out, cf_insertion_bound(s, rule).s1);
+        nodal_values(s, out, s->tet_frag[tets[0]], cf_insertion_bound(s, rule).s1);
     /* The faces of the tets that may have a qualifying one, then those
      * tets listed after the nodes. */
     int m = out->n, rc = 0;
@@ -414,4 +426,182 @@ int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched)
     }
     s->coh[s->n_coh++] = ce;
     return 0;
+}
+
+
+/* How far qualifying facet f exceeds its strength, at least 1: the smallest
+ * of its three nodal values over the facet's threshold (source), or the
+ * larger of sigma_n / sigma_max_f and tau / tau_max_f (traction), from the
+ * nodal values and stresses of the check that found it.  A NaN reads as
+ * infinitely far (the divergence guard stops the run). */
+static double facet_ratio(const cf_solid *s, int f, cf_criterion rule)
+{
+    const int *F = &s->facet[4 * f];
+    double w = s->strength ? s->strength[f] : 1.0, r;
+    if (rule == CF_CRITERION_SOURCE) {
+        r = INFINITY;
+        for (int j = 0; j < 3; j++) {
+            double q = s->nodal[s->tet[4 * F[0] + CF_TET_FACE[F[1]][j]]] / (0.9 * s->mat.sigma_max * w);
+            r = q < r ? q : r;
+        }
+    } else {
+        double sn, tau;
+        facet_traction(s, F[0], F[1], &sn, &tau);
+        r = fmax(sn / (s->mat.sigma_max * w), tau / (s->mat.tau_max * w));
+    }
+    return r == r ? r : INFINITY;
+}
+
+/* The original vertices of face k of tet t. */
+static void face_vertices(const cf_solid *s, int t, int k, int o[3])
+{
+    for (int j = 0; j < 3; j++)
+        o[j] = s->tet0[4 * t + CF_TET_FACE[k][j]];
+}
+
+/* Rest centroid of a triangle of original vertices, m. */
+static void centroid(const cf_solid *s, const int o[3], double c[3])
+{
+    for (int k = 0; k < 3; k++)
+        c[k] = (s->X[3 * o[0] + k] + s->X[3 * o[1] + k] + s->X[3 * o[2] + k]) / 3.0;
+}
+
+/* Rest distance between the centroids of two triangles of original vertices. */
+static double centroid_distance(const cf_solid *s, const int a[3], const int b[3])
+{
+    double ca[3], cb[3], d[3];
+    centroid(s, a, ca), centroid(s, b, cb);
+    v3_sub(ca, cb, d);
+    return v3_norm(d);
+}
+
+/* How facet f meets the cracks at time t: CF_FRONT when it shares an edge
+ * with a cracked facet inserted at least d / speed earlier (d between their
+ * rest centroids: a front moves no faster than `speed`); CF_TOUCH when it
+ * meets a cracked facet otherwise (at a vertex, or across an edge the crack
+ * reached too recently, this check's insertions included); CF_CLEAR when it
+ * meets none. */
+enum { CF_CLEAR, CF_TOUCH, CF_FRONT };
+static int crack_contact(const cf_solid *s, int f, double t, double speed)
+{
+    const int *F = &s->facet[4 * f];
+    int o[3], touch = CF_CLEAR;
+    face_vertices(s, F[0], F[1], o);
+    for (int a = 0; a < 3; a++)
+        for (int j = s->vt_start[o[a]]; j < s->vt_start[o[a] + 1]; j++) {
+            int slot = s->vt_slot[j], tt = slot / 4;
+            for (int k = 0; k < 4; k++) {
+                int g = s->tet_facet[4 * tt + k];
+                if (k == slot % 4 || g == f || !s->cracked[g])
+                    continue;
+                int og[3], shared = 0;
+                face_vertices(s, tt, k, og);
+                for (int p = 0; p < 3; p++)
+                    shared += og[p] == o[0] || og[p] == o[1] || og[p] == o[2];
+                if (shared == 2 && t - s->crack_time[g] >= centroid_distance(s, o, og) / speed)
+                    return CF_FRONT;
+                touch = CF_TOUCH;
+            }
+        }
+    return touch;
+}
+
+/* Whether cracking facet f would close crack faces (and the boundary)
+ * around a piece of at most `most` tets on either side: a search through
+ * the uncracked interior facets from each of its tets, which stops once it
+ * has found more. */
+static int closes_small_piece(const cf_solid *s, int f, int most)
+{
+    int seen[CF_MAX_PIECE_TETS + 1];
+    for (int side = 0; side < 2 && most > 0; side++) {
+        int n = 0;
+        seen[n++] = s->facet[4 * f + 2 * side];
+        for (int i = 0; i < n && n <= most; i++)
+            for (int k = 0; k < 4 && n <= most; k++) {
+                int g = s->tet_facet[4 * seen[i] + k];
+                const int *G = &s->facet[4 * g];
+                if (g == f || G[2] < 0 || s->cracked[g])
+                    continue;
+                int other = G[0] == seen[i] ? G[2] : G[0], known = 0;
+                for (int q = 0; q < n; q++)
+                    known |= seen[q] == other;
+                if (!known)
+                    seen[n++] = other;
+            }
+        if (n <= most)
+            return 1;
+    }
+    return 0;
+}
+
+typedef struct {
+    double ratio;
+    int facet;
+} ranked;
+
+/* Larger ratio first; the lower facet first among equals. */
+static int by_ratio(const void *x, const void *y)
+{
+    const ranked *a = x, *b = y;
+    if (a->ratio != b->ratio)
+        return a->ratio > b->ratio ? -1 : 1;
+    return (a->facet > b->facet) - (a->facet < b->facet);
+}
+
+int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const cf_growth *g)
+{
+    int nc = cand->n;
+    if (g->rule == CF_GROWTH_ALL || nc == 0) {
+        for (int i = 0; i < nc; i++)
+            s->crack_time[cand->v[i]] = g->t;
+        return nc;
+    }
+    ranked *r = malloc((size_t)nc * sizeof *r);
+    if (!r)
+        return -1;
+    for (int i = 0; i < nc; i++)
+        r[i].ratio = facet_ratio(s, cand->v[i], rule), r[i].facet = cand->v[i];
+    qsort(r, (size_t)nc, sizeof *r, by_ratio);
+    int kept = 0;
+    for (int i = 0; i < nc; i++) {
+        int f = r[i].facet, ta = s->facet[4 * f], tb = s->facet[4 * f + 2];
+        if (s->qualify[ta] || s->qualify[tb]) /* one new facet per tet and check */
+            continue;
+        /* A front extends its crack; a facet clear of every crack nucleates
+         * one (the largest ratio around it, as the ratios come in falling
+         * order and any facet taken before touches it); a facet that only
+         * touches a crack does neither. */
+        int contact = crack_contact(s, f, g->t, g->front_speed), o[3];
+        double c[3], q = r[i].ratio;
+        face_vertices(s, ta, s->facet[4 * f + 1], o);
+        centroid(s, o, c);
+        /* A crack shields a radius that shrinks as 1/ratio^2 (Irwin: the
+         * flaw that is critical at a stress sigma grows as
+         * l_ch (sigma_max / sigma)^2), so an overloaded solid still
+         * nucleates wherever the stress exceeds the strength. */
+        double shield = s->nucleation_radius / (q * q);
+        if (contact == CF_TOUCH ||
+            (contact == CF_CLEAR && cf_crack_grid_near(&s->cracks, c, shield)) ||
+            closes_small_piece(s, f, g->min_piece_tets))
+            continue;
+        if (cf_crack_grid_add(&s->cracks, c)) {
+            for (int j = 0; j < kept; j++) { /* nothing marked */
+                const int *F = &s->facet[4 * cand->v[j]];
+                s->cracked[cand->v[j]] = 0, s->qualify[F[0]] = s->qualify[F[2]] = 0;
+            }
+            free(r);
+            return -1;
+        }
+        s->cracked[f] = 1, s->crack_time[f] = g->t;
+        s->qualify[ta] = s->qualify[tb] = 1;
+        cand->v[kept++] = f;
+    }
+    free(r);
+    for (int i = 0; i < kept; i++) {
+        const int *F = &s->facet[4 * cand->v[i]];
+        s->qualify[F[0]] = s->qualify[F[2]] = 0;
+    }
+    cand->n = kept;
+    cf_ints_sort(cand->v, kept);
+    return kept;
 }

@@ -42,6 +42,28 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
                             cf_int_list *out);
 
+/* How a check chooses among the facets that meet the criterion
+ * (docs/physics.md §5.1). */
+typedef struct cf_growth {
+    cf_crack_growth rule;  /* fronts, or all (the source's) */
+    double front_speed;    /* m/s: the fastest a crack front may move (Rayleigh speed) */
+    int min_piece_tets;    /* no insertion closes a piece of at most this many tets */
+    double t;              /* s: now */
+} cf_growth;
+
+/* The facets of `cand` (cf_insertion_candidates) that a check inserts,
+ * left in `cand` in ascending order; each is marked cracked, with its
+ * insertion time.  CF_GROWTH_ALL keeps every one.  CF_GROWTH_FRONTS visits
+ * them by falling ratio (how far each exceeds its strength; the lower facet
+ * first among equals) and takes a facet when none of its two tets took one
+ * before it in this check, when it either shares an edge with a crack facet
+ * inserted at least d / front_speed before (a front) or touches no cracked
+ * facet and lies farther than s->nucleation_radius / ratio^2 from every
+ * one (a nucleus, the largest ratio around it), and when it closes no piece of at
+ * most min_piece_tets tets.  Returns how many, or -1 out of memory (nothing
+ * marked; the crack grid may hold the centroids of facets it refused). */
+int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const cf_growth *g);
+
 /* Crack facet f: mark it, duplicate the nodes whose star it disconnects
  * (new copies are appended to `nodes`; each split node and its copies to
  * `touched`, for cf_bars_patch), re-lump the masses of the affected nodes,

@@ -67,7 +67,8 @@ static int build_facets(cf_solid *s)
     free(k);
     s->n_facets = nf;
     s->cracked = calloc((size_t)nf, 1);
-    return s->cracked ? 0 : -1;
+    s->crack_time = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
+    return s->cracked && s->crack_time ? 0 : -1;
 }
 
 int cf_boundary_faces(const int *tet_nodes, const int *list, int nt, int *faces)
@@ -196,13 +197,25 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     if (!s->sigma || !s->hot || !s->qualify || !s->node_mark || !s->nodal || build_facets(s))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
                             s->n_tets);
+    const cf_material *mt = &s->mat;
+    double l_ch = mt->E * mt->G_I / (mt->sigma_max * mt->sigma_max);
+    s->nucleation_radius = mt->nucleation_radius > 0 ? mt->nucleation_radius : l_ch;
+    cf_crack_grid_init(&s->cracks, s->nucleation_radius);
     s->strength_min = s->strength_max = 1.0;
     if (s->mat.weibull) {
         s->strength = malloc((size_t)(s->n_facets > 0 ? s->n_facets : 1) * sizeof(float));
         if (!s->strength)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory for facet strengths");
+        /* Weakest-link scaling (Zhou and Molinari 2004): a facet of area A
+         * draws at scale (A0/A)^(1/m), so the strength of a surface does not
+         * depend on how many facets the mesh divides it into. */
+        const cf_material *m = mt;
+        double A0 = m->strength_area > 0 ? m->strength_area : l_ch * l_ch;
         for (int f = 0; f < s->n_facets; f++) {
-            s->strength[f] = (float)weibull_factor(s->mat.strength_seed, f, s->mat.weibull_modulus);
+            const int *T = &s->tet0[4 * s->facet[4 * f]], *k = CF_TET_FACE[s->facet[4 * f + 1]];
+            double A = tri_area(&s->X[3 * T[k[0]]], &s->X[3 * T[k[1]]], &s->X[3 * T[k[2]]]);
+            double size = A > 0 ? pow(A0 / A, 1.0 / m->weibull_modulus) : 1.0;
+            s->strength[f] = (float)(size * weibull_factor(m->strength_seed, f, m->weibull_modulus));
             s->strength_min = fmin(s->strength_min, s->strength[f]);
             s->strength_max = fmax(s->strength_max, s->strength[f]);
         }
@@ -326,9 +339,10 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->tf, s->tw, s->ep, s->wp, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
+                    s->cracked, s->crack_time, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
+    cf_crack_grid_free(&s->cracks);
     memset(s, 0, sizeof *s);
 }
 

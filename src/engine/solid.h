@@ -11,6 +11,7 @@
 
 #include "cohfrac/tetmesh.h"
 #include "cohfrac/types.h"
+#include "crack_grid.h"
 
 extern const int CF_TET_FACE[4][3];
 
@@ -82,6 +83,10 @@ typedef struct cf_solid {
     int *facet;               /* [nf][4] tetA, faceA, tetB, faceB (tetB = -1 on the boundary) */
     int *tet_facet;           /* [nt][4] facet of face k */
     unsigned char *cracked;   /* [nf] */
+    double *crack_time;       /* [nf] s, when each cracked facet was inserted */
+    double nucleation_radius; /* m (material.nucleation_radius, l_ch when 0) */
+    cf_crack_grid cracks;     /* rest centroids of the cracked facets, by place
+                                 (crack_growth "fronts") */
     unsigned char *candidate; /* [nf] may crack (NULL: every interior facet) */
     float *strength;          /* [nf] facet strength / sigma_max (material.strength;
                                  NULL: 1 everywhere) */

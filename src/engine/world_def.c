@@ -46,6 +46,7 @@ cf_solver_settings cf_default_solver(void)
     s.ccd = 1;
     s.elasticity = CF_ELASTICITY_COROTATIONAL;
     s.criterion = CF_CRITERION_TRACTION;
+    s.crack_growth = CF_GROWTH_FRONTS, s.min_piece_tets = 4;
     s.crack_plane_normal[2] = 1.0, s.crack_plane_tolerance = 1e-6;
     s.constraints = CF_CONSTRAINTS_PBD;
     s.k_stiffness = 0.9, s.iterations = 3, s.k_damping = 1.0;
@@ -109,6 +110,7 @@ static const interval UNIT = {0.0, 1.0, 1, 1};
 static const interval POISSON = {-1.0, 0.5, 0, 0};
 static const interval PPR_SHAPE = {1.0, INFINITY, 0, 0};
 static const interval ITERATIONS = {1.0, CF_MAX_ITERATIONS, 1, 1};
+static const interval PIECE_TETS = {0.0, CF_MAX_PIECE_TETS, 1, 1};
 
 static cf_status in_interval(const char *key, double v, const interval *r, cf_error *err)
 {
@@ -222,6 +224,8 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("material.friction", m->friction, NON_NEGATIVE);
     CHECK("material.restitution", m->restitution, UNIT);
     CHECK("material.strength.modulus", m->weibull_modulus, POSITIVE);
+    CHECK("material.strength.area", m->strength_area, NON_NEGATIVE);
+    CHECK("material.nucleation_radius", m->nucleation_radius, NON_NEGATIVE);
     CHECK("solver.dt_rigid", s->dt_rigid, POSITIVE);
     CHECK("solver.rigid_substeps", s->rigid_substeps, ITERATIONS);
     CHECK("solver.dt_fracture", s->dt_fracture, POSITIVE);
@@ -243,6 +247,7 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("solver.cfl_fraction", s->cfl_fraction, NON_NEGATIVE);
     CHECK("solver.check_interval", s->check_interval, AT_LEAST_ONE);
     CHECK("solver.quiet_steps", s->quiet_steps, AT_LEAST_ONE);
+    CHECK("solver.min_piece_tets", s->min_piece_tets, PIECE_TETS);
     CHECK("solver.max_fracture_time", s->max_fracture_time, POSITIVE);
     CHECK("solver.impact_threshold", s->impact_threshold, NON_NEGATIVE);
     CHECK("solver.sleeping.linear", s->sleep_linear, NON_NEGATIVE);

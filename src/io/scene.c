@@ -51,8 +51,8 @@ static const char *const top_keys[] = {"name",     "duration", "gravity",   "mat
 static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
                                             "sigma_max", "alpha", "G_II", "tau_max",
                                             "beta",  "friction", "restitution", "compressive_strength",
-                                            "strength"};
-static const char *const strength_keys[] = {"distribution", "modulus", "seed"};
+                                            "strength", "nucleation_radius"};
+static const char *const strength_keys[] = {"distribution", "modulus", "seed", "area"};
 static const char *const distribution_names[] = {"uniform", "weibull"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
                                         "velocity", "angular_velocity", "expansion_rate",
@@ -80,6 +80,7 @@ static const char *const solver_keys[] = {
     "dt_fracture",       "cfl_fraction",     "check_interval", "quiet_steps",
     "max_fracture_time",
     "impact_threshold",  "elasticity",       "criterion",      "crack_plane",
+    "crack_growth",      "min_piece_tets",
     "constraints",       "pbd",              "xpbd",           "contact_stiffness",
     "guard",             "threads"};
 static const char *const sleeping_keys[] = {"linear", "angular"};
@@ -101,6 +102,7 @@ static const char *const backend_names[] = {"bullet", "pbd"};
 static const char *const elasticity_names[] = {"corotational", "linear"};
 static const char *const criterion_names[] = {"traction", "source", "none"};
 static const char *const constraints_names[] = {"pbd", "xpbd", "none"};
+static const char *const growth_names[] = {"fronts", "all"};
 _Static_assert(CF_PRIM_NONE == 0 && CF_PRIM_BOX == 1 && CF_PRIM_SPHERE == 2 &&
                    CF_PRIM_HOLLOW_SPHERE == 3 && CF_PRIM_PLATE == 4 && CF_PRIM_NOTCHED_BEAM == 5,
                "primitive_names follows cf_primitive_type");
@@ -115,6 +117,7 @@ _Static_assert(CF_ELASTICITY_COROTATIONAL == 0 && CF_ELASTICITY_LINEAR == 1,
                "elasticity_names follows cf_elasticity");
 _Static_assert(CF_CRITERION_TRACTION == 0 && CF_CRITERION_SOURCE == 1 && CF_CRITERION_NONE == 2,
                "criterion_names follows cf_criterion");
+_Static_assert(CF_GROWTH_FRONTS == 0 && CF_GROWTH_ALL == 1, "growth_names follows cf_crack_growth");
 _Static_assert(CF_CONSTRAINTS_PBD == 0 && CF_CONSTRAINTS_XPBD == 1 && CF_CONSTRAINTS_NONE == 2,
                "constraints_names follows cf_constraints");
 
@@ -129,6 +132,7 @@ static const range POSITIVE = {0.0, INFINITY, 0, 0, NULL};
 static const range ANY_INTEGER = {-INFINITY, INFINITY, 1, 1, NULL};
 static const range NON_NEGATIVE = {0.0, INFINITY, 1, 0, NULL};
 static const range AT_LEAST_ONE = {1.0, INFINITY, 1, 0, NULL};
+static const range PIECE_TETS = {0.0, CF_MAX_PIECE_TETS, 1, 1, NULL};
 static const range UNIT = {0.0, 1.0, 1, 1, NULL};
 static const range POISSON = {-1.0, 0.5, 0, 0,
                               "(Poisson's ratio of a stable isotropic solid)"};
@@ -801,12 +805,13 @@ static cf_status resolve_surface(loader *ld, const char *key, const char *name, 
 
 static cf_status read_strength(loader *ld, int t, cf_material *m)
 {
-    static const double modulus = 10.0;
+    static const double modulus = 10.0, area = 0.0;
     TRY(check_keys(ld, t, strength_keys, COUNT(strength_keys)));
     TRY(get_enum(ld, t, "distribution", distribution_names, COUNT(distribution_names), 0,
                  &m->weibull));
     TRY(get_num(ld, t, "modulus", &modulus, &POSITIVE, &m->weibull_modulus));
     TRY(get_int(ld, t, "seed", 1, &ANY_INTEGER, &m->strength_seed));
+    TRY(get_num(ld, t, "area", &area, &NON_NEGATIVE, &m->strength_area));
     return CF_OK;
 }
 
@@ -829,6 +834,7 @@ static cf_status read_material(loader *ld, int t, cf_material *m)
     TRY(get_num(ld, t, "friction", &friction, &NON_NEGATIVE, &m->friction));
     TRY(get_num(ld, t, "restitution", &restitution, &restitution_range, &m->restitution));
     TRY(get_num(ld, t, "compressive_strength", &none, &NON_NEGATIVE, &m->compressive_strength));
+    TRY(get_num(ld, t, "nucleation_radius", &none, &NON_NEGATIVE, &m->nucleation_radius));
     WITH_TABLE(ld, t, "strength", read_strength(ld, lua_gettop(ld->L), m));
     return CF_OK;
 }
@@ -1175,7 +1181,7 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     static const double dt_rigid = 1e-3, dt_fracture = 5e-6, max_fracture_time = 0.05,
                         impact_threshold = 0.2, contact_stiffness = 0.0, cfl_fraction = 0.0;
     lua_State *L = ld->L;
-    int mode, backend, elasticity, criterion, constraints;
+    int mode, backend, elasticity, criterion, growth, constraints;
     TRY(check_keys(ld, t, solver_keys, COUNT(solver_keys)));
     TRY(get_enum(ld, t, "mode", mode_names, COUNT(mode_names), CF_RUN_HYBRID, &mode));
     s->mode = (cf_run_mode)mode;
@@ -1204,6 +1210,10 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     TRY(get_enum(ld, t, "criterion", criterion_names, COUNT(criterion_names),
                  CF_CRITERION_TRACTION, &criterion));
     s->criterion = (cf_criterion)criterion;
+    TRY(get_enum(ld, t, "crack_growth", growth_names, COUNT(growth_names), CF_GROWTH_FRONTS,
+                 &growth));
+    s->crack_growth = (cf_crack_growth)growth;
+    TRY(get_int(ld, t, "min_piece_tets", 4, &PIECE_TETS, &s->min_piece_tets));
     s->has_crack_plane = 0;
     if (raw_get(L, t, "crack_plane") != LUA_TNIL) {
         lua_pop(L, 1);
@@ -1726,10 +1736,12 @@ static char *resolved_text(const cf_world_def *s)
     put_num(&b, 4, "friction", m->friction);
     put_num(&b, 4, "restitution", m->restitution);
     put_num(&b, 4, "compressive_strength", m->compressive_strength);
+    put_num(&b, 4, "nucleation_radius", m->nucleation_radius);
     put(&b, "    strength = {\n");
     put_str(&b, 6, "distribution", distribution_names[m->weibull]);
     put_num(&b, 6, "modulus", m->weibull_modulus);
     put_num(&b, 6, "seed", m->strength_seed);
+    put_num(&b, 6, "area", m->strength_area);
     put(&b, "    },\n");
     put(&b, "  },\n  bodies = {\n");
     for (int i = 0; i < s->n_bodies; i++) {
@@ -1803,6 +1815,8 @@ static char *resolved_text(const cf_world_def *s)
     put_num(&b, 4, "impact_threshold", v->impact_threshold);
     put_str(&b, 4, "elasticity", elasticity_names[v->elasticity]);
     put_str(&b, 4, "criterion", criterion_names[v->criterion]);
+    put_str(&b, 4, "crack_growth", growth_names[v->crack_growth]);
+    put(&b, "    min_piece_tets = %d,\n", v->min_piece_tets);
     if (v->has_crack_plane) {
         put(&b, "    crack_plane = {\n");
         put_vec(&b, 6, "point", v->crack_plane_point, 3);
