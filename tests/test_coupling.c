@@ -244,6 +244,55 @@ static void test_determinism_hash_coloured(void **state)
     assert_true(h[0] == STORED_HASH_COLOURED_SOURCE);
 }
 
+/* A weak box whose cohesive law never lets go (a final opening of 10 km)
+ * lands, cracks and goes back to rigid mode.  Its cracks cut it into
+ * pieces that share no node, but every one is still held by a cohesive
+ * element with unfailed node pairs: it goes back as one body, and the
+ * elements stay in the solid with their state for the next impact. */
+static const char *bonded_scene =
+    "return {\n"
+    "  name = 'bonded', duration = 0.05,\n"
+    "  material = {E = 1e5, nu = 0.3, rho = 1000, G_I = 1e6, sigma_max = 200,\n"
+    "              friction = 0.5, restitution = 0},\n"
+    "  bodies = {\n"
+    "    {mesh = {type = 'box', size = {0.15, 0.15, 0.15}, cells = {3, 3, 3}, tets_per_cell = 5},\n"
+    "     position = {0, 0, 0.08}, velocity = {0, 0, -4}},\n"
+    "  },\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {dt_rigid = 1e-3, dt_fracture = 1e-4, quiet_steps = 100,\n"
+    "            crack_growth = 'all', min_piece_tets = 0},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void test_handoff_keeps_bonded_pieces_together(void **state)
+{
+    (void)state;
+    cf_world_def sc;
+    cf_sim *sim = make_sim(bonded_scene, &sc);
+    run_to_end(sim);
+    const cf_world *w = cf_sim_world(sim);
+    int alive = 0, rigid = 0, fi = -1;
+    for (int i = 0; i < w->n_frag; i++)
+        if (w->frag[i].mode != CF_MODE_DEAD)
+            alive++, rigid += w->frag[i].mode == CF_MODE_RIGID, fi = i;
+    int failed = 0;
+    for (int c = 0; c < w->solid.n_coh; c++)
+        failed += w->solid.coh[c].failed[0] && w->solid.coh[c].failed[1] && w->solid.coh[c].failed[2];
+    int *comp = malloc((size_t)w->frag[fi].nt * sizeof(int));
+    int by_nodes = cf_label_components(&w->solid, w->frag[fi].tets, w->frag[fi].nt, comp);
+    printf("FIGURE bonded: %d cohesive elements (%d failed), %d hand-offs, %d fragment(s) alive, "
+           "%d pieces by shared nodes alone\n",
+           w->solid.n_coh, failed, w->n_handoffs, alive, by_nodes);
+    assert_true(w->n_handoffs >= 2); /* rigid -> fracture -> rigid */
+    assert_int_equal(failed, 0);
+    assert_true(by_nodes >= 2); /* the cracks do cut it */
+    assert_int_equal(alive, 1);
+    assert_int_equal(rigid, 1);
+    free(comp);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
 /* A weak box lands on the ground at 4 m/s and breaks; a sweeper box then
  * runs along the ground at 6 m/s into its pieces.  Its cohesive length
  * (2.5 m) is far above its size, so the front rule would grow one crack
@@ -464,6 +513,7 @@ int main(void)
         cmocka_unit_test(test_mesh_obstacle_matches_plane),
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),
         cmocka_unit_test(test_fracture_only_fragments_and_weibull),
+        cmocka_unit_test(test_handoff_keeps_bonded_pieces_together),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -484,7 +484,11 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         free(comp), free(seen);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
     }
-    int k = cf_label_components(s, tets, nt, comp);
+    /* Pieces still joined by a cohesive element with an unfailed node pair
+     * go back as one body, and the element keeps its state for the next
+     * impact (its stored energy is dropped below, as a rigid body stores
+     * none): only what has come apart leaves on its own. */
+    int k = cf_label_pieces(s, tets, nt, f->coh.v, f->coh.n, comp);
     int *cstart = NULL, *grouped = k < 1 ? NULL : group_by_component(tets, comp, nt, k, &cstart);
     free(comp);
     if (!grouped) { /* k -1: out of memory; 0 components would empty the fragment */
