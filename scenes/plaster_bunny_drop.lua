@@ -9,16 +9,22 @@
 -- Method: explicit fracture mode (constraints "none") at 0.5 dt_cfl
 -- (42 ns), the only setting the stability map (`cohfrac stability`) finds
 -- stable for a real stiff material; the source's nodal maximum-principal
--- stress rule (Rankine, tension only) inserts cohesive elements; a fragment
--- stays in fracture mode until 5,000 steps (0.21 ms, about a wave's return
--- trip through its 0.23 m height) pass with no insertion.
+-- stress rule (Rankine, tension only) on the whole star of each vertex,
+-- with cracks that grow from fronts no faster than the Rayleigh speed,
+-- nucleate only clear of other cracks (radius l_ch = E G_I / sigma^2 =
+-- 12.5 mm) and never close a piece of 4 tets or fewer; a Weibull strength
+-- of weakest-link areas (docs/physics.md §5.1); a fragment stays in
+-- fracture mode until 5,000 steps (0.21 ms, about a wave's return trip
+-- through its 0.23 m height) pass with no insertion, and goes back to
+-- rigid mode as the pieces still held by a cohesive element.
 -- Mesh: the bunny at about 1,000 tets (`bunny_1k`, 993 tets, prepared by
--- `make run`); about a minute on one thread here.
--- Expected (seed 1): four pieces of at least 5% of the mass (about 37, 20,
--- 11 and 5%) and about 280 single-tet chips; of the 78 J it lands with,
--- about 39 J go into crushing and 3.3 J into the cracks; the fastest piece leaves at about 7 m/s against the bound
--- 8 m/s of tools/check_physics.py.  Other seeds give two large halves and
--- pieces of 2-7% (docs/physics.md §14.9).
+-- `make run`); about 30 s on one thread here.
+-- Expected (seed 1): four pieces of at least 5% of the mass (about 33, 22,
+-- 20 and 6%), a few of 1-5% and no chip of 4 tets or fewer; of the 78 J it
+-- lands with, about 39 J go into crushing and 3 J into the cracks; the
+-- fastest piece leaves at about 4.4 m/s against the bound 7.8 m/s of
+-- tools/check_physics.py.  Seeds 2-5 give 4, 5, 2 and 4 pieces of at
+-- least 5% (docs/physics.md §14.10).
 return {
   name = "plaster_bunny_drop",
   duration = 0.65,

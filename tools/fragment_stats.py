@@ -1,0 +1,68 @@
+#!/usr/bin/python3
+"""The fragments of a cohfrac run at its last frame, as the fracture tables count them.
+
+usage: fragment_stats.py OUT.h5 [OUT.h5 ...] [--chip-tets N] [--json]
+
+For each file prints one line: the fragments alive at the last frame, the
+pieces holding at least 5 % of the mass (their shares, largest first), the
+share of the mass in chips (fragments of at most N tets, default 4), the
+fastest fragment (m/s) and the crack area (m^2, facets whose cohesive
+element has failed at every node pair, one side).  With --json, one JSON
+object per file instead.  Exit status 0, or 2 when a file cannot be read.
+"""
+import argparse
+import json
+import sys
+
+import h5py
+import numpy as np
+
+
+def stats(path, chip_tets):
+    with h5py.File(path, "r") as f:
+        ids = f["particles/fragments/id/value"][-1]
+        vel = f["particles/fragments/velocity/value"][-1]
+        mass = f["fragments/mass"][()]
+        n_tets = f["fragments/n_tets"][()]
+        crack = f["observables/crack_area/value"][-1] if "observables/crack_area" in f else float("nan")
+    alive = ids >= 0
+    ids, vel = ids[alive], vel[alive]
+    m, nt = mass[ids], n_tets[ids]
+    total = m.sum()
+    share = np.sort(m / total)[::-1]
+    speed = np.linalg.norm(vel, axis=1)
+    return {
+        "file": path,
+        "fragments": int(len(ids)),
+        "pieces_5pct": [round(float(s), 4) for s in share[share >= 0.05]],
+        "pieces_1pct": int((share >= 0.01).sum()),
+        "chip_share": float(m[nt <= chip_tets].sum() / total),
+        "fastest": float(speed.max()) if len(speed) else 0.0,
+        "crack_area": float(crack),
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("files", nargs="+")
+    ap.add_argument("--chip-tets", type=int, default=4)
+    ap.add_argument("--json", action="store_true")
+    a = ap.parse_args()
+    for p in a.files:
+        try:
+            s = stats(p, a.chip_tets)
+        except (OSError, KeyError) as e:
+            print(f"fragment_stats.py: {p}: {e}", file=sys.stderr)
+            return 2
+        if a.json:
+            print(json.dumps(s))
+        else:
+            pieces = ", ".join(f"{100 * x:.1f}" for x in s["pieces_5pct"])
+            print(f"{p}: {s['fragments']} fragments, {len(s['pieces_5pct'])} pieces >= 5 % "
+                  f"({pieces}), {s['pieces_1pct']} >= 1 %, chips {100 * s['chip_share']:.1f} %, "
+                  f"fastest {s['fastest']:.2f} m/s, crack area {s['crack_area']:.4g} m^2")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
