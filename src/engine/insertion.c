@@ -82,6 +82,10 @@ static double nodal_principal(const cf_solid *s, int n, int frag, double lowest)
     return bound < lowest ? bound : max_principal(sig);
 }
 
+/* The source rule's threshold for a facet of strength factor w, Pa: 0.9 of
+ * its strength (the source's §6.6.2). */
+static double source_threshold(double sigma_max, double w) { return 0.9 * sigma_max * w; }
+
 /* Normal and shear traction (Pa) on face k of tet ta from the mean stress of
  * the facet's two tets, across its current normal. */
 static void facet_traction(const cf_solid *s, int ta, int k, double *sn, double *tau)
@@ -185,7 +189,7 @@ static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion ru
             continue;
         double w = s->strength ? s->strength[f] : 1.0; /* this facet's strength */
         if (rule == CF_CRITERION_SOURCE) {
-            bits |= (unsigned char)(source_rule(s, ta, k, 0.9 * smax * w) << k);
+            bits |= (unsigned char)(source_rule(s, ta, k, source_threshold(smax, w)) << k);
             continue;
         }
         if (!s->hot[ta] && !s->hot[F[2]]) /* the mean stress is below both bounds */
@@ -202,7 +206,7 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule)
     cf_stress_check c = {INFINITY, INFINITY};
     double w = s->strength ? s->strength_min : 1.0; /* the weakest facet */
     if (rule == CF_CRITERION_SOURCE)
-        c.s1 = 0.9 * s->mat.sigma_max * w;
+        c.s1 = source_threshold(s->mat.sigma_max, w);
     else if (rule == CF_CRITERION_TRACTION)
         c.s1 = s->mat.sigma_max * w, c.tau = s->mat.tau_max * w;
     return c;
@@ -428,7 +432,6 @@ int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched)
     return 0;
 }
 
-
 /* How far qualifying facet f exceeds its strength, at least 1: the smallest
  * of its three nodal values over the facet's threshold (source), or the
  * larger of sigma_n / sigma_max_f and tau / tau_max_f (traction), from the
@@ -439,9 +442,10 @@ static double facet_ratio(const cf_solid *s, int f, cf_criterion rule)
     const int *F = &s->facet[4 * f];
     double w = s->strength ? s->strength[f] : 1.0, r;
     if (rule == CF_CRITERION_SOURCE) {
+        double threshold = source_threshold(s->mat.sigma_max, w);
         r = INFINITY;
         for (int j = 0; j < 3; j++) {
-            double q = s->nodal[s->tet[4 * F[0] + CF_TET_FACE[F[1]][j]]] / (0.9 * s->mat.sigma_max * w);
+            double q = s->nodal[s->tet[4 * F[0] + CF_TET_FACE[F[1]][j]]] / threshold;
             r = q < r ? q : r;
         }
     } else {
@@ -466,27 +470,28 @@ static void centroid(const cf_solid *s, const int o[3], double c[3])
         c[k] = (s->X[3 * o[0] + k] + s->X[3 * o[1] + k] + s->X[3 * o[2] + k]) / 3.0;
 }
 
-/* Rest distance between the centroids of two triangles of original vertices. */
-static double centroid_distance(const cf_solid *s, const int a[3], const int b[3])
+/* Rest distance from point c to the centroid of a triangle of original
+ * vertices, m. */
+static double centroid_distance(const cf_solid *s, const double c[3], const int o[3])
 {
-    double ca[3], cb[3], d[3];
-    centroid(s, a, ca), centroid(s, b, cb);
-    v3_sub(ca, cb, d);
+    double co[3], d[3];
+    centroid(s, o, co);
+    v3_sub(c, co, d);
     return v3_norm(d);
 }
 
-/* How facet f meets the cracks at time t: CF_FRONT when it shares an edge
+/* How facet f (original vertices o, rest centroid c) meets the cracks at
+ * time t: CF_FRONT when it shares an edge
  * with a cracked facet inserted at least d / speed earlier (d between their
  * rest centroids: a front moves no faster than `speed`); CF_TOUCH when it
  * meets a cracked facet otherwise (at a vertex, or across an edge the crack
  * reached too recently, this check's insertions included); CF_CLEAR when it
  * meets none. */
 enum { CF_CLEAR, CF_TOUCH, CF_FRONT };
-static int crack_contact(const cf_solid *s, int f, double t, double speed)
+static int crack_contact(const cf_solid *s, int f, const int o[3], const double c[3], double t,
+                         double speed)
 {
-    const int *F = &s->facet[4 * f];
-    int o[3], touch = CF_CLEAR;
-    face_vertices(s, F[0], F[1], o);
+    int touch = CF_CLEAR;
     for (int a = 0; a < 3; a++)
         for (int j = s->vt_start[o[a]]; j < s->vt_start[o[a] + 1]; j++) {
             int slot = s->vt_slot[j], tt = slot / 4;
@@ -498,7 +503,7 @@ static int crack_contact(const cf_solid *s, int f, double t, double speed)
                 face_vertices(s, tt, k, og);
                 for (int p = 0; p < 3; p++)
                     shared += og[p] == o[0] || og[p] == o[1] || og[p] == o[2];
-                if (shared == 2 && t - s->crack_time[g] >= centroid_distance(s, o, og) / speed)
+                if (shared == 2 && t - s->crack_time[g] >= centroid_distance(s, c, og) / speed)
                     return CF_FRONT;
                 touch = CF_TOUCH;
             }
@@ -571,10 +576,11 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
          * one (the largest ratio around it, as the ratios come in falling
          * order and any facet taken before touches it); a facet that only
          * touches a crack does neither. */
-        int contact = crack_contact(s, f, g->t, g->front_speed), o[3];
+        int o[3];
         double c[3], q = r[i].ratio;
         face_vertices(s, ta, s->facet[4 * f + 1], o);
         centroid(s, o, c);
+        int contact = crack_contact(s, f, o, c, g->t, g->front_speed);
         /* A crack shields a radius that shrinks as 1/ratio^2 (Irwin: the
          * flaw that is critical at a stress sigma grows as
          * l_ch (sigma_max / sigma)^2), so an overloaded solid still
