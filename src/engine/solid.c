@@ -209,13 +209,12 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
         /* Weakest-link scaling (Zhou and Molinari 2004): a facet of area A
          * draws at scale (A0/A)^(1/m), so the strength of a surface does not
          * depend on how many facets the mesh divides it into. */
-        const cf_material *m = mt;
-        double A0 = m->strength_area > 0 ? m->strength_area : l_ch * l_ch;
+        double A0 = mt->strength_area > 0 ? mt->strength_area : l_ch * l_ch;
         for (int f = 0; f < s->n_facets; f++) {
             const int *T = &s->tet0[4 * s->facet[4 * f]], *k = CF_TET_FACE[s->facet[4 * f + 1]];
             double A = tri_area(&s->X[3 * T[k[0]]], &s->X[3 * T[k[1]]], &s->X[3 * T[k[2]]]);
-            double size = A > 0 ? pow(A0 / A, 1.0 / m->weibull_modulus) : 1.0;
-            s->strength[f] = (float)(size * weibull_factor(m->strength_seed, f, m->weibull_modulus));
+            double size = A > 0 ? pow(A0 / A, 1.0 / mt->weibull_modulus) : 1.0;
+            s->strength[f] = (float)(size * weibull_factor(mt->strength_seed, f, mt->weibull_modulus));
             s->strength_min = fmin(s->strength_min, s->strength[f]);
             s->strength_max = fmax(s->strength_max, s->strength[f]);
         }
