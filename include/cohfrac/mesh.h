@@ -41,6 +41,29 @@ cf_status cf_mesh_load_tetgen_unchecked(const char *base, cf_mesh *m, cf_error *
  * det[x1-x0, x2-x0, x3-x0] > 0.  Returns the number of tets flipped. */
 int cf_mesh_orient_positive(cf_mesh *m);
 
+/* What sets a Tet4 mesh's explicit step (src/mesh/mesh_quality.c). */
+typedef struct cf_mesh_quality {
+    double min_dihedral; /* smallest dihedral angle of any tet, degrees */
+    double dt_ratio;     /* dt_cfl of the worst tet over that of the median one: the
+                          * ratio of twice their inradii (dt_cfl = h / c_d,
+                          * docs/physics.md §3); 1 for a uniform mesh */
+    int worst_tet;       /* the tet that sets dt_cfl (0-based), -1 without tets */
+} cf_mesh_quality;
+
+/* The quality of m; NANs and worst_tet -1 for an empty mesh or no memory. */
+cf_mesh_quality cf_mesh_quality_of(const cf_mesh *m);
+
+/* Peel boundary slivers: remove each tet thinner than `fraction` of the
+ * median h (twice the inradius, as measured before peeling) that has two or
+ * three faces on the surface, where removing it leaves the surface a closed
+ * 2-manifold (an edge flip of the surface, or one surface node fewer).
+ * Nodes no tet uses any more are dropped and the rest renumbered in order.
+ * *peeled gets the tets removed, *volume their volume (m^3).  Errors:
+ * CF_ERR_USAGE (the mesh has node groups, whose numbering would break),
+ * CF_ERR_NOMEM. */
+cf_status cf_mesh_peel_slivers(cf_mesh *m, double fraction, int *peeled, double *volume,
+                               cf_error *err);
+
 /* Write `<base>.node` and `<base>.ele` (0-based, coordinates with %.17g so
  * they read back bit-exactly; `base` may carry either extension).  Each file
  * is written under a temporary name and renamed.  Errors: CF_ERR_OUTPUT,

@@ -120,7 +120,11 @@ typedef struct cf_mesh_prep_opts {
 /* Load, report self-intersections (face indices) and repair them, check the
  * surface is a closed manifold, coarsen it if `target_tets` needs it, run
  * tetgen, orient every tet positively, check the tets' total volume against
- * the surface's enclosed volume (1e-5 relative), and write
+ * the surface's enclosed volume (1e-5 relative), peel the boundary caps
+ * thinner than 0.25 of the median tet (cf_mesh_peel_slivers: the surface
+ * changes by their volume, about 0.1-0.2 % of it), print the smallest
+ * dihedral angle and dt_cfl of the worst tet over the median's (verbose),
+ * and write
  * <output>.node/.ele (0-based, %.17g; coordinates in the surface's file
  * units and axes: no scaling or rotation).  The output directory is created
  * if missing.  Skips all work (printing "cached" when verbose) when the

@@ -4,7 +4,9 @@
  * it is closed, coarsen it (meshoptimizer, cf_surface_decimate) when the wanted tet count
  * needs a coarser boundary, run the `tetgen` program (never linked: AGPL),
  * orient every tet positively, check the tet volume against the surface's
- * enclosed volume and write <output>.node/.ele plus a stamp for caching.
+ * enclosed volume, peel the boundary caps that would set the explicit step
+ * (cf_mesh_peel_slivers, docs/physics.md §3.1), report the quality that sets
+ * it, and write <output>.node/.ele plus a stamp for caching.
  *
  * Size selection for target_tets = N > 0 (everything is deterministic, so
  * the same input always gives the same mesh):
@@ -48,13 +50,15 @@
 
 /* Bump when the pipeline changes in a way that changes its output, so old
  * cached meshes are rebuilt. */
-#define PREP_VERSION "cohfrac-mesh 2 (assimp; repair valence3; meshoptimizer; tetgen -pYq2.0 [-a])"
+#define PREP_VERSION                                                                          \
+    "cohfrac-mesh 3 (assimp; repair valence3; meshoptimizer; tetgen -pYq2.0 [-a]; peel 0.25)"
 #define TETS_PER_TRI 2.4 /* tetgen -pYq2.0 tets per surface triangle (bunny: 2.3-2.5) */
 #define BASE_OPTS "pYq2.0"
 #define TOL 0.05
 #define MAX_A_RUNS 8
 #define MAX_SUBDIVISIONS 3 /* 64 x the triangles at most */
 #define MISS_ALLOWED 0.25  /* the target met within 25 %, or an error */
+#define PEEL_FRACTION 0.25 /* boundary caps thinner than this x the median h are peeled */
 
 static char *str_cat(const char *a, const char *b)
 {
@@ -569,6 +573,16 @@ static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_su
 
 /* ---- the command ---------------------------------------------------------- */
 
+/* Prints what sets the mesh's explicit step (cf_mesh_quality_of). */
+static void report_quality(const cf_mesh *m)
+{
+    cf_mesh_quality q = cf_mesh_quality_of(m);
+    fprintf(stderr,
+            "  quality: smallest dihedral angle %.2f deg; dt_cfl of the worst tet (%d) / the "
+            "median's %.3f\n",
+            q.min_dihedral, q.worst_tet, q.dt_ratio);
+}
+
 static cf_status write_stamp(const cf_mesh_prep_opts *o, const char *key, const char *opts,
                              int n_tris, const cf_mesh *m, cf_error *err)
 {
@@ -581,8 +595,11 @@ static cf_status write_stamp(const cf_mesh_prep_opts *o, const char *key, const 
                                  "%s: cannot write (%s)", tmp, strerror(errno));
     } else {
         fprintf(f, "%s", key);
-        fprintf(f, "# informational\ntetgen -%s\nsurface_triangles %d\nnodes %d\ntets %d\n",
-                opts, n_tris, m->n_nodes, m->n_tets);
+        cf_mesh_quality q = cf_mesh_quality_of(m);
+        fprintf(f,
+                "# informational\ntetgen -%s\nsurface_triangles %d\nnodes %d\ntets %d\n"
+                "min_dihedral_deg %.4g\ndt_cfl_worst_over_median %.4g\n",
+                opts, n_tris, m->n_nodes, m->n_tets, q.min_dihedral, q.dt_ratio);
         int bad = ferror(f);
         bad |= fclose(f) != 0;
         if (bad || rename(tmp, sp) != 0)
@@ -606,8 +623,14 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
     if (st != CF_OK)
         return st;
     if (cache_valid(o, key)) {
-        if (o->verbose)
+        if (o->verbose) {
             fprintf(stderr, "cohfrac mesh: %s.node/.ele up to date (cached)\n", o->output);
+            cf_mesh m = {0};
+            cf_error ignored;
+            if (cf_mesh_load_tetgen(o->output, &m, &ignored) == CF_OK)
+                report_quality(&m);
+            cf_mesh_free(&m);
+        }
         return CF_OK;
     }
     if ((st = make_parent_dirs(o->output, err)) != CF_OK)
@@ -676,6 +699,20 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
                           "check the surface is closed and does not intersect itself",
                           best.opts, vm, vs, rel);
         goto out;
+    }
+    /* Boundary caps set the explicit step where -Y keeps the surface
+     * (src/mesh/mesh_quality.c); peeling them changes the volume by theirs. */
+    int peeled;
+    double peeled_volume;
+    if ((st = cf_mesh_peel_slivers(&best.m, PEEL_FRACTION, &peeled, &peeled_volume, err)) !=
+        CF_OK)
+        goto out;
+    if (o->verbose) {
+        fprintf(stderr,
+                "  slivers: %d boundary cap(s) thinner than %.2g x the median tet peeled "
+                "(%.2g of the volume)\n",
+                peeled, PEEL_FRACTION, peeled_volume / vm);
+        report_quality(&best.m);
     }
     if ((st = cf_mesh_write_tetgen(&best.m, o->output, err)) != CF_OK ||
         (st = write_stamp(o, key, best.opts, used->n_tris, &best.m, err)) != CF_OK)
