@@ -1,4 +1,4 @@
-/* End to end on the 993-tet bunny: the default drop (gypsum plaster, a
+/* End to end on the 979-tet bunny: the default drop (gypsum plaster, a
  * 1.3 m fall onto its side, cut short 20 ms after the touch) falls in
  * Bullet, breaks in fracture mode into pieces of which at least two hold
  * 5 % of the mass each, and every hand-off conserves linear momentum to
