@@ -147,9 +147,11 @@ else
 fi
 
 # SIGINT and SIGTERM: the step ends, a last frame, the file closes whole.
+# The drop is lengthened so that it cannot end before the signal comes.
 for sig in INT TERM; do
     want=130; [ $sig = TERM ] && want=143
-    "$exe" run "$src/scenes/bunny_drop.lua" -q -m "$meshes" -o "$tmp/sig.h5" >/dev/null 2>"$tmp/sig.err" &
+    "$exe" run "$src/scenes/bunny_drop.lua" -q -m "$meshes" -o "$tmp/sig.h5" --set duration=60 \
+        >/dev/null 2>"$tmp/sig.err" &
     pid=$!
     sleep 3
     kill -$sig $pid
