@@ -293,6 +293,30 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
     }
 }
 
+/* A piece going back to rigid mode is its rest shape at the pose fitted
+ * to its deformed nodes, and where a body still pressed the ground that
+ * shape reaches into it by about the compression.  Bullet's push-out of
+ * such an overlap reads as a fresh impact, and the piece went straight
+ * back to fracture mode; the pose is lifted clear of every obstacle
+ * instead (the translation alone: momenta stay as they are). */
+static void lift_clear(cf_world *sim, const cf_fragment *g, double com[3], const double R[9])
+{
+    const cf_solid *s = &sim->solid;
+    for (int j = 0; j < sim->obs.n; j++) {
+        double deepest = 0, n[3] = {0, 0, 0};
+        for (int i = 0; i < g->nodes.n; i++) {
+            double r[3], x[3], nj[3];
+            v3_sub(&s->X[3 * g->nodes.v[i]], g->com_rest, r);
+            m3_mulv(R, r, x);
+            v3_axpy(1.0, com, x);
+            double d = cf_obstacle_distance(&sim->obs, j, sim->t, x, nj);
+            if (d < deepest)
+                deepest = d, memcpy(n, nj, sizeof n);
+        }
+        v3_axpy(-deepest, n, com);
+    }
+}
+
 cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
@@ -330,6 +354,7 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     f->steps = f->quiet = 0;
     f->t_enter = sim->t;
     cf_fragment_ledger_reset(sim, fi);
+    f->e_enter = f->e_kin;
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
     cf_fragment_momenta(sim, fi, P1, L1);
@@ -433,6 +458,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         cf_fragment_rest_props(sim, ci);
         g->mode = CF_MODE_FRACTURE;
         g->steps = p->steps, g->quiet = p->quiet, g->t_enter = p->t_enter;
+        g->e_enter = p->e_enter;
         memcpy(g->q_match, p->q_match, sizeof g->q_match);
         g->e_strain = cf_tet4_strain_energy(s, g->tets, g->nt);
         for (int i = 0; i < g->nodes.n; i++) {
@@ -535,6 +561,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         rigid_velocity(g, &ns, w);
         ke_after += 0.5 * ns.M * v3_dot(ns.v, ns.v) + 0.5 * v3_dot(w, ns.L);
         if (sim->bullet) {
+            lift_clear(sim, g, ns.com, ns.R);
             cf_status st = cf_fragment_add_body(sim, ci, ns.com, ns.R, ns.v, w, err);
             if (st != CF_OK) {
                 free(grouped), free(cstart), free(seen);

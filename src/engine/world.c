@@ -1041,7 +1041,60 @@ static cf_status check_energy(cf_world *sim, cf_error *err)
     return diverged(sim, err, what);
 }
 
-/* Fracture-mode fragments that have been quiet long enough go back to rigid mode. */
+#define CF_CONTACT_SLOP 1e-9 /* m: a node projected onto an obstacle, up to round-off */
+#define CF_IMPACT_OVER 0.01  /* of the kinetic energy at entry: see impact_unfinished */
+
+/* Whether fracture-mode fragment fi is still in the middle of an impact:
+ * a node lies on an obstacle (or would reach it within a rigid step at the
+ * fragment's rigid-body velocity), and either its rigid-body velocity there
+ * approaches the obstacle faster than the impact threshold (rigid mode would
+ * see an impact at once), or the energy a hand-off would drop,
+ * the strain energy and the kinetic energy beyond the rigid-body motion,
+ * is more than CF_IMPACT_OVER of the kinetic energy it entered with.
+ * Handed back in the middle of its impact, a fragment hits again at once:
+ * it chattered between the modes (63 round trips on the 3,858-tet plaster
+ * bunny), every hand-off kept only the rigid part of the motion and gave
+ * the rest of the impact to Bullet's inelastic contact, and the stress
+ * wave that breaks a body never built up.  A body that rests on the ground
+ * holds next to no strain energy, so it still goes back
+ * (docs/physics.md §9). */
+static int impact_unfinished(cf_world *sim, int fi)
+{
+    const cf_fragment *f = &sim->frag[fi];
+    const cf_solid *s = &sim->solid;
+    double com[3], R[9], v[3], w[3], P[3], L[3], r[3], wr[3], vr[3];
+    double reach = sim->def.solver.dt_rigid;
+    cf_fragment_pose(sim, fi, com, R, v, w);
+    int touching = 0;
+    for (int i = 0; i < f->nodes.n; i++) {
+        const double *x = &s->x[3 * f->nodes.v[i]];
+        v3_sub(x, com, r);
+        v3_cross(w, r, wr);
+        for (int j = 0; j < sim->obs.n; j++) {
+            double n[3], u[3];
+            double d = cf_obstacle_distance(&sim->obs, j, sim->t, x, n);
+            cf_obstacle_velocity(&sim->obs.o[j], u);
+            for (int k = 0; k < 3; k++)
+                vr[k] = v[k] + wr[k] - u[k];
+            double approach = -v3_dot(vr, n);
+            if (d > fmax(0.0, approach) * reach + CF_CONTACT_SLOP)
+                continue;
+            if (approach > sim->def.solver.impact_threshold)
+                return 1; /* rigid mode would see an impact at once */
+            touching = 1;
+        }
+    }
+    if (!touching)
+        return 0;
+    cf_fragment_momenta(sim, fi, P, L);
+    v3_cross(com, P, r);
+    double rigid = 0.5 * f->mass * v3_dot(v, v) + 0.5 * (v3_dot(w, L) - v3_dot(w, r));
+    double deformation = f->e_strain + fmax(0.0, f->e_kin - rigid);
+    return deformation > CF_IMPACT_OVER * f->e_enter;
+}
+
+/* Fracture-mode fragments that have been quiet long enough, and no longer
+ * drive into an obstacle, go back to rigid mode. */
 static cf_status return_to_rigid(cf_world *sim, cf_error *err)
 {
     const cf_solver_settings *set = &sim->def.solver;
@@ -1050,7 +1103,8 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
         cf_fragment *f = &sim->frag[fi];
         if (f->mode != CF_MODE_FRACTURE)
             continue;
-        if (f->quiet < set->quiet_steps && sim->t - f->t_enter < set->max_fracture_time - 1e-12)
+        int timed_out = sim->t - f->t_enter >= set->max_fracture_time - 1e-12;
+        if (!timed_out && (f->quiet < set->quiet_steps || impact_unfinished(sim, fi)))
             continue;
         int first_new = sim->n_frag;
         double th = cf_wall_time();

@@ -48,6 +48,7 @@ typedef struct cf_fragment {
     int separated;           /* its cohesive elements with every node pair failed at the
                                 last split check; -1: not counted yet */
     double t_enter;          /* s, when fracture mode began */
+    double e_enter;          /* J, its kinetic energy when fracture mode began */
     int *contact;            /* [nodes.n] obstacle in contact after the last projection, -1 */
     double *vn_pre;          /* [nodes.n] normal velocity before projection, m/s */
     double *v_old;           /* [nodes.n][3] velocity at the start of the step, m/s */
