@@ -269,6 +269,33 @@ static void place_rigid(cf_solid *s, const cf_fragment *f, const double com[3], 
     }
 }
 
+/* How deep fragment f's nodes reach into obstacle j (m, <= 0), and the
+ * obstacle's normal at the deepest: at their current positions, or (R not
+ * NULL) at those of its rest shape placed with rotation R and centre of
+ * mass com. */
+static double deepest_overlap(const cf_world *sim, int j, const cf_fragment *f,
+                              const double com[3], const double R[9], double n[3])
+{
+    const cf_solid *s = &sim->solid;
+    double deepest = 0;
+    n[0] = n[1] = n[2] = 0;
+    for (int i = 0; i < f->nodes.n; i++) {
+        double x[3], nj[3];
+        if (R) {
+            double r[3];
+            v3_sub(&s->X[3 * f->nodes.v[i]], f->com_rest, r);
+            m3_mulv(R, r, x);
+            v3_axpy(1.0, com, x);
+        } else {
+            memcpy(x, &s->x[3 * f->nodes.v[i]], sizeof x);
+        }
+        double d = cf_obstacle_distance(&sim->obs, j, sim->t, x, nj);
+        if (d < deepest)
+            deepest = d, memcpy(n, nj, sizeof nj);
+    }
+    return deepest;
+}
+
 /* Translate fragment f out of every obstacle its placed nodes overlap (a
  * rigid pose from Bullet rests within the contact margin; a best rigid fit
  * of deformed nodes can reach below the ground).  In fracture mode the PBD
@@ -279,15 +306,7 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
 {
     cf_solid *s = &sim->solid;
     for (int j = 0; j < sim->obs.n; j++) {
-        double deepest = 0, n[3] = {0, 0, 0};
-        for (int i = 0; i < f->nodes.n; i++) {
-            double nj[3];
-            double d = cf_obstacle_distance(&sim->obs, j, sim->t, &s->x[3 * f->nodes.v[i]], nj);
-            if (d < deepest) {
-                deepest = d;
-                memcpy(n, nj, sizeof n);
-            }
-        }
+        double n[3], deepest = deepest_overlap(sim, j, f, NULL, NULL, n);
         for (int i = 0; deepest < 0 && i < f->nodes.n; i++)
             v3_axpy(-deepest, n, &s->x[3 * f->nodes.v[i]]);
     }
@@ -301,18 +320,8 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
  * instead (the translation alone: momenta stay as they are). */
 static void lift_clear(cf_world *sim, const cf_fragment *g, double com[3], const double R[9])
 {
-    const cf_solid *s = &sim->solid;
     for (int j = 0; j < sim->obs.n; j++) {
-        double deepest = 0, n[3] = {0, 0, 0};
-        for (int i = 0; i < g->nodes.n; i++) {
-            double r[3], x[3], nj[3];
-            v3_sub(&s->X[3 * g->nodes.v[i]], g->com_rest, r);
-            m3_mulv(R, r, x);
-            v3_axpy(1.0, com, x);
-            double d = cf_obstacle_distance(&sim->obs, j, sim->t, x, nj);
-            if (d < deepest)
-                deepest = d, memcpy(n, nj, sizeof n);
-        }
+        double n[3], deepest = deepest_overlap(sim, j, g, com, R, n);
         v3_axpy(-deepest, n, com);
     }
 }

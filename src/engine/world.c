@@ -1086,9 +1086,11 @@ static int impact_unfinished(cf_world *sim, int fi)
     }
     if (!touching)
         return 0;
+    double Lo[3]; /* the spin's angular momentum, about the centre of mass */
     cf_fragment_momenta(sim, fi, P, L);
     v3_cross(com, P, r);
-    double rigid = 0.5 * f->mass * v3_dot(v, v) + 0.5 * (v3_dot(w, L) - v3_dot(w, r));
+    v3_sub(L, r, Lo);
+    double rigid = 0.5 * f->mass * v3_dot(v, v) + 0.5 * v3_dot(w, Lo);
     double deformation = f->e_strain + fmax(0.0, f->e_kin - rigid);
     return deformation > CF_IMPACT_OVER * f->e_enter;
 }
