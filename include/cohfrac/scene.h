@@ -150,6 +150,14 @@
  *       (constraints = "none"; with PBD/XPBD the crack-contact constraint
  *       keeps the faces apart); 0 = the stability cap of each node pair,
  *       K_p A/3 = 1/(4 dt^2 (1/m_a + 1/m_b))
+ *     obstacle_contact ["kinematic"] | "penalty": how fracture-mode nodes
+ *       meet obstacles in explicit runs (docs/physics.md §7.1): "kinematic"
+ *       projects each node onto the surface and applies restitution per
+ *       node (plastic at restitution 0); "penalty" pushes a node behind the
+ *       surface out with a force k d, k = 0.1 m / dt^2 from its lumped mass
+ *       (a conservative spring: the body's own elasticity makes the
+ *       rebound, and the contact neither takes nor gives energy).  With
+ *       PBD or XPBD the projection keeps the kinematic contact.
  *     guard = { max_inverted_fraction [0.01], max_energy_growth [0.5] }:
  *       stop (exit 3) when more than this fraction of the tets of a body's
  *       fragments in fracture mode are inverted, or when the total energy exceeds the initial energy plus

@@ -124,6 +124,8 @@ typedef enum { CF_CONSTRAINTS_PBD, CF_CONSTRAINTS_XPBD, CF_CONSTRAINTS_NONE } cf
  * (docs/physics.md §5.1): those that extend a crack front or nucleate one
  * at a local maximum, or every one (the source's rule). */
 typedef enum { CF_GROWTH_FRONTS, CF_GROWTH_ALL } cf_crack_growth;
+/* How fracture-mode nodes meet obstacles in explicit runs (docs/physics.md §7.1). */
+typedef enum { CF_OBSTACLE_CONTACT_KINEMATIC, CF_OBSTACLE_CONTACT_PENALTY } cf_obstacle_contact;
 
 typedef struct cf_solver_settings {
     cf_run_mode mode;
@@ -153,6 +155,7 @@ typedef struct cf_solver_settings {
     int iteration_independent;
     double compliance_scale;
     double contact_stiffness;     /* Pa/m, 0 = stability cap */
+    cf_obstacle_contact obstacle_contact; /* explicit runs: kinematic or penalty */
     double max_inverted_fraction;
     double max_energy_growth;
     int threads;

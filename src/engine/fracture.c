@@ -82,6 +82,13 @@ static int explicit_step(const cf_solver_settings *set, int fracture)
     return fracture && set->constraints == CF_CONSTRAINTS_NONE;
 }
 
+/* Whether obstacles act on this step's nodes by a penalty force rather
+ * than the projection (explicit fracture steps, docs/physics.md §7.1). */
+static int penalty_step(const cf_solver_settings *set, int fracture)
+{
+    return explicit_step(set, fracture) && set->obstacle_contact == CF_OBSTACLE_CONTACT_PENALTY;
+}
+
 /* Energy a velocity change takes out of node i, J: from `from` to `to`.
  * The ledger's kinetic energy is the leapfrog product 1/2 m v_old . v
  * (update_velocities).  A change that also moves the node (`moves`: the
@@ -124,6 +131,7 @@ typedef struct {
     cf_fragment *f;
     double t_next, dt, dv[3];
     int leapfrog; /* contact_velocities: explicit friction moves the node */
+    int penalty;  /* obstacles act by the penalty force (penalty_contact) */
 } step_sums;
 
 /* Whether an obstacle is a triangle mesh: its FCL queries run on one thread. */
@@ -167,11 +175,15 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
         double vn = v3_dot(vr, n), vt[3];
         for (int k = 0; k < 3; k++)
             vt[k] = vr[k] - vn * n[k];
-        double vn_new = vn;
-        if (f->vn_pre[i] < 0 && vn < -e * f->vn_pre[i])
-            vn_new = -e * f->vn_pre[i];
+        double vn_new = vn, dvn;
+        if (c->penalty) { /* the penalty force's normal velocity change (penalty_contact) */
+            dvn = f->vn_pre[i];
+        } else {
+            if (f->vn_pre[i] < 0 && vn < -e * f->vn_pre[i])
+                vn_new = -e * f->vn_pre[i];
+            dvn = fabs(vn_new - (f->vn_pre[i] < 0 ? f->vn_pre[i] : 0));
+        }
         /* Coulomb: the tangential change is bounded by mu times the normal one. */
-        double dvn = fabs(vn_new - (f->vn_pre[i] < 0 ? f->vn_pre[i] : 0));
         double vtl = v3_norm(vt);
         double scale = vtl > 0 ? fmax(0.0, 1.0 - mu * dvn / vtl) : 0;
         double dv[3], vnew[3];
@@ -194,9 +206,9 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
  * shifted by dv (the speed cap's momentum, from project; zero: none); the
  * shift's energy is booked with the projection's. */
 static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog,
-                                 const double dv[3])
+                                 int penalty, const double dv[3])
 {
-    step_sums c = {sim, f, t, dt, {dv[0], dv[1], dv[2]}, leapfrog};
+    step_sums c = {sim, f, t, dt, {dv[0], dv[1], dv[2]}, leapfrog, penalty};
     double sums[3]; /* removed, of which the obstacles' work; the shift's */
     cf_sum_chunks(f->nodes.n, 3, !mesh_obstacles(sim), contact_chunk, &c, sums);
     f->pending.obstacles += sums[1];
@@ -224,6 +236,49 @@ static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
             }
         }
     return work;
+}
+
+#define CF_PENALTY_SCALE 0.1 /* k = CF_PENALTY_SCALE m / dt^2 (penalty_contact) */
+
+/* The penalty contact on nodes i0..i1-1 at x_n: a node at signed distance
+ * d < 0 from an obstacle gets the force k (-d) n along its outward normal,
+ * k = CF_PENALTY_SCALE m / dt^2 from the node's lumped mass and the step
+ * (the soft-constraint stiffness of explicit codes, e.g. LS-DYNA's
+ * SOFT = 1 with its default scale 0.1): (k/m) dt^2 = 0.1 adds at most a
+ * tenth to the squared frequency of the leapfrog's stability limit 4, so
+ * the contact never sets the step, and a body's weight sinks it by
+ * nanometres.  The spring is conservative: its energy 1/2 k d^2 goes to
+ * acc[0] (booked with the strain energy), a moving obstacle's work
+ * F . u dt to acc[1].  contact[i] records the obstacle and vn_pre[i] the
+ * normal velocity the force gives in the step, dt |F|/m, the bound of
+ * Coulomb friction in contact_chunk. */
+static void penalty_chunk(void *ctx, int i0, int i1, double *acc)
+{
+    const step_sums *c = ctx;
+    cf_solid *s = &c->sim->solid;
+    cf_fragment *f = c->f;
+    const cf_obstacles *obs = &c->sim->obs;
+    for (int i = i0; i < i1; i++) {
+        int a = f->nodes.v[i];
+        const double *x = &s->x[3 * a];
+        f->contact[i] = -1;
+        f->vn_pre[i] = 0;
+        if (cf_obstacles_clear(obs, x))
+            continue;
+        double k = CF_PENALTY_SCALE * s->m[a] / (c->dt * c->dt);
+        for (int j = 0; j < obs->n; j++) {
+            double n[3], u[3];
+            double d = cf_obstacle_distance(obs, j, c->t_next, x, n);
+            if (d >= 0)
+                continue;
+            v3_axpy(-k * d, n, &s->f[3 * a]);
+            cf_obstacle_velocity(&obs->o[j], u);
+            acc[0] += 0.5 * k * d * d;
+            acc[1] += -k * d * c->dt * v3_dot(n, u);
+            f->contact[i] = j;
+            f->vn_pre[i] += -k * d * c->dt / s->m[a];
+        }
+    }
 }
 
 /* f = f_ext - f_int + f_coh at x_n; strain energy and inverted tets. */
@@ -260,6 +315,13 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double t, double dt, int 
          * projection; the penalty is for explicit runs. */
         double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;
         cf_cohesive_forces(s, sim->law, sim->law_params, f->coh.v, f->coh.n, dt, kp, f->pairs);
+        if (penalty_step(set, fracture)) {
+            step_sums c = {sim, f, t, dt, {0, 0, 0}, 1, 1};
+            double e[2]; /* the springs' energy; moving obstacles' work */
+            cf_sum_chunks(f->nodes.n, 2, !mesh_obstacles(sim), penalty_chunk, &c, e);
+            f->e_strain += e[0];
+            f->pending.obstacles += e[1];
+        }
     } else {
         for (int i = 0; i < f->nodes.n; i++) {
             int a = f->nodes.v[i];
@@ -311,7 +373,7 @@ static int update_velocities(cf_world *sim, cf_fragment *f, double dt, int fract
     cf_solid *s = &sim->solid;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n;
-    step_sums c = {sim, f, 0, dt, {0, 0, 0}, 0};
+    step_sums c = {sim, f, 0, dt, {0, 0, 0}, 0, 0};
     double sums[5];
     cf_sum_chunks(nn, 5, 1, kick_chunk, &c, sums);
     int n_bc = (int)sums[4]; /* prescribed nodes: most fragments have none */
@@ -356,14 +418,16 @@ static int update_velocities(cf_world *sim, cf_fragment *f, double dt, int fract
 /* The obstacles and rigid neighbours' hulls on node i's prediction at
  * t_next; records its contact and approach speed.  Returns the work of
  * moving obstacles on it in this pass, J. */
-static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next, double dt)
+static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next, double dt,
+                            int penalty)
 {
     cf_solid *s = &sim->solid;
     int a = f->nodes.v[i];
     double n[3], before[3], w = 0;
     memcpy(before, &s->p[4 * a], sizeof before);
-    int hit =
-        cf_obstacles_project(&sim->obs, t_next - dt, &s->x[3 * a], t_next, &s->p[4 * a], n);
+    int hit = penalty ? -1
+                      : cf_obstacles_project(&sim->obs, t_next - dt, &s->x[3 * a], t_next,
+                                             &s->p[4 * a], n);
     if (hit >= 0 && f->contact[i] < 0) {
         double u[3], vr[3];
         cf_obstacle_velocity(&sim->obs.o[hit], u);
@@ -397,10 +461,12 @@ static void obstacle_chunk(void *ctx, int i0, int i1, double *acc)
     const step_sums *c = ctx;
     const cf_solid *s = &c->sim->solid;
     int alone = c->f->near.n == 0; /* no rigid neighbour's hull to test */
+    if (alone && c->penalty)
+        return; /* the obstacles acted as forces (penalty_contact) */
     for (int i = i0; i < i1; i++) {
         if (alone && cf_obstacles_clear(&c->sim->obs, &s->p[4 * c->f->nodes.v[i]]))
             continue; /* nothing to move, record or add */
-        acc[0] += obstacle_node(c->sim, c->f, i, c->t_next, c->dt);
+        acc[0] += obstacle_node(c->sim, c->f, i, c->t_next, c->dt, c->penalty);
     }
 }
 
@@ -427,15 +493,17 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     /* The obstacle pass on the threads unless hull pushes of rigid
      * neighbours (one list) or FCL queries need one thread. */
     int obstacles_par = par && f->near.n == 0 && !mesh_obstacles(sim);
-    int bars = !explicit_step(set, fracture);
+    int bars = !explicit_step(set, fracture), penalty = penalty_step(set, fracture);
 #pragma omp parallel for schedule(static) if (par)
     for (int i = 0; i < nn; i++) {
         int a = nodes[i];
         for (int k = 0; k < 3; k++)
             s->p[4 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
         s->p[4 * a + 3] = 1.0 / s->m[a];
-        f->contact[i] = -1;
-        f->vn_pre[i] = 0;
+        if (!penalty) { /* the penalty force recorded its contacts (penalty_chunk) */
+            f->contact[i] = -1;
+            f->vn_pre[i] = 0;
+        }
         if (bars) /* the predicted speed, for the cap below (v stays until then) */
             s->vcap[a] = s->speed[a] = v3_norm(&s->v[3 * a]);
     }
@@ -445,7 +513,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     if (set->constraints == CF_CONSTRAINTS_XPBD)
         cf_bars_reset_lambda(&f->bars);
     double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
-    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}, 0};
+    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}, 0, penalty};
     int caps = 0; /* the neighbours' speeds taken (below) in the first PBD sweep */
     for (int it = 0; it < iterations; it++) {
         if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture) {
@@ -552,8 +620,9 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
     sim->prof.forces += t1 - t0;
     double dv[3];
     project(sim, f, t + dt, dt, fracture, n_bc, dv);
-    f->pending.contact +=
-        contact_velocities(sim, f, t + dt, dt, explicit_step(&sim->def.solver, fracture), dv);
+    const cf_solver_settings *set = &sim->def.solver;
+    f->pending.contact += contact_velocities(sim, f, t + dt, dt, explicit_step(set, fracture),
+                                             penalty_step(set, fracture), dv);
     sim->prof.pbd += cf_wall_time() - t1;
     f->steps++;
     return CF_OK;

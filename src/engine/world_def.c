@@ -47,6 +47,7 @@ cf_solver_settings cf_default_solver(void)
     s.elasticity = CF_ELASTICITY_COROTATIONAL;
     s.criterion = CF_CRITERION_TRACTION;
     s.crack_growth = CF_GROWTH_FRONTS, s.min_piece_tets = 4;
+    s.obstacle_contact = CF_OBSTACLE_CONTACT_KINEMATIC;
     s.crack_plane_normal[2] = 1.0, s.crack_plane_tolerance = 1e-6;
     s.constraints = CF_CONSTRAINTS_PBD;
     s.k_stiffness = 0.9, s.iterations = 3, s.k_damping = 1.0;

@@ -82,6 +82,7 @@ static const char *const solver_keys[] = {
     "impact_threshold",  "elasticity",       "criterion",      "crack_plane",
     "crack_growth",      "min_piece_tets",
     "constraints",       "pbd",              "xpbd",           "contact_stiffness",
+    "obstacle_contact",
     "guard",             "threads"};
 static const char *const sleeping_keys[] = {"linear", "angular"};
 static const char *const crack_plane_keys[] = {"point", "normal", "tolerance"};
@@ -103,6 +104,7 @@ static const char *const elasticity_names[] = {"corotational", "linear"};
 static const char *const criterion_names[] = {"traction", "source", "none"};
 static const char *const constraints_names[] = {"pbd", "xpbd", "none"};
 static const char *const growth_names[] = {"fronts", "all"};
+static const char *const obstacle_contact_names[] = {"kinematic", "penalty"};
 _Static_assert(CF_PRIM_NONE == 0 && CF_PRIM_BOX == 1 && CF_PRIM_SPHERE == 2 &&
                    CF_PRIM_HOLLOW_SPHERE == 3 && CF_PRIM_PLATE == 4 && CF_PRIM_NOTCHED_BEAM == 5,
                "primitive_names follows cf_primitive_type");
@@ -118,6 +120,8 @@ _Static_assert(CF_ELASTICITY_COROTATIONAL == 0 && CF_ELASTICITY_LINEAR == 1,
 _Static_assert(CF_CRITERION_TRACTION == 0 && CF_CRITERION_SOURCE == 1 && CF_CRITERION_NONE == 2,
                "criterion_names follows cf_criterion");
 _Static_assert(CF_GROWTH_FRONTS == 0 && CF_GROWTH_ALL == 1, "growth_names follows cf_crack_growth");
+_Static_assert(CF_OBSTACLE_CONTACT_KINEMATIC == 0 && CF_OBSTACLE_CONTACT_PENALTY == 1,
+               "obstacle_contact_names follows cf_obstacle_contact");
 _Static_assert(CF_CONSTRAINTS_PBD == 0 && CF_CONSTRAINTS_XPBD == 1 && CF_CONSTRAINTS_NONE == 2,
                "constraints_names follows cf_constraints");
 
@@ -1181,7 +1185,7 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     static const double dt_rigid = 1e-3, dt_fracture = 5e-6, max_fracture_time = 0.05,
                         impact_threshold = 0.2, contact_stiffness = 0.0, cfl_fraction = 0.0;
     lua_State *L = ld->L;
-    int mode, backend, elasticity, criterion, growth, constraints;
+    int mode, backend, elasticity, criterion, growth, constraints, obstacle_contact;
     TRY(check_keys(ld, t, solver_keys, COUNT(solver_keys)));
     TRY(get_enum(ld, t, "mode", mode_names, COUNT(mode_names), CF_RUN_HYBRID, &mode));
     s->mode = (cf_run_mode)mode;
@@ -1213,6 +1217,9 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     TRY(get_enum(ld, t, "crack_growth", growth_names, COUNT(growth_names), CF_GROWTH_FRONTS,
                  &growth));
     s->crack_growth = (cf_crack_growth)growth;
+    TRY(get_enum(ld, t, "obstacle_contact", obstacle_contact_names, COUNT(obstacle_contact_names),
+                 CF_OBSTACLE_CONTACT_KINEMATIC, &obstacle_contact));
+    s->obstacle_contact = (cf_obstacle_contact)obstacle_contact;
     TRY(get_int(ld, t, "min_piece_tets", 4, &PIECE_TETS, &s->min_piece_tets));
     s->has_crack_plane = 0;
     if (raw_get(L, t, "crack_plane") != LUA_TNIL) {
@@ -1817,6 +1824,7 @@ static char *resolved_text(const cf_world_def *s)
     put_str(&b, 4, "criterion", criterion_names[v->criterion]);
     put_str(&b, 4, "crack_growth", growth_names[v->crack_growth]);
     put(&b, "    min_piece_tets = %d,\n", v->min_piece_tets);
+    put_str(&b, 4, "obstacle_contact", obstacle_contact_names[v->obstacle_contact]);
     if (v->has_crack_plane) {
         put(&b, "    crack_plane = {\n");
         put_vec(&b, 6, "point", v->crack_plane_point, 3);
