@@ -146,9 +146,16 @@ int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, c
             hi[d] = fmax(hi[d], s->x[3 * f->nodes.v[i] + d] + pad);
         }
     double size = 0;
+    int root = cf_fragment_root(sim, fi);
     for (int g = 0; g < sim->n_frag; g++) {
         const cf_fragment *o = &sim->frag[g];
-        if (!cf_boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
+        /* Fragments of one body do not collide (as in Bullet, §9): their
+         * hulls overlap where a crack face is not convex, and a hull that
+         * pushes a sibling's node pushes it into whatever holds it (the
+         * ground's penalty then springs it back with energy no load put
+         * in). */
+        if (cf_fragment_root(sim, g) == root ||
+            !cf_boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
             continue;
         if (add_hulls(sim, g, hs))
             return -1;
