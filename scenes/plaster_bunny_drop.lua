@@ -10,7 +10,8 @@
 -- (417 ns on the peeled mesh, docs/physics.md §3.1), the only setting the stability map (`cohfrac stability`) finds
 -- stable for a real stiff material; the source's nodal maximum-principal
 -- stress rule (Rankine, tension only) on the whole star of each vertex,
--- with cracks that grow from fronts no faster than the Rayleigh speed,
+-- and at a crack front on the vertex ahead of it, with cracks that grow
+-- from fronts no faster than the Rayleigh speed,
 -- nucleate only clear of other cracks (radius l_ch = E G_I / sigma^2 =
 -- 12.5 mm) and never close a piece of 4 tets or fewer; a Weibull strength
 -- of weakest-link areas (docs/physics.md §5.1); a fragment stays in
@@ -19,17 +20,17 @@
 -- over, and goes back to rigid mode as the pieces still held by a
 -- cohesive element.
 -- Mesh: the bunny at about 1,000 tets (`bunny_1k`, 979 tets once its
--- boundary caps are peeled, prepared by `make run`); about 10 s here.
+-- boundary caps are peeled, prepared by `make run`).
 -- Floor: a penalty contact (docs/physics.md §7.1) that neither takes nor
 -- gives energy; the body's elasticity makes the rebound.  Fracture mode
 -- begins at the engine's impact threshold (0.2 m/s).
--- Expected (seed 1): three pieces of at least 5% of the mass (about 34, 29
--- and 26%), five of 1-5% and no chip of 4 tets or fewer; of the 78 J it
--- lands with, about 38 J go into crushing and 2.7 J into the cracks; the
--- fastest piece leaves at about 4.8 m/s against the bound 8.0 m/s of
--- tools/check_physics.py.  Seeds 2-5 give 3, 5, 5 and 3 pieces of at
--- least 5%, all within the bound; the finer bunny_4k keeps 96-100% in one
--- body (docs/physics.md §14.10).
+-- Expected (seed 1): four pieces of at least 5% of the mass (about 20, 9,
+-- 8 and 8%), 19 of at least 1% and no chip of 4 tets or fewer; of the 78 J
+-- it lands with, about 39 J go into crushing and 4.2 J into the cracks;
+-- the fastest piece leaves at about 5.3 m/s against the bound 8.0 m/s of
+-- tools/check_physics.py; about 18 s on one thread.  Seeds 2-5 give 2, 4,
+-- 3 and 4 pieces of at least 5%, all within the bound; bunny_4k gives 1,
+-- 3, 3, 2 and 3 (docs/physics.md §14.10).
 return {
   name = "plaster_bunny_drop",
   duration = 0.65,

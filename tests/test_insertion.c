@@ -582,6 +582,60 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* The source's rule at a crack front reads the stress ahead of it
+ * (docs/physics.md §5.1): beside a cracked facet whose neighbourhood has
+ * unloaded (every tet at one of its vertices at zero stress, the rest under
+ * a tension ten times the threshold), the facets that share an edge with it
+ * qualify when their vertex off that edge reaches the threshold, although
+ * their two vertices on the edge read zero; a facet that touches the crack
+ * at one vertex only does not (that vertex fails the plain rule, and it is
+ * no front). */
+static void test_front_rule_reads_the_stress_ahead(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 4, 4, 4, 1, 1, 1);
+    cf_solid s;
+    double strength = 1.0, thr = 0.9 * strength;
+    int *all = stressed_box(&s, &m, 10.0 * thr, strength, 1e-9);
+    int f0 = -1; /* an interior facet normal to y near the middle */
+    for (int f = 0; f < s.n_facets && f0 < 0; f++) {
+        const int *F = &s.facet[4 * f];
+        double y[3];
+        for (int j = 0; j < 3; j++)
+            y[j] = s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][j]] + 1];
+        if (F[2] >= 0 && y[0] == 0.5 && y[1] == 0.5 && y[2] == 0.5)
+            f0 = f;
+    }
+    assert_true(f0 >= 0);
+    int o0[3];
+    for (int j = 0; j < 3; j++)
+        o0[j] = s.tet0[4 * s.facet[4 * f0] + CF_TET_FACE[s.facet[4 * f0 + 1]][j]];
+    s.cracked[f0] = 1;
+    for (int t = 0; t < s.n_tets; t++)
+        for (int j = 0; j < 4; j++)
+            if (s.tet0[4 * t + j] == o0[0] || s.tet0[4 * t + j] == o0[1] ||
+                s.tet0[4 * t + j] == o0[2])
+                memset(&s.sigma[9 * t], 0, 9 * sizeof(double));
+    cf_int_list cand = {0};
+    int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &cand);
+    int fronts = 0;
+    for (int i = 0; i < n; i++) {
+        const int *F = &s.facet[4 * cand.v[i]];
+        int shared = 0;
+        for (int j = 0; j < 3; j++) {
+            int o = s.tet0[4 * F[0] + CF_TET_FACE[F[1]][j]];
+            shared += o == o0[0] || o == o0[1] || o == o0[2];
+        }
+        assert_true(shared != 1 && shared != 3);
+        fronts += shared == 2;
+    }
+    printf("FIGURE front rule: %d facets qualify, %d of them fronts of the crack\n", n, fronts);
+    assert_true(fronts >= 2);
+    free(cand.v), free(all);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
 /* Weakest-link strength (Zhou and Molinari 2004): facet f of area A_f
  * draws w_f with P(w > x) = exp(-(A_f / A0) x^m), so z_f = (A_f / A0) w_f^m
  * is exponential with mean 1 and variance 1 whatever the facet's size.
@@ -651,6 +705,7 @@ int main(void)
         cmocka_unit_test(test_source_rule_equals_brute_force),
         cmocka_unit_test(test_fronts_close_no_small_piece),
         cmocka_unit_test(test_front_moves_no_faster_than_its_speed),
+        cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
         cmocka_unit_test(test_weibull_strength_scales_with_facet_area),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

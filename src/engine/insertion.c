@@ -170,6 +170,52 @@ static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowe
     marked->n = kept;
 }
 
+/* Slot of original vertex o in tet t, or -1. */
+static int slot_of(const cf_solid *s, int t, int o)
+{
+    for (int j = 0; j < 4; j++)
+        if (s->tet0[4 * t + j] == o)
+            return j;
+    return -1;
+}
+
+/* Whether a cracked facet other than f holds the edge of original
+ * vertices a and b: a face with both of them, of a tet in a's star. */
+static int edge_cracked(const cf_solid *s, int f, int a, int b)
+{
+    for (int j = s->vt_start[a]; j < s->vt_start[a + 1]; j++) {
+        int slot = s->vt_slot[j], t = slot / 4, sb = slot_of(s, t, b);
+        if (sb < 0)
+            continue;
+        for (int q = 0; q < 4; q++) { /* face q holds every corner but q */
+            int g = s->tet_facet[4 * t + q];
+            if (q != slot % 4 && q != sb && g != f && s->cracked[g])
+                return 1;
+        }
+    }
+    return 0;
+}
+
+/* The source's rule at a crack front (docs/physics.md §5.1): face k of tet
+ * ta shares an edge with a cracked facet, and its vertex off that edge,
+ * the one ahead of the front, reaches the threshold.  The two vertices on
+ * the edge sit on the crack, whose faces carry no traction, so their
+ * averages read half a star of unloaded tets: the stress ahead of the front
+ * is the third vertex's. */
+static int front_rule(const cf_solid *s, int ta, int k, double threshold)
+{
+    int f = s->tet_facet[4 * ta + k];
+    for (int j = 0; j < 3; j++) {
+        int n = s->tet[4 * ta + CF_TET_FACE[k][j]];
+        if (!s->node_mark[n] || s->nodal[n] < threshold)
+            continue;
+        if (edge_cracked(s, f, s->tet0[4 * ta + CF_TET_FACE[k][(j + 1) % 3]],
+                         s->tet0[4 * ta + CF_TET_FACE[k][(j + 2) % 3]]))
+            return 1;
+    }
+    return 0;
+}
+
 /* The faces of tet ta that qualify, as bits 1 << k.  Either rule needs a
  * hot tet holding all three nodes of the face (the source's rule marks
  * exactly those nodes; the traction rule needs ta or its neighbour hot), so
@@ -178,7 +224,7 @@ static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion ru
 {
     const int *T = &s->tet[4 * ta];
     const unsigned char *mark = s->node_mark;
-    if (mark[T[0]] + mark[T[1]] + mark[T[2]] + mark[T[3]] < 3)
+    if (mark[T[0]] + mark[T[1]] + mark[T[2]] + mark[T[3]] < (rule == CF_CRITERION_SOURCE ? 1 : 3))
         return 0;
     double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
     unsigned char bits = 0;
@@ -189,7 +235,8 @@ static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion ru
             continue;
         double w = s->strength ? s->strength[f] : 1.0; /* this facet's strength */
         if (rule == CF_CRITERION_SOURCE) {
-            bits |= (unsigned char)(source_rule(s, ta, k, source_threshold(smax, w)) << k);
+            double th = source_threshold(smax, w);
+            bits |= (unsigned char)((source_rule(s, ta, k, th) || front_rule(s, ta, k, th)) << k);
             continue;
         }
         if (!s->hot[ta] && !s->hot[F[2]]) /* the mean stress is below both bounds */
@@ -320,14 +367,6 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     return nf;
 }
 
-/* Slot of original vertex o in tet t, or -1. */
-static int slot_of(const cf_solid *s, int t, int o)
-{
-    for (int j = 0; j < 4; j++)
-        if (s->tet0[4 * t + j] == o)
-            return j;
-    return -1;
-}
 
 static int uf_find(int *parent, int i)
 {
