@@ -318,6 +318,77 @@ static void test_cfl_of_regular_tet(void **state)
     cf_solid_free(&s);
 }
 
+static int by_value(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Mass scaling (docs/physics.md §3.2): a box whose lowest layer
+ * of cells is 200 times thinner than the rest has its step set by that
+ * layer's tets.  With a floor of 0.5, every tet whose step h / c_d lies
+ * below half the median's gets the density (floor dt_median / dt)^2 rho,
+ * which puts its step exactly at the floor; the others keep rho; dt_cfl
+ * becomes that floor; and the lumped masses add up to the scaled tets'
+ * masses, the added mass reported to round-off. */
+static void test_mass_scaling_lifts_the_thin_tets(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    cf_solid s;
+    int *body;
+    fixture_box(&m, 3, 2, 4, 0.3, 0.2, 0.5);
+    for (int i = 0; i < m.n_nodes; i++) /* the first layer of nodes above z = 0 */
+        if (fabs(m.x[3 * i + 2] - 0.125) < 1e-9)
+            m.x[3 * i + 2] = 0.125 / 200;
+    body = calloc((size_t)m.n_tets, sizeof(int));
+    cf_material mat = material(1e6, 0.3, 2400);
+    assert_int_equal(cf_solid_init(&s, &m, &mat, body, NULL), CF_OK);
+    int nt = s.n_tets;
+    double cd = sqrt(1e6 * 0.7 / (2400 * 1.3 * 0.4)), *dt = malloc((size_t)nt * sizeof(double)),
+           *sorted = malloc((size_t)nt * sizeof(double));
+    for (int t = 0; t < nt; t++) { /* h = 6 V / total face area */
+        const double *x[4];
+        for (int j = 0; j < 4; j++)
+            x[j] = &s.X[3 * s.tet[4 * t + j]];
+        double area = 0;
+        for (int k = 0; k < 4; k++) {
+            double e1[3], e2[3], n[3];
+            v3_sub(x[CF_TET_FACE[k][1]], x[CF_TET_FACE[k][0]], e1);
+            v3_sub(x[CF_TET_FACE[k][2]], x[CF_TET_FACE[k][0]], e2);
+            v3_cross(e1, e2, n);
+            area += 0.5 * v3_norm(n);
+        }
+        dt[t] = sorted[t] = 6 * s.vol[t] / area / cd;
+    }
+    qsort(sorted, (size_t)nt, sizeof(double), by_value);
+    double least = 0.5 * sorted[nt / 2];
+    assert_true(s.dt_cfl < 0.1 * least); /* the thin layer sets the step */
+    assert_int_equal(cf_solid_scale_mass(&s, 0.5, NULL), CF_OK);
+    assert_near(s.dt_cfl, least, 1e-12 * least);
+    int scaled = 0;
+    double added = 0, M = 0;
+    for (int t = 0; t < nt; t++) {
+        double scale = s.mass_scale[t];
+        if (dt[t] < least) {
+            assert_near(dt[t] * sqrt(scale), least, 1e-12 * least);
+            added += (scale - 1) * 2400 * s.vol[t], scaled++;
+        } else {
+            assert_true(scale == 1.0);
+        }
+    }
+    for (int i = 0; i < s.n_nodes; i++)
+        M += s.m[i];
+    printf("FIGURE mass scaling: %d of %d tets scaled, %.4g kg added to %.4g kg\n", scaled, nt,
+           added, M);
+    assert_int_equal(scaled, s.n_mass_scaled);
+    assert_true(scaled > 0 && scaled < nt / 2);
+    assert_near(s.mass_added, added, 1e-12 * added);
+    assert_near(M, 2400 * 0.3 * 0.2 * 0.5 + added, 1e-12 * M);
+    free(dt), free(sorted), free(body);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
 /* The strain energy of many tets is summed on the threads in chunks cut by
  * the count alone (chunks.h): the same bits for 1, 2 and 3 threads, with
  * terms whose sum depends on the order (magnitudes 2^-30 to 2^30: the halves'
@@ -368,6 +439,7 @@ int main(void)
         cmocka_unit_test(test_no_crushing_no_plastic_state),
         cmocka_unit_test(test_lanes_equal_one_tet_at_a_time),
         cmocka_unit_test(test_cfl_of_regular_tet),
+        cmocka_unit_test(test_mass_scaling_lifts_the_thin_tets),
         cmocka_unit_test(test_strain_energy_same_bits_for_any_thread_count),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

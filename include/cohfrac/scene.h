@@ -150,6 +150,10 @@
  *       (constraints = "none"; with PBD/XPBD the crack-contact constraint
  *       keeps the faces apart); 0 = the stability cap of each node pair,
  *       K_p A/3 = 1/(4 dt^2 (1/m_a + 1/m_b))
+ *     mass_scaling [0]: mass scaling (docs/physics.md §3.2): a tet
+ *       whose stable step h/c_d lies below this fraction of the median
+ *       tet's gets the density that raises it to that fraction (the added
+ *       mass is printed in the summary); 0 = none, at most 1
  *     obstacle_contact ["kinematic"] | "penalty": how fracture-mode nodes
  *       meet obstacles in explicit runs (docs/physics.md §7.1): "kinematic"
  *       projects each node onto the surface and applies restitution per

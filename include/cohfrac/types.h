@@ -156,6 +156,7 @@ typedef struct cf_solver_settings {
     double compliance_scale;
     double contact_stiffness;     /* Pa/m, 0 = stability cap */
     cf_obstacle_contact obstacle_contact; /* explicit runs: kinematic or penalty */
+    double mass_scaling;          /* floor of a tet's step over the median's; 0: none */
     double max_inverted_fraction;
     double max_energy_growth;
     int threads;

@@ -307,6 +307,9 @@ void cf_world_initial_bounds(const cf_world *w, cf_initial_bounds *out);
 typedef struct cf_world_stats {
     int tets, nodes_input, nodes;       /* nodes after duplication */
     double dt_fracture, dt_cfl, dt_outer;/* s */
+    int mass_scaled;                    /* tets whose density solver.mass_scaling raised */
+    double mass_added, mass_total;      /* kg: what it added; the bodies' mass with it */
+    double wave_speed_least;            /* the slowest scaled tet's wave speed over c_d */
     long steps_rigid, steps_fracture;
     int threads;
     int alive, in_fracture, ever;       /* fragments */

@@ -79,7 +79,7 @@ void cf_tet_mass_props(const cf_solid *s, const int *tets, int nt, const double 
 {
     memset(mp, 0, sizeof *mp);
     for (int i = 0; i < nt; i++) {
-        double m = s->mat.rho * s->vol[tets[i]];
+        double m = cf_tet_mass(s, tets[i]);
         mp->mass += m;
         for (int j = 0; j < 4; j++)
             v3_axpy(0.25 * m, &pos[3 * s->tet[4 * tets[i] + j]], mp->com);
@@ -90,7 +90,7 @@ void cf_tet_mass_props(const cf_solid *s, const int *tets, int nt, const double 
         mp->com[c] /= mp->mass;
     double C[9] = {0};
     for (int i = 0; i < nt; i++) {
-        double m = s->mat.rho * s->vol[tets[i]], r[4][3], sum[3] = {0, 0, 0};
+        double m = cf_tet_mass(s, tets[i]), r[4][3], sum[3] = {0, 0, 0};
         for (int j = 0; j < 4; j++) {
             v3_sub(&pos[3 * s->tet[4 * tets[i] + j]], mp->com, r[j]);
             v3_axpy(1.0, r[j], sum);

@@ -433,7 +433,7 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes, cf_int_list
     for (int i = 0; i < ns; i++)
         s->m[s->tet[star[i]]] = 0;
     for (int i = 0; i < ns; i++)
-        s->m[s->tet[star[i]]] += s->mat.rho * s->vol[star[i] / 4] / 4.0;
+        s->m[s->tet[star[i]]] += cf_tet_mass(s, star[i] / 4) / 4.0;
     if (buf != local)
         free(buf);
     return rc;

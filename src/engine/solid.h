@@ -104,7 +104,20 @@ typedef struct cf_solid {
     cf_cohesive *coh;
 
     double dt_cfl;            /* s, docs/physics.md §3 */
+    /* Mass scaling of the tets that set the step (docs/physics.md §3.2;
+     * cf_solid_scale_mass):
+     * [nt] each tet's density over the material's, NULL when none is
+     * scaled; how many are, and the mass they add, kg. */
+    double *mass_scale;
+    int n_mass_scaled;
+    double mass_added, mass_scale_max;
 } cf_solid;
+
+/* Mass of tet t, kg: rho V, times its mass scale. */
+static inline double cf_tet_mass(const cf_solid *s, int t)
+{
+    return s->mat.rho * s->vol[t] * (s->mass_scale ? s->mass_scale[t] : 1.0);
+}
 
 /* Build the solid from meshes already placed in the world frame.
  * `tet_body` ([nt]) gives each tet's initial fragment id.
@@ -112,6 +125,13 @@ typedef struct cf_solid {
 cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat,
                         const int *tet_body, cf_error *err);
 void cf_solid_free(cf_solid *s);
+
+/* Mass scaling (docs/physics.md §3.2): every tet whose stable
+ * step h / c_d lies below `floor` times the median tet's gets the density
+ * that raises it to that, rho (floor dt_median / dt_t)^2, and its lumped
+ * masses grow by as much; dt_cfl becomes the smallest step after scaling.
+ * floor in (0, 1]; 0 does nothing.  Errors: CF_ERR_NOMEM. */
+cf_status cf_solid_scale_mass(cf_solid *s, double floor, cf_error *err);
 
 /* The facets (interior and boundary faces), each tet face's facet, the
  * crack flags and the stress of the checks: the fracture state, built only for a scene that may insert

@@ -522,6 +522,8 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
         st = cf_solid_init(&sim->solid, &all, &scene->material, body, err);
         if (st == CF_OK)
             memcpy(sim->solid.bc, bc, (size_t)all.n_nodes * sizeof(int));
+        if (st == CF_OK)
+            st = cf_solid_scale_mass(&sim->solid, scene->solver.mass_scaling, err);
         if (st == CF_OK && scene->solver.criterion != CF_CRITERION_NONE)
             st = cf_solid_init_facets(&sim->solid, err);
         cf_mesh_free(&all);
@@ -1238,6 +1240,10 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->tets = sim->solid.n_tets, o->nodes_input = sim->solid.n_verts0;
     o->nodes = sim->solid.n_nodes;
     o->dt_fracture = sim->dt_fracture, o->dt_cfl = sim->solid.dt_cfl, o->dt_outer = sim->dt_outer;
+    o->mass_scaled = sim->solid.n_mass_scaled, o->mass_added = sim->solid.mass_added;
+    for (int a = 0; a < sim->solid.n_nodes; a++)
+        o->mass_total += sim->solid.m[a];
+    o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(sim->solid.mass_scale_max) : 1.0;
     o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
     o->threads = omp_get_max_threads();
     o->alive = alive_fragments(sim, &o->in_fracture);

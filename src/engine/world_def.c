@@ -258,6 +258,7 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("solver.pbd.k_damping", s->k_damping, UNIT);
     CHECK("solver.xpbd.compliance_scale", s->compliance_scale, POSITIVE);
     CHECK("solver.contact_stiffness", s->contact_stiffness, NON_NEGATIVE);
+    CHECK("solver.mass_scaling", s->mass_scaling, UNIT);
     CHECK("solver.guard.max_inverted_fraction", s->max_inverted_fraction, UNIT);
     CHECK("solver.guard.max_energy_growth", s->max_energy_growth, POSITIVE);
     CHECK("solver.threads", s->threads, NON_NEGATIVE);

@@ -82,7 +82,7 @@ static const char *const solver_keys[] = {
     "impact_threshold",  "elasticity",       "criterion",      "crack_plane",
     "crack_growth",      "min_piece_tets",
     "constraints",       "pbd",              "xpbd",           "contact_stiffness",
-    "obstacle_contact",
+    "obstacle_contact",  "mass_scaling",
     "guard",             "threads"};
 static const char *const sleeping_keys[] = {"linear", "angular"};
 static const char *const crack_plane_keys[] = {"point", "normal", "tolerance"};
@@ -1183,7 +1183,8 @@ static cf_status read_guard(loader *ld, int t, cf_solver_settings *s)
 static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
 {
     static const double dt_rigid = 1e-3, dt_fracture = 5e-6, max_fracture_time = 0.05,
-                        impact_threshold = 0.2, contact_stiffness = 0.0, cfl_fraction = 0.0;
+                        impact_threshold = 0.2, contact_stiffness = 0.0, cfl_fraction = 0.0,
+                        mass_scaling = 0.0;
     lua_State *L = ld->L;
     int mode, backend, elasticity, criterion, growth, constraints, obstacle_contact;
     TRY(check_keys(ld, t, solver_keys, COUNT(solver_keys)));
@@ -1220,6 +1221,7 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     TRY(get_enum(ld, t, "obstacle_contact", obstacle_contact_names, COUNT(obstacle_contact_names),
                  CF_OBSTACLE_CONTACT_KINEMATIC, &obstacle_contact));
     s->obstacle_contact = (cf_obstacle_contact)obstacle_contact;
+    TRY(get_num(ld, t, "mass_scaling", &mass_scaling, &UNIT, &s->mass_scaling));
     TRY(get_int(ld, t, "min_piece_tets", 4, &PIECE_TETS, &s->min_piece_tets));
     s->has_crack_plane = 0;
     if (raw_get(L, t, "crack_plane") != LUA_TNIL) {
@@ -1825,6 +1827,7 @@ static char *resolved_text(const cf_world_def *s)
     put_str(&b, 4, "crack_growth", growth_names[v->crack_growth]);
     put(&b, "    min_piece_tets = %d,\n", v->min_piece_tets);
     put_str(&b, 4, "obstacle_contact", obstacle_contact_names[v->obstacle_contact]);
+    put_num(&b, 4, "mass_scaling", v->mass_scaling);
     if (v->has_crack_plane) {
         put(&b, "    crack_plane = {\n");
         put_vec(&b, 6, "point", v->crack_plane_point, 3);

@@ -582,6 +582,11 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
             p.nodes_input, p.nodes);
     fprintf(out, "time step          dt_fracture %.3g s = %.4g dt_cfl (dt_cfl %.4g s)\n",
             p.dt_fracture, p.dt_fracture / p.dt_cfl, p.dt_cfl);
+    if (p.mass_scaled > 0)
+        fprintf(out, "mass scaling       %d tets below %g of the median tet's step: +%.3g kg "
+                "(%.3g %% of the mass), their wave speed down to %.3g of c_d at the least\n",
+                p.mass_scaled, d->solver.mass_scaling, p.mass_added,
+                100.0 * p.mass_added / p.mass_total, p.wave_speed_least);
     fprintf(out, "steps per mode     rigid %ld, fracture %ld (threads %d)\n", p.steps_rigid,
             p.steps_fracture, p.threads);
     fprintf(out, "fragments          %d alive (%d in fracture mode), %d ever\n", p.alive,
