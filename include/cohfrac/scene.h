@@ -158,7 +158,7 @@
  *       meet obstacles in explicit runs (docs/physics.md §7.1): "kinematic"
  *       projects each node onto the surface and applies restitution per
  *       node (plastic at restitution 0); "penalty" pushes a node behind the
- *       surface out with a force k d, k = 0.1 m / dt^2 from its lumped mass
+ *       surface out with a force k d, k = 0.01 m / dt^2 from its lumped mass
  *       (a conservative spring: the body's own elasticity makes the
  *       rebound, and the contact neither takes nor gives energy).  With
  *       PBD or XPBD the projection keeps the kinematic contact.

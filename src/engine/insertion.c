@@ -216,15 +216,17 @@ static int front_rule(const cf_solid *s, int ta, int k, double threshold)
     return 0;
 }
 
-/* The faces of tet ta that qualify, as bits 1 << k.  Either rule needs a
- * hot tet holding all three nodes of the face (the source's rule marks
- * exactly those nodes; the traction rule needs ta or its neighbour hot), so
- * a tet with fewer than three marked nodes is done without reading a facet. */
+/* The faces of tet ta that qualify, as bits 1 << k.  The traction rule
+ * needs ta or its neighbour hot, so a tet with fewer than three marked
+ * nodes (the nodes of hot tets) is done without reading a facet.  The
+ * source's rule is asked only of tets that hold a marked node (a node whose
+ * value may pass, qualify_near_marks), and at a front one marked vertex
+ * may be enough (front_rule). */
 static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion rule)
 {
     const int *T = &s->tet[4 * ta];
     const unsigned char *mark = s->node_mark;
-    if (mark[T[0]] + mark[T[1]] + mark[T[2]] + mark[T[3]] < (rule == CF_CRITERION_SOURCE ? 1 : 3))
+    if (rule != CF_CRITERION_SOURCE && mark[T[0]] + mark[T[1]] + mark[T[2]] + mark[T[3]] < 3)
         return 0;
     double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
     unsigned char bits = 0;
@@ -366,7 +368,6 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     out->n = nf;
     return nf;
 }
-
 
 static int uf_find(int *parent, int i)
 {

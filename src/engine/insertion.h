@@ -36,7 +36,9 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
  * (sigma_max and tau_max times the facet's s->strength factor throughout.)
  * - CF_CRITERION_SOURCE (the source's rule, §6.6.2): the volume-averaged
  *   nodal maximum principal stress is >= 0.9 sigma_max at all three nodes
- *   (computed only at nodes of hot tets, in s->nodal, s->node_mark).
+ *   (computed only at nodes of hot tets, in s->nodal, s->node_mark); or,
+ *   for a facet that shares an edge with a cracked facet, at its vertex off
+ *   that edge, ahead of the crack's front (docs/physics.md §5.1).
  * Writes the qualifying facet indices into `out` (emptied first) and
  * returns their number, or -1 when out of memory. */
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
