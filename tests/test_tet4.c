@@ -10,6 +10,7 @@
 
 #include "fixtures.h"
 #include "linalg.h"
+#include "sort.h"
 #include "solid.h"
 #include "tet4.h"
 
@@ -318,12 +319,6 @@ static void test_cfl_of_regular_tet(void **state)
     cf_solid_free(&s);
 }
 
-static int by_value(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* Mass scaling (docs/physics.md §3.2): a box whose lowest layer
  * of cells is 200 times thinner than the rest has its step set by that
  * layer's tets.  With a floor of 0.5, every tet whose step h / c_d lies
@@ -361,7 +356,7 @@ static void test_mass_scaling_lifts_the_thin_tets(void **state)
         }
         dt[t] = sorted[t] = 6 * s.vol[t] / area / cd;
     }
-    qsort(sorted, (size_t)nt, sizeof(double), by_value);
+    cf_doubles_sort(sorted, nt);
     double least = 0.5 * sorted[nt / 2];
     assert_true(s.dt_cfl < 0.1 * least); /* the thin layer sets the step */
     assert_int_equal(cf_solid_scale_mass(&s, 0.5, NULL), CF_OK);

@@ -308,7 +308,7 @@ typedef struct cf_world_stats {
     int tets, nodes_input, nodes;       /* nodes after duplication */
     double dt_fracture, dt_cfl, dt_outer;/* s */
     int mass_scaled;                    /* tets whose density solver.mass_scaling raised */
-    double mass_added, mass_total;      /* kg: what it added; the bodies' mass with it */
+    double mass_added, mass_total;      /* kg: what it added; the bodies' mass with it (0: none) */
     double wave_speed_least;            /* the slowest scaled tet's wave speed over c_d */
     long steps_rigid, steps_fracture;
     int threads;

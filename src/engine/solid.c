@@ -1,6 +1,7 @@
 #include "solid.h"
 
 #include "linalg.h"
+#include "sort.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -332,57 +333,43 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     return CF_OK;
 }
 
-/* Rest stable step of tet t, s: h / c_d (docs/physics.md §3). */
-static double tet_dt(const cf_solid *s, int t, double c_d)
-{
-    const int *T = &s->tet0[4 * t];
-    return tet_h(s->vol[t], &s->X[3 * T[0]], &s->X[3 * T[1]], &s->X[3 * T[2]],
-                 &s->X[3 * T[3]]) / c_d;
-}
-
-static int by_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 cf_status cf_solid_scale_mass(cf_solid *s, double floor, cf_error *err)
 {
     int nt = s->n_tets;
     if (!(floor > 0) || nt == 0)
         return CF_OK;
-    double c_d = wave_speed(&s->mat), *dt = malloc((size_t)nt * sizeof(double));
-    if (!dt)
+    double c_d = wave_speed(&s->mat), *dt = malloc((size_t)2 * nt * sizeof(double));
+    s->mass_scale = malloc((size_t)nt * sizeof(double));
+    if (!dt || !s->mass_scale) {
+        free(dt);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory scaling the mass of %d tets", nt);
-    for (int t = 0; t < nt; t++)
-        dt[t] = tet_dt(s, t, c_d);
-    qsort(dt, (size_t)nt, sizeof(double), by_double);
-    double least = floor * dt[nt / 2];
-    free(dt);
+    }
+    double *sorted = dt + nt; /* rest stable steps h / c_d (§3), then sorted */
+    for (int t = 0; t < nt; t++) {
+        const int *T = &s->tet0[4 * t];
+        dt[t] = sorted[t] = tet_h(s->vol[t], &s->X[3 * T[0]], &s->X[3 * T[1]], &s->X[3 * T[2]],
+                                  &s->X[3 * T[3]]) / c_d;
+    }
+    cf_doubles_sort(sorted, nt);
+    double least = floor * sorted[nt / 2];
     s->dt_cfl = INFINITY;
     for (int t = 0; t < nt; t++) {
-        double d = tet_dt(s, t, c_d);
-        s->dt_cfl = fmin(s->dt_cfl, fmax(d, least));
-        if (d >= least)
-            continue;
-        if (!s->mass_scale) {
-            s->mass_scale = malloc((size_t)nt * sizeof(double));
-            if (!s->mass_scale)
-                return cf_error_set(err, CF_ERR_NOMEM, "out of memory scaling the mass of %d tets",
-                                    nt);
-            for (int u = 0; u < nt; u++)
-                s->mass_scale[u] = 1.0;
-        }
         /* The wave speed falls as 1/sqrt(density), so the step grows as its
          * square root. */
-        double scale = (least / d) * (least / d), added = (scale - 1.0) * s->mat.rho * s->vol[t];
+        double scale = dt[t] < least ? (least / dt[t]) * (least / dt[t]) : 1.0;
+        double mass = s->mat.rho * s->vol[t], added = (scale - 1.0) * mass;
         s->mass_scale[t] = scale;
+        s->dt_cfl = fmin(s->dt_cfl, fmax(dt[t], least));
+        s->mass_total += mass + added;
+        if (scale == 1.0)
+            continue;
         for (int j = 0; j < 4; j++)
             s->m[s->tet[4 * t + j]] += added / 4.0;
         s->mass_added += added;
         s->mass_scale_max = fmax(s->mass_scale_max, scale);
         s->n_mass_scaled++;
     }
+    free(dt);
     return CF_OK;
 }
 

@@ -106,11 +106,12 @@ typedef struct cf_solid {
     double dt_cfl;            /* s, docs/physics.md §3 */
     /* Mass scaling of the tets that set the step (docs/physics.md §3.2;
      * cf_solid_scale_mass):
-     * [nt] each tet's density over the material's, NULL when none is
-     * scaled; how many are, and the mass they add, kg. */
+     * [nt] each tet's density over the material's (NULL without scaling);
+     * how many are scaled, the largest scale, and the mass they add and
+     * the solid's whole mass with it, kg. */
     double *mass_scale;
     int n_mass_scaled;
-    double mass_added, mass_scale_max;
+    double mass_scale_max, mass_added, mass_total;
 } cf_solid;
 
 /* Mass of tet t, kg: rho V, times its mass scale. */

@@ -10,6 +10,7 @@
 
 #include "linalg.h"
 #include "renumber.h"
+#include "sort.h"
 
 #include <math.h>
 #include <omp.h>
@@ -1227,12 +1228,6 @@ uint64_t cf_world_state_hash(const cf_world *sim)
     return h;
 }
 
-static int by_value(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
 {
     const cf_profile *p = &sim->prof;
@@ -1241,8 +1236,7 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->nodes = sim->solid.n_nodes;
     o->dt_fracture = sim->dt_fracture, o->dt_cfl = sim->solid.dt_cfl, o->dt_outer = sim->dt_outer;
     o->mass_scaled = sim->solid.n_mass_scaled, o->mass_added = sim->solid.mass_added;
-    for (int a = 0; a < sim->solid.n_nodes; a++)
-        o->mass_total += sim->solid.m[a];
+    o->mass_total = sim->solid.mass_total;
     o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(sim->solid.mass_scale_max) : 1.0;
     o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
     o->threads = omp_get_max_threads();
@@ -1270,7 +1264,7 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     if (n > 0 && !e) {
         o->hull_error_median = o->hull_error_worst = NAN;
     } else if (n > 0) {
-        qsort(e, (size_t)n, sizeof *e, by_value);
+        cf_doubles_sort(e, n);
         o->hull_error_median = n % 2 ? e[n / 2] : 0.5 * (e[n / 2 - 1] + e[n / 2]);
         o->hull_error_worst = e[n - 1];
     }
