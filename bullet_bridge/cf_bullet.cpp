@@ -732,6 +732,23 @@ static int add_compound_body_unguarded(cfb_world *w, double mass, const double i
     return id;
 }
 
+static int add_sphere_body_unguarded(cfb_world *w, double mass, const double inertia[3],
+                                     double radius, const cfb_state *s, double friction,
+                                     double restitution)
+{
+    if (!w) {
+        set_error("world is NULL");
+        return -1;
+    }
+    if (!mass_props_valid(mass, inertia)) return -1;
+    if (!std::isfinite(radius) || !(radius > 0.0)) {
+        set_error("sphere radius must be finite and > 0 (got %g)", radius);
+        return -1;
+    }
+    if (!state_valid(s) || !friction_valid(friction, restitution)) return -1;
+    return add_dynamic(w, new btSphereShape(radius), mass, inertia, s, friction, restitution);
+}
+
 static int add_trimesh_unguarded(cfb_world *w, const double *verts, int nv, const int *tris, int nt,
                                  double friction, double restitution)
 {
@@ -1182,6 +1199,14 @@ int cfb_add_compound_body(cfb_world *w, double mass, const double inertia[3], co
     return marked(w, -1, [&] {
         return add_compound_body_unguarded(w, mass, inertia, pts, start, n_hulls, margin, s,
                                            friction, restitution);
+    });
+}
+
+int cfb_add_sphere_body(cfb_world *w, double mass, const double inertia[3], double radius,
+                        const cfb_state *s, double friction, double restitution)
+{
+    return marked(w, -1, [&] {
+        return add_sphere_body_unguarded(w, mass, inertia, radius, s, friction, restitution);
     });
 }
 

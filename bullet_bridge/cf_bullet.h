@@ -71,6 +71,13 @@ int cfb_add_compound_body(cfb_world *w, double mass, const double inertia[3], co
                           const int *start, int n_hulls, double margin, const cfb_state *s,
                           double friction, double restitution);
 
+/* Dynamic body whose collision shape is a sphere of `radius` (m) about
+ * its centre of mass, with the given mass (kg) and principal moments
+ * (kg m^2): debris, whose contact needs no more than its size
+ * (docs/physics.md §9.2).  Otherwise as cfb_add_hull_body. */
+int cfb_add_sphere_body(cfb_world *w, double mass, const double inertia[3], double radius,
+                        const cfb_state *s, double friction, double restitution);
+
 /* Continuous collision detection for dynamic body `id`: when it moves more
  * than motion_threshold (m) in a sub-step, Bullet sweeps a sphere of radius
  * swept_radius (m, best somewhat below the body's inner radius) from its

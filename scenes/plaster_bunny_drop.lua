@@ -18,7 +18,8 @@
 -- fracture mode until 500 steps (0.21 ms, about a wave's return trip
 -- through its 0.23 m height) pass with no insertion and its landing is
 -- over, and goes back to rigid mode as the pieces still held by a
--- cohesive element.
+-- cohesive element.  Pieces of 4 tets or fewer, or narrower than l_ch,
+-- are debris (docs/physics.md §9.2): spheres in Bullet that break no more.
 -- Mesh: the bunny at about 1,000 tets (`bunny_1k`, 979 tets once its
 -- boundary caps are peeled, prepared by `make run`).
 -- Floor: a penalty contact (docs/physics.md §7.1) that neither takes nor
@@ -61,6 +62,7 @@ return {
     elasticity = "corotational", criterion = "source",
     constraints = "none", cfl_fraction = 0.5,
     obstacle_contact = "penalty",           -- the floor neither takes nor gives energy
+    debris_size = 0.0125,                   -- l_ch: pieces narrower are debris (§9.2)
   },
   output = { file = "out/plaster_bunny_drop.h5", frame_interval = 0.005 },
 }

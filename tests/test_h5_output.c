@@ -204,13 +204,13 @@ static void write_scenario(const char *path)
     assert_int_equal(cf_h5_open(path, "drop", SCENE_TEXT, &h, &err), CF_OK);
     assert_non_null(h);
 
-    const cf_frag_info first = {0, -1, 0.0, 2.5, 100, {1.0, 2.0, 3.0}, 0, 0, 0, {0, 0, 0}, 0, 0};
+    const cf_frag_info first = {0, -1, 0.0, 2.5, 100, {1.0, 2.0, 3.0}, 0, 0, 0, {0, 0, 0}, 0, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &first, 1, &err), CF_OK);
     for (int t = 0; t < NFRAMES; ++t) {
         if (t == 2) {
             /* the split's children, given out of id order */
-            const cf_frag_info kids[2] = {{2, 0, 0.02, 1.0, 40, {0.1, 0.2, 0.3}, 0, 0, 0, {0, 0, 0}, 0, 0},
-                                          {1, 0, 0.02, 1.5, 60, {0.4, 0.5, 0.6}, 0, 0, 0, {0, 0, 0}, 0, 0}};
+            const cf_frag_info kids[2] = {{2, 0, 0.02, 1.0, 40, {0.1, 0.2, 0.3}, 0, 0, 0, {0, 0, 0}, 0, 0, 1},
+                                          {1, 0, 0.02, 1.5, 60, {0.4, 0.5, 0.6}, 0, 0, 0, {0, 0, 0}, 0, 0, 0}};
             assert_int_equal(cf_h5_add_fragments(h, kids, 2, &err), CF_OK);
         }
         cf_frag_frame frames[NFRAGS];
@@ -333,12 +333,16 @@ static void test_round_trip(void **state)
     H5Dclose(d);
 
     /* fragment records, stored by id */
-    int parent[NFRAGS], ntets[NFRAGS];
+    int parent[NFRAGS], ntets[NFRAGS], debris[NFRAGS];
     double birth[NFRAGS], mass[NFRAGS], inertia[NFRAGS][3];
     read_1d(f, "/fragments/parent", H5T_NATIVE_INT, parent, NFRAGS);
     read_1d(f, "/fragments/n_tets", H5T_NATIVE_INT, ntets, NFRAGS);
     read_1d(f, "/fragments/birth_time", H5T_NATIVE_DOUBLE, birth, NFRAGS);
     read_1d(f, "/fragments/mass", H5T_NATIVE_DOUBLE, mass, NFRAGS);
+    read_1d(f, "/fragments/debris", H5T_NATIVE_INT, debris, NFRAGS);
+    assert_int_equal(debris[0], 0);
+    assert_int_equal(debris[1], 0);
+    assert_int_equal(debris[2], 1); /* given out of id order */
     assert_int_equal(dims_of(f, "/fragments/inertia_principal", dims), 2);
     assert_int_equal(dims[0], NFRAGS);
     assert_int_equal(dims[1], 3);
@@ -458,7 +462,7 @@ static void test_growth(void **state)
     for (int t = 0; t < T; ++t) {
         int n = t + 1 < NMAX ? t + 1 : NMAX;
         if (t < NMAX) {
-            cf_frag_info fi = {t, t == 0 ? -1 : 0, 0.001 * t, 1.0, 4, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
+            cf_frag_info fi = {t, t == 0 ? -1 : 0, 0.001 * t, 1.0, 4, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0, 0};
             assert_int_equal(cf_h5_add_fragments(h, &fi, 1, &err), CF_OK);
         }
         for (int j = 0; j < n; ++j)
@@ -561,7 +565,7 @@ static void test_readable_while_open(void **state)
     cf_error err = {0};
     cf_h5 *h = NULL;
     assert_int_equal(cf_h5_open(path, "live", "x = 1", &h, &err), CF_OK);
-    const cf_frag_info fi = {0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
+    const cf_frag_info fi = {0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &fi, 1, &err), CF_OK);
     for (int t = 0; t < 2; ++t) {
         cf_frag_frame fr = frag_state(0, t, 0);
@@ -606,8 +610,8 @@ static void test_killed_writer(void **state)
     if (pid == 0) {
         cf_error err = {0};
         cf_h5 *h = NULL;
-        const cf_frag_info fi[2] = {{0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0},
-                                    {1, -1, 0.0, 2.0, 20, {2, 2, 2}, 0, 0, 0, {0, 0, 0}, 0, 0}};
+        const cf_frag_info fi[2] = {{0, -1, 0.0, 1.0, 10, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0, 0},
+                                    {1, -1, 0.0, 2.0, 20, {2, 2, 2}, 0, 0, 0, {0, 0, 0}, 0, 0, 0}};
         if (cf_h5_open(path, "killed", "", &h, &err) != CF_OK ||
             cf_h5_add_fragments(h, fi, 2, &err) != CF_OK)
             _exit(2);
@@ -721,13 +725,13 @@ static void test_bad_arguments(void **state)
     cf_h5 *h = NULL;
     assert_int_equal(cf_h5_open(path, NULL, NULL, &h, &err), CF_OK);
 
-    const cf_frag_info skip = {1, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
+    const cf_frag_info skip = {1, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &skip, 1, &err), CF_ERR_OUTPUT);
     assert_non_null(strstr(err.msg, path));
-    const cf_frag_info twice[2] = {{0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0},
-                                   {0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0}};
+    const cf_frag_info twice[2] = {{0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0, 0},
+                                   {0, -1, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0, 0}};
     assert_int_equal(cf_h5_add_fragments(h, twice, 2, &err), CF_ERR_OUTPUT);
-    const cf_frag_info orphan = {0, 5, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0};
+    const cf_frag_info orphan = {0, 5, 0.0, 1.0, 1, {1, 1, 1}, 0, 0, 0, {0, 0, 0}, 0, 0, 0};
     assert_int_equal(cf_h5_add_fragments(h, &orphan, 1, &err), CF_ERR_OUTPUT);
 
     cf_frag_frame dup[2] = {frag_state(3, 0, 0), frag_state(3, 0, 0)};

@@ -6,6 +6,7 @@ usage: fragment_stats.py OUT.h5 [OUT.h5 ...] [--chip-tets N] [--json]
 For each file prints one line: the fragments alive at the last frame, the
 pieces holding at least 5 % of the mass (their shares, largest first), the
 share of the mass in chips (fragments of at most N tets, default 4), the
+share of the mass in debris (docs/physics.md §9.2; chips may be debris), the
 fastest fragment (m/s) and the crack area (m^2, facets whose cohesive
 element has failed at every node pair, one side).  With --json, one JSON
 object per file instead.  Exit status 0, or 2 when a file cannot be read.
@@ -24,6 +25,7 @@ def stats(path, chip_tets):
         vel = f["particles/fragments/velocity/value"][-1]
         mass = f["fragments/mass"][()]
         n_tets = f["fragments/n_tets"][()]
+        debris = f["fragments/debris"][()] if "fragments/debris" in f else np.zeros_like(n_tets)
         crack = f["observables/crack_area/value"][-1] if "observables/crack_area" in f else float("nan")
     alive = ids >= 0
     ids, vel = ids[alive], vel[alive]
@@ -37,6 +39,7 @@ def stats(path, chip_tets):
         "pieces_5pct": [round(float(s), 4) for s in share[share >= 0.05]],
         "pieces_1pct": int((share >= 0.01).sum()),
         "chip_share": float(m[nt <= chip_tets].sum() / total),
+        "debris_share": float(m[debris[ids] != 0].sum() / total),
         "fastest": float(speed.max()) if len(speed) else 0.0,
         "crack_area": float(crack),
     }
@@ -60,6 +63,7 @@ def main():
             pieces = ", ".join(f"{100 * x:.1f}" for x in s["pieces_5pct"])
             print(f"{p}: {s['fragments']} fragments, {len(s['pieces_5pct'])} pieces >= 5 % "
                   f"({pieces}), {s['pieces_1pct']} >= 1 %, chips {100 * s['chip_share']:.1f} %, "
+                  f"debris {100 * s['debris_share']:.1f} %, "
                   f"fastest {s['fastest']:.2f} m/s, crack area {s['crack_area']:.4g} m^2")
     return 0
 

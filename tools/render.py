@@ -9,7 +9,7 @@ and the movie beside the file, as OUT minus .h5 plus ".mp4".  The camera
 looks at the whole run (the rest mesh and every fragment's path) from above
 and to the side, +z up; the ground plane and the other obstacles are drawn
 (spheres and boxes where they are at each frame); fragments are coloured by
-id, crack faces darker.  Reads the file with tools/cohfrac_h5.py.
+id, crack faces darker, debris grey and at half its size.  Reads the file with tools/cohfrac_h5.py.
 
 Exit status: 0 done, 2 the file has no geometry (an older file), 3
 matplotlib is missing, 5 ffmpeg failed or is missing (the PNGs stay).
@@ -43,14 +43,26 @@ def shade(rgb, normals):
     return np.clip(rgb * (0.35 + 0.65 * lam)[:, None], 0, 1)
 
 
+DEBRIS_RGB = np.array([0.55, 0.5, 0.45])
+DEBRIS_SHRINK = 0.5
+
+
 def fragment_polys(run, frame, cmap):
-    """Triangles [n][3][3] and face colours [n][4] of every alive fragment."""
+    """Triangles [n][3][3] and face colours [n][4] of every alive fragment.
+    Debris (docs/physics.md §9.2) is drawn grey and at half its size about
+    its centre, so that it reads as crumbs beside the pieces."""
     polys, colours = [], []
+    debris = run.fragments.get("debris")
     for i, verts, tris, crack in run.surfaces_at(frame):
+        rgb = np.array(cmap(i % 20)[:3])
+        if debris is not None and debris[i]:
+            c = verts.mean(axis=0)
+            verts = c + DEBRIS_SHRINK * (verts - c)
+            rgb = DEBRIS_RGB
         tri = verts[tris]
         n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-        base = np.tile(np.array(cmap(i % 20)[:3]), (len(tri), 1))
+        base = np.tile(rgb, (len(tri), 1))
         base[crack.astype(bool)] *= 0.55
         polys.append(tri)
         colours.append(np.column_stack([shade(base, n), np.ones(len(tri))]))

@@ -136,6 +136,13 @@
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
+ *     debris_tets [4] (integer >= 0) and debris_size [0] m: a piece of at
+ *       most debris_tets tets, or whose sphere of equal volume is narrower
+ *       than debris_size, is debris (docs/physics.md §9.2): it leaves
+ *       fracture mode at once, never returns to it, and is a sphere of its
+ *       own mass and inertia in Bullet.  0 turns each rule off; a real
+ *       material's scene may set debris_size to its cohesive length
+ *       l_ch = E G_I / sigma_max^2 (the plaster drop does)
  *     crack_plane = {point={..}, normal={..}, tolerance [1e-6] m}: a
  *       pre-selected crack path: only interior facets whose three vertices
  *       lie within tolerance of the plane are candidates for insertion

@@ -145,6 +145,9 @@ typedef struct cf_solver_settings {
     cf_crack_growth crack_growth;
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
+    int debris_tets;              /* a piece of at most this many tets is debris; 0: none */
+    double debris_size;           /* m: a piece whose equal-volume sphere is narrower is
+                                     debris; 0: no size rule */
     int has_crack_plane;
     double crack_plane_point[3], crack_plane_normal[3]; /* normal normalised */
     double crack_plane_tolerance;                    /* m */

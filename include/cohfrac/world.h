@@ -92,6 +92,7 @@ typedef struct cf_frag_info {
                                 X to com + R (X - com_rest) */
     int surface_first, surface_count; /* its boundary triangles in the output's
                                 /surfaces (filled in by the run loop; 0, 0 when none) */
+    int debris;              /* 1: debris, a sphere in Bullet (docs/physics.md §9.2) */
 } cf_frag_info;
 
 /* One hand-off between modes. */
@@ -316,7 +317,9 @@ typedef struct cf_world_stats {
     int cohesive;
     int handoffs;
     double max_momentum_error, handoff_loss; /* relative; J */
-    int rigid_with_hulls, hulls;        /* Bullet bodies alive and their hulls */
+    int debris;                         /* fragments alive that are debris (§9.2) */
+    double debris_mass, mass_alive;     /* kg: their mass, and all fragments' alive */
+    int rigid_with_hulls, hulls;        /* Bullet bodies alive with hulls, and the hulls */
     double hull_error_median, hull_error_worst; /* hull volume / tet volume - 1 (NaN:
                                                  * no memory to sort them) */
     double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s */

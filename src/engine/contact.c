@@ -153,8 +153,9 @@ int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, c
          * hulls overlap where a crack face is not convex, and a hull that
          * pushes a sibling's node pushes it into whatever holds it (the
          * ground's penalty then springs it back with energy no load put
-         * in). */
-        if (cf_fragment_root(sim, g) == root ||
+         * in).  Debris has no hulls: a sphere in Bullet, too small to hold
+         * a node (§9.2). */
+        if (cf_fragment_root(sim, g) == root || o->hulls.n_hulls == 0 ||
             !cf_boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
             continue;
         if (add_hulls(sim, g, hs))

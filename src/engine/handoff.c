@@ -38,6 +38,31 @@ int cf_fragment_root(const cf_world *sim, int fi)
     return fi;
 }
 
+static const double PI = 3.14159265358979323846;
+
+/* Rest volume of fragment f's tets, m^3. */
+static double fragment_volume(const cf_world *sim, const cf_fragment *f)
+{
+    double v = 0;
+    for (int i = 0; i < f->nt; i++)
+        v += sim->solid.vol[f->tets[i]];
+    return v;
+}
+
+/* Debris (docs/physics.md §9.2): a piece, not an initial body, of at most
+ * solver.debris_tets tets (the mesh cannot resolve its breaking), or
+ * whose sphere of equal volume is narrower than solver.debris_size.  A
+ * property of the fragment's tets, so it holds from birth. */
+int cf_fragment_is_debris(const cf_world *sim, int fi)
+{
+    const cf_fragment *f = &sim->frag[fi];
+    const cf_solver_settings *set = &sim->def.solver;
+    if (f->parent < 0)
+        return 0;
+    return f->nt <= set->debris_tets ||
+           (set->debris_size > 0 && cbrt(6 * fragment_volume(sim, f) / PI) < set->debris_size);
+}
+
 /* Mass and centre of mass from the tets (identical to the lumped ones); the
  * inertia of the lumped masses, the solver's own discretisation, so that a
  * hand-off preserves linear and angular momentum and never adds kinetic
@@ -75,14 +100,27 @@ static int decompose_fragment(cf_world *sim, cf_fragment *f)
     return 0;
 }
 
+/* Debris's sphere: of the piece's volume, shrunk where an obstacle is
+ * nearer its centre of mass (a piece lying flat on the floor), so that
+ * Bullet finds no overlap to push apart. */
+static double debris_radius(const cf_world *sim, int fi, const double com[3])
+{
+    const cf_fragment *f = &sim->frag[fi];
+    double n[3], r = cbrt(3 * fragment_volume(sim, f) / (4 * PI));
+    for (int j = 0; j < sim->obs.n; j++) {
+        double d = cf_obstacle_distance(&sim->obs, j, sim->t, com, n);
+        if (d > 0)
+            r = fmin(r, d);
+    }
+    return r;
+}
+
 /* Rotation of the Bullet body frame: rest->current R times principal axes Q. */
 cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const double R[9],
                                const double v[3], const double w[3], cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
     const cf_solid *s = &sim->solid;
-    if (decompose_fragment(sim, f))
-        return cf_error_set(err, CF_ERR_NOMEM, "out of memory decomposing fragment %d", fi);
     cfb_state st;
     double RQ[9];
     m3_mul(R, f->Q, RQ);
@@ -90,9 +128,16 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     memcpy(st.pos, pos, sizeof st.pos);
     memcpy(st.v, v, sizeof st.v);
     memcpy(st.w, w, sizeof st.w);
-    f->body = cfb_add_compound_body(sim->bullet, f->mass, f->principal, f->hulls.pts,
-                                    f->hulls.start, f->hulls.n_hulls, cf_fragment_margin(sim, fi), &st,
-                                    s->mat.friction, s->mat.restitution);
+    if (cf_fragment_is_debris(sim, fi))
+        f->body = cfb_add_sphere_body(sim->bullet, f->mass, f->principal, debris_radius(sim, fi, pos),
+                                      &st, s->mat.friction, s->mat.restitution);
+    else if (decompose_fragment(sim, f))
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory decomposing fragment %d", fi);
+    else
+        f->body = cfb_add_compound_body(sim->bullet, f->mass, f->principal, f->hulls.pts,
+                                        f->hulls.start, f->hulls.n_hulls,
+                                        cf_fragment_margin(sim, fi), &st, s->mat.friction,
+                                        s->mat.restitution);
     if (f->body < 0)
         return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused fragment %d: %s", fi,
                             cfb_last_error());

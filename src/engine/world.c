@@ -388,6 +388,7 @@ int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
     o->n_tets = f->nt;
     memcpy(o->inertia_principal, f->principal, sizeof f->principal);
     o->n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
+    o->debris = cf_fragment_is_debris(sim, id);
     o->hull_volume_error = cf_hulls_error(&f->hulls);
     o->decomposition_time = f->decompose_time;
     memcpy(o->com_rest, f->com_rest, sizeof o->com_rest);
@@ -799,12 +800,12 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
     return insane == 0;
 }
 
-/* A fragment with no uncracked interior facet (a single tet, say) cannot
- * break further: an impact leaves it in rigid mode. */
+/* Debris, and a fragment with no uncracked interior facet (a single tet,
+ * say), cannot break further: an impact leaves it in rigid mode. */
 static int can_break(const cf_world *sim, const cf_fragment *f)
 {
     const cf_solid *s = &sim->solid;
-    if (sim->def.solver.criterion == CF_CRITERION_NONE)
+    if (sim->def.solver.criterion == CF_CRITERION_NONE || cf_fragment_is_debris(sim, (int)(f - sim->frag)))
         return 0;
     for (int i = 0; i < f->nt; i++)
         for (int k = 0; k < 4; k++) {
@@ -1099,7 +1100,8 @@ static int impact_unfinished(cf_world *sim, int fi)
 }
 
 /* Fracture-mode fragments that have been quiet long enough, and no longer
- * drive into an obstacle, go back to rigid mode. */
+ * drive into an obstacle, go back to rigid mode; debris at once, as it
+ * cannot break further. */
 static cf_status return_to_rigid(cf_world *sim, cf_error *err)
 {
     const cf_solver_settings *set = &sim->def.solver;
@@ -1109,7 +1111,8 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         int timed_out = sim->t - f->t_enter >= set->max_fracture_time - 1e-12;
-        if (!timed_out && (f->quiet < set->quiet_steps || impact_unfinished(sim, fi)))
+        if (!timed_out && !cf_fragment_is_debris(sim, fi) &&
+            (f->quiet < set->quiet_steps || impact_unfinished(sim, fi)))
             continue;
         int first_new = sim->n_frag;
         double th = cf_wall_time();
@@ -1254,6 +1257,13 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     int n = 0;
     for (int fi = 0; fi < sim->n_frag; fi++) {
         const cf_fragment *f = &sim->frag[fi];
+        if (f->mode != CF_MODE_DEAD)
+            o->mass_alive += f->mass;
+        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(sim, fi)) {
+            o->debris++;
+            o->debris_mass += f->mass;
+            continue;
+        }
         if (f->mode == CF_MODE_RIGID && f->body >= 0) {
             if (e)
                 e[n] = cf_hulls_error(&f->hulls);

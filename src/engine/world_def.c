@@ -46,7 +46,7 @@ cf_solver_settings cf_default_solver(void)
     s.ccd = 1;
     s.elasticity = CF_ELASTICITY_COROTATIONAL;
     s.criterion = CF_CRITERION_TRACTION;
-    s.crack_growth = CF_GROWTH_FRONTS, s.min_piece_tets = 4;
+    s.crack_growth = CF_GROWTH_FRONTS, s.min_piece_tets = 4, s.debris_tets = 4;
     s.obstacle_contact = CF_OBSTACLE_CONTACT_KINEMATIC;
     s.crack_plane_normal[2] = 1.0, s.crack_plane_tolerance = 1e-6;
     s.constraints = CF_CONSTRAINTS_PBD;
@@ -249,6 +249,8 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("solver.check_interval", s->check_interval, AT_LEAST_ONE);
     CHECK("solver.quiet_steps", s->quiet_steps, AT_LEAST_ONE);
     CHECK("solver.min_piece_tets", s->min_piece_tets, PIECE_TETS);
+    CHECK("solver.debris_tets", s->debris_tets, PIECE_TETS);
+    CHECK("solver.debris_size", s->debris_size, NON_NEGATIVE);
     CHECK("solver.max_fracture_time", s->max_fracture_time, POSITIVE);
     CHECK("solver.impact_threshold", s->impact_threshold, NON_NEGATIVE);
     CHECK("solver.sleeping.linear", s->sleep_linear, NON_NEGATIVE);

@@ -142,6 +142,9 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
  * threshold (normal approach speed). */
 int cf_pbd_impact(const cf_world *sim, int fi, double dt);
 
+/* Whether fragment fi is debris (docs/physics.md §9.2): 1 or 0. */
+int cf_fragment_is_debris(const cf_world *sim, int fi);
+
 /* Compute the rest-shape mass properties of fragment fi. */
 void cf_fragment_rest_props(cf_world *sim, int fi);
 

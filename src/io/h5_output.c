@@ -73,7 +73,7 @@ static const column_def FIELDS[FLD_COUNT] = {
 };
 
 enum { FR_PARENT, FR_BIRTH, FR_MASS, FR_NTETS, FR_INERTIA, FR_NHULLS, FR_HULLERR, FR_DECOMP,
-       FR_COMREST, FR_SURF_FIRST, FR_SURF_COUNT, FR_COUNT };
+       FR_COMREST, FR_SURF_FIRST, FR_SURF_COUNT, FR_DEBRIS, FR_COUNT };
 static const column_def FRAGMENT_COLUMNS[FR_COUNT] = {
     {"parent", 1, 1, NULL},
     {"birth_time", 1, 0, "s"},
@@ -86,6 +86,7 @@ static const column_def FRAGMENT_COLUMNS[FR_COUNT] = {
     {"com_rest", 3, 0, "m"},
     {"surface_first", 1, 1, NULL},
     {"surface_count", 1, 1, NULL},
+    {"debris", 1, 1, NULL},
 };
 
 /* Fragment surfaces: boundary triangles on /mesh/rest/nodes (outward
@@ -984,12 +985,13 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
     if (n == 0)
         return CF_OK;
     size_t un = (size_t)n;
-    if (grow_scratch(h, 6 * un, 10 * un) < 0)
+    if (grow_scratch(h, 7 * un, 10 * un) < 0)
         return no_memory(err, h->path);
     /* Rows are stored by id; the batch may list the new ids in any order. */
     long long base = (long long)h->nfragments;
     int *src = h->ibuf, *parent = h->ibuf + un, *ntets = h->ibuf + 2 * un;
     int *nhulls = h->ibuf + 3 * un, *sfirst = h->ibuf + 4 * un, *scount = h->ibuf + 5 * un;
+    int *debris = h->ibuf + 6 * un;
     for (size_t i = 0; i < un; ++i)
         src[i] = -1;
     for (int i = 0; i < n; ++i) {
@@ -1023,9 +1025,10 @@ static cf_status add_fragments_impl(cf_h5 *h, const cf_frag_info *info, int n, c
         }
         sfirst[r] = fi->surface_first;
         scount[r] = fi->surface_count;
+        debris[r] = fi->debris;
     }
     const void *bufs[FR_COUNT] = {parent, birth,      mass, ntets,  inertia, nhulls,
-                                  hull_error, decomp, com,  sfirst, scount};
+                                  hull_error, decomp, com,  sfirst, scount, debris};
     for (int c = 0; c < FR_COUNT; ++c)
         if (append_rows(h->fragment[c], h->nfragments, un, mem_type(&FRAGMENT_COLUMNS[c]),
                         bufs[c]) < 0)

@@ -591,6 +591,10 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
             p.steps_fracture, p.threads);
     fprintf(out, "fragments          %d alive (%d in fracture mode), %d ever\n", p.alive,
             p.in_fracture, p.ever);
+    if (p.debris > 0)
+        fprintf(out, "debris             %d fragments, %.4g kg (%.2f%% of the mass), spheres in "
+                     "the rigid step (docs/physics.md §9.2)\n",
+                p.debris, p.debris_mass, 100 * p.debris_mass / fmax(p.mass_alive, 1e-300));
     fprintf(out, "cohesive elements  %d\n", p.cohesive);
     fprintf(out, "hand-offs          %d, max linear momentum error %.3g (relative), "
                  "handoff_loss %.4g J\n",
