@@ -71,6 +71,11 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
 cf_status cf_world_step(cf_world *w, cf_error *err);
 int cf_world_done(const cf_world *w);
 
+/* Threads for the element loops from the next step on (n >= 1; the
+ * calling thread's OpenMP setting).  The results do not depend on it: the
+ * state hash is the same for any count. */
+void cf_world_set_threads(cf_world *w, int n);
+
 /* Rigid steps taken and the number the duration needs; the rigid step, s
  * (fracture-only runs: a whole number of fracture steps). */
 long cf_world_step_count(const cf_world *w);

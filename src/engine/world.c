@@ -1160,6 +1160,13 @@ const cf_world_def *cf_world_definition(const cf_world *sim) { return &sim->def;
 
 int cf_world_done(const cf_world *sim) { return sim->step >= sim->n_steps; }
 
+void cf_world_set_threads(cf_world *sim, int n)
+{
+    (void)sim;
+    if (n >= 1)
+        omp_set_num_threads(n);
+}
+
 long cf_world_step_count(const cf_world *sim) { return sim->step; }
 
 long cf_world_steps_total(const cf_world *sim) { return sim->n_steps; }

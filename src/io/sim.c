@@ -6,6 +6,7 @@
 #include "cohfrac/h5_output.h"
 #include "cohfrac/surface.h"
 
+#include <dirent.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -64,6 +65,12 @@ struct cf_sim {
     int *tet_frag;              /* [n_tets] */
     int topology_changed;
     long frames_written;
+    /* Threads on a shared host (docs/performance.md): with the default
+     * count, the element loops use the cores other processes leave free. */
+    int threads_max;            /* the count at create; 0: the user chose it, fixed */
+    int threads_now, threads_least;
+    double busy;                /* other processes' runnable tasks, smoothed */
+    double last_balance;        /* s, wall clock of the last look at the host */
 };
 
 cf_world *cf_sim_world(const cf_sim *sim) { return sim->world; }
@@ -313,6 +320,11 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
         st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
     if (st == CF_OK)
         st = cf_world_create(&w, &sim->world, err);
+    if (st == CF_OK && w.solver.threads == 0) { /* the default: adapts to the host */
+        cf_world_stats ws;
+        cf_world_stats_get(sim->world, &ws);
+        sim->threads_max = sim->threads_now = sim->threads_least = ws.threads;
+    }
     free(w.bodies), free(w.obstacles);
     if (st == CF_OK && sim->h5) {
         st = write_initial_bounds(sim, err);
@@ -475,6 +487,64 @@ static void progress(cf_sim *sim, int final)
     }
 }
 
+/* Runnable tasks of other processes now: the count in /proc/loadavg less
+ * this process's running threads; -1 where /proc cannot say. */
+static int others_runnable(void)
+{
+    FILE *f = fopen("/proc/loadavg", "r");
+    double a, b, c;
+    int running = -1, total, own = 0;
+    if (!f)
+        return -1;
+    int ok = fscanf(f, "%lf %lf %lf %d/%d", &a, &b, &c, &running, &total) == 5;
+    fclose(f);
+    DIR *d = ok ? opendir("/proc/self/task") : NULL;
+    if (!d)
+        return -1;
+    for (struct dirent *e; (e = readdir(d));) {
+        char path[300], buf[512];
+        if (e->d_name[0] == '.')
+            continue;
+        snprintf(path, sizeof path, "/proc/self/task/%s/stat", e->d_name);
+        FILE *s = fopen(path, "r");
+        if (!s)
+            continue;
+        size_t n = fread(buf, 1, sizeof buf - 1, s);
+        fclose(s);
+        buf[n] = 0;
+        const char *p = strrchr(buf, ')'); /* the state follows the name */
+        own += p && p[1] == ' ' && p[2] == 'R';
+    }
+    closedir(d);
+    return running > own ? running - own : 0;
+}
+
+/* With the default thread count, use the cores other processes leave free
+ * (at least one), looked at every quarter second and smoothed over about
+ * a second.  OpenMP threads spin at every barrier, so on a host whose
+ * cores are all taken two threads wait for each other's turn: `make run`
+ * took 6.5 times as long with two threads as with one beside two busy
+ * processes.  The bits do not depend on the count. */
+static void balance_threads(cf_sim *sim)
+{
+    double now = cf_wall_time();
+    if (sim->threads_max < 2 || now - sim->last_balance < 0.25)
+        return;
+    sim->last_balance = now;
+    int others = others_runnable();
+    if (others < 0)
+        return;
+    sim->busy += 0.3 * (others - sim->busy);
+    int want = sim->threads_max - (int)lround(sim->busy);
+    want = want < 1 ? 1 : want;
+    if (want != sim->threads_now) {
+        cf_world_set_threads(sim->world, want);
+        sim->threads_now = want;
+        if (want < sim->threads_least)
+            sim->threads_least = want;
+    }
+}
+
 cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
 {
     if (sim->loop_start == 0)
@@ -491,6 +561,7 @@ cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
             sim->next_frame += sim->output.frame_interval;
     }
     progress(sim, 0);
+    balance_threads(sim);
     return st;
 }
 
@@ -587,8 +658,11 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
                 "(%.3g %% of the mass), their wave speed down to %.3g of c_d at the least\n",
                 p.mass_scaled, d->solver.mass_scaling, p.mass_added,
                 100.0 * p.mass_added / p.mass_total, p.wave_speed_least);
-    fprintf(out, "steps per mode     rigid %ld, fracture %ld (threads %d)\n", p.steps_rigid,
-            p.steps_fracture, p.threads);
+    fprintf(out, "steps per mode     rigid %ld, fracture %ld (threads %d", p.steps_rigid,
+            p.steps_fracture, sim->threads_max ? sim->threads_max : p.threads);
+    if (sim->threads_least < sim->threads_max)
+        fprintf(out, ", down to %d while other processes held the cores", sim->threads_least);
+    fprintf(out, ")\n");
     fprintf(out, "fragments          %d alive (%d in fracture mode), %d ever\n", p.alive,
             p.in_fracture, p.ever);
     if (p.debris > 0)
