@@ -81,9 +81,15 @@ void cf_fragment_rest_props(cf_world *sim, int fi)
 }
 
 /* Convex decomposition of fragment fi (docs/physics.md §9), kept in the principal
- * frame for Bullet and for fracture-mode contact. */
+ * frame for Bullet and for fracture-mode contact.  A fragment's tets never
+ * change (a split makes new fragments) and the decomposition reads their
+ * rest shape only, so a fragment that comes back from fracture mode in one
+ * piece keeps the hulls it had: the same bits, without the work (most of
+ * a drop's wall time went to decomposing pieces again after each touch). */
 static int decompose_fragment(cf_world *sim, cf_fragment *f)
 {
+    if (f->hulls.n_hulls > 0)
+        return 0;
     double t0 = cf_wall_time();
     cf_hulls_free(&f->hulls);
     if (cf_decompose(&sim->solid, f->tets, f->nt, CF_HULL_MAX_ERROR, CF_HULL_MAX_COUNT,
