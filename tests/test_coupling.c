@@ -572,6 +572,59 @@ static void test_no_return_while_driving_in(void **state)
     cf_scene_free(&sc);
 }
 
+/* A box lands at 1 m/s under gravity, bounces on its own elasticity (each
+ * bounce a new impact), and then rests on the ground (docs/physics.md
+ * §9).  Resting contact is no impact: Bullet's contact impulse on a
+ * resting body is m g dt per step, far below the impact threshold's m v,
+ * so once at rest it never goes back to fracture mode; the resting piece
+ * of examples/drop.c used to switch modes every 2 ms. */
+static const char *resting_scene =
+    "return {\n"
+    "  name = 'resting', duration = 1.0,\n"
+    "  material = {E = 1e5, nu = 0.25, rho = 1000, G_I = 1, sigma_max = 1e9,\n"
+    "              friction = 0.5, restitution = 0},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {2, 2, 2}},\n"
+    "             position = {0, 0, 0.101}}},\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {dt_rigid = 1e-3, dt_fracture = 1e-4, quiet_steps = 100,\n"
+    "            constraints = 'xpbd'},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void test_resting_body_stays_rigid(void **state)
+{
+    (void)state;
+    cf_world_def sc;
+    cf_sim *sim = make_sim(resting_scene, &sc);
+    cf_error err = {0};
+    int entries = 0, was = 0, after_rest = 0, handoffs_at_rest = -1;
+    double rest_time = -1;
+    while (!cf_sim_done(sim)) {
+        if (cf_sim_advance(sim, &err) != CF_OK)
+            fail_msg("run: %s", err.msg);
+        cf_world *w = cf_sim_world(sim);
+        int now = any_in_fracture_mode(sim);
+        entries += now && !was;
+        after_rest += now && !was && rest_time >= 0;
+        was = now;
+        cf_fragment_state f[1];
+        cf_world_fragments(w, f, 1);
+        double speed = sqrt(f[0].v[0] * f[0].v[0] + f[0].v[1] * f[0].v[1] + f[0].v[2] * f[0].v[2]);
+        if (rest_time < 0 && !now && speed < 0.01 && fabs(f[0].com[2] - 0.05) < 1e-3)
+            rest_time = cf_world_time(w), handoffs_at_rest = w->n_handoffs;
+    }
+    const cf_world *w = cf_sim_world(sim);
+    printf("FIGURE resting: %d entries into fracture mode (landing and bounces), at rest from "
+           "t = %.3f s, then %d entries and %d hand-offs to t = 1 s\n",
+           entries, rest_time, after_rest, w->n_handoffs - handoffs_at_rest);
+    assert_true(entries >= 1); /* the landing is an impact */
+    assert_true(rest_time >= 0 && rest_time < 0.6);
+    assert_int_equal(after_rest, 0);
+    assert_int_equal(w->n_handoffs, handoffs_at_rest);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
 /* scenes/expanding_bar.lua (fracture mode only): pieces alive at the end
  * and the state hash, for a strength setting and a thread count. */
 static int expanding_bar(const char *strength, int threads, uint64_t *hash)
@@ -626,6 +679,7 @@ int main(void)
         cmocka_unit_test(test_determinism_hash_coloured),
         cmocka_unit_test(test_reentry_keeps_the_family_tree),
         cmocka_unit_test(test_debris_stays_rigid_and_conserves),
+        cmocka_unit_test(test_resting_body_stays_rigid),
         cmocka_unit_test(test_mesh_obstacle_matches_plane),
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),
         cmocka_unit_test(test_no_return_while_driving_in),
