@@ -20,6 +20,12 @@ expect 0 "--version" "$exe" --version
 expect 0 "a tiny run" "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q
 expect 1 "no command" "$exe"
 expect 1 "unknown option" "$exe" run --bogus "$tmp/drop.lua"
+expect 0 "bench --scene: the cost of fracture mode" "$exe" bench --scene "$tmp/drop.lua" \
+    -m "$meshes" --set duration=0.001
+expect 1 "bench --fracture-ms that is no number" "$exe" bench --scene "$tmp/drop.lua" \
+    --fracture-ms soon
+expect 1 "bench --set without --scene" "$exe" bench --set duration=1
+expect 2 "bench --scene with a bad value" "$exe" bench --scene "$tmp/bad.lua" -m "$meshes"
 expect 2 "scene value out of range" "$exe" run "$tmp/bad.lua" --mesh-dir "$meshes"
 expect 2 "missing scene file" "$exe" run "$tmp/none.lua"
 expect 2 "open surface" "$exe" mesh "$tmp/open.obj" -o "$tmp/m"

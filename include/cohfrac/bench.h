@@ -71,6 +71,35 @@ typedef struct cf_bench_result {
  * scene, CF_ERR_EXTERNAL (the peer failed), CF_ERR_NOMEM. */
 cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *err);
 
+/* A whole scene, as `cohfrac run` runs it without output: what a
+ * simulated millisecond of fracture mode costs (`cohfrac bench --scene`,
+ * docs/performance.md).  Each of `repeats` runs loads the scene with its
+ * overrides, runs it to its duration, or until `fracture_ms` (> 0) of
+ * simulated time has had a fragment in fracture mode, and reads the wall
+ * time of the rigid steps with and without fracture mode.  The rows: wall
+ * per simulated ms of fracture mode, Tet4 steps per second of that wall,
+ * and wall per rigid-only step, min and median over the repeats, with the
+ * process CPU time beside the wall. */
+typedef struct cf_bench_scene_options {
+    const char *scene;                /* path of the scene script */
+    const char *const *overrides;     /* --set KEY=VALUE, as for `cohfrac run` */
+    int n_overrides;
+    double fracture_ms;               /* stop after this much fracture mode; 0: the duration */
+} cf_bench_scene_options;
+
+typedef struct cf_bench_scene_result {
+    double fracture_ms;               /* simulated ms with a fragment in fracture mode */
+    double s_per_fracture_ms_min, s_per_fracture_ms_median; /* wall s per simulated ms */
+    double cpu_s_per_fracture_ms;     /* CPU s per simulated ms (median repeat) */
+    double tet_steps_per_s;           /* Tet4 steps per second of fracture-mode wall (best) */
+    double rigid_step_ms;             /* wall ms per rigid-only step (median) */
+    double wall_min, wall_median;     /* s, the whole run */
+} cf_bench_scene_result;
+
+/* Errors: those of loading the scene and of the run. */
+cf_status cf_bench_scene(const cf_bench_options *o, const cf_bench_scene_options *so,
+                         cf_bench_scene_result *r, cf_error *err);
+
 /* Scaling: the step (criterion "none", N threads, min of `repeats`) on each
  * of `n` meshes; prints a table (tets, ms per step, ns per tet-step, bytes
  * of engine memory per tet) and the least-squares exponent b of

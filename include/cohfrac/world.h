@@ -316,7 +316,9 @@ typedef struct cf_world_stats {
     int mass_scaled;                    /* tets whose density solver.mass_scaling raised */
     double mass_added, mass_total;      /* kg: what it added; the bodies' mass with it (0: none) */
     double wave_speed_least;            /* the slowest scaled tet's wave speed over c_d */
-    long steps_rigid, steps_fracture;
+    long steps_rigid, steps_fracture;   /* rigid steps; fracture-mode fragment steps */
+    long long tet_steps_fracture;       /* tets stepped, summed over fracture steps */
+    double t_fracture;                  /* s of simulated time with a fragment in fracture mode */
     int threads;
     int alive, in_fracture, ever;       /* fragments */
     int cohesive;

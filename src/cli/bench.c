@@ -359,3 +359,107 @@ cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes,
                 *exponent, *bytes_per_tet);
     return CF_OK;
 }
+
+/* One run of a scene (cf_bench_scene): wall and CPU s with and without
+ * fracture mode, simulated s of fracture mode, tet-steps, rigid-only steps. */
+typedef struct scene_sample {
+    double wall, fracture_wall, fracture_cpu, fracture_t, rigid_wall;
+    long long tet_steps;
+    long rigid_steps;
+} scene_sample;
+
+static cf_status scene_once(const cf_bench_options *o, const cf_bench_scene_options *so,
+                            scene_sample *out, cf_error *err)
+{
+    cf_world_def def;
+    const char **sets = malloc((size_t)(so->n_overrides + 1) * sizeof *sets);
+    if (!sets)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < so->n_overrides; i++)
+        sets[i] = so->overrides[i];
+    sets[so->n_overrides] = "output.file=\"\"";
+    cf_status st = cf_scene_load(so->scene, sets, so->n_overrides + 1, o->mesh_dir, &def, err);
+    free(sets);
+    if (st != CF_OK)
+        return st;
+    cf_run_options ro = {.progress = 0, .threads = o->threads, .mesh_dir = o->mesh_dir};
+    cf_sim *sim = NULL;
+    st = cf_sim_create(&def, &ro, &sim, err);
+    memset(out, 0, sizeof *out);
+    double w0 = cf_wall_time();
+    while (st == CF_OK && !cf_sim_done(sim) &&
+           !(so->fracture_ms > 0 && out->fracture_t >= 1e-3 * so->fracture_ms)) {
+        cf_world_stats a, b;
+        cf_world_stats_get(cf_sim_world(sim), &a);
+        double w = cf_wall_time(), c = cpu_time();
+        st = cf_sim_advance(sim, err);
+        w = cf_wall_time() - w, c = cpu_time() - c;
+        cf_world_stats_get(cf_sim_world(sim), &b);
+        if (b.steps_fracture > a.steps_fracture) {
+            out->fracture_wall += w, out->fracture_cpu += c;
+            out->fracture_t += b.t_fracture - a.t_fracture;
+            out->tet_steps += b.tet_steps_fracture - a.tet_steps_fracture;
+        } else {
+            out->rigid_wall += w, out->rigid_steps++;
+        }
+    }
+    out->wall = cf_wall_time() - w0;
+    cf_sim_destroy(sim);
+    cf_scene_free(&def);
+    return st;
+}
+
+cf_status cf_bench_scene(const cf_bench_options *o, const cf_bench_scene_options *so,
+                         cf_bench_scene_result *r, cf_error *err)
+{
+    int n = o->repeats > 0 ? o->repeats : 1;
+    scene_sample *s = calloc((size_t)n, sizeof *s);
+    double *v = malloc((size_t)n * sizeof *v);
+    if (!s || !v) {
+        free(s), free(v);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    memset(r, 0, sizeof *r);
+    cf_status st = CF_OK;
+    for (int k = 0; k < n && st == CF_OK; k++) {
+        st = scene_once(o, so, &s[k], err);
+        if (st == CF_OK && o->log)
+            fprintf(o->log, "repeat %d: %.2f s, fracture mode %.3f ms simulated in %.2f s\n", k + 1,
+                    s[k].wall, 1e3 * s[k].fracture_t, s[k].fracture_wall);
+    }
+    if (st == CF_OK) {
+        r->fracture_ms = 1e3 * s[0].fracture_t;
+        for (int k = 0; k < n; k++)
+            v[k] = s[k].fracture_t > 0 ? s[k].fracture_wall / (1e3 * s[k].fracture_t) : 0;
+        r->s_per_fracture_ms_median = median(v, n);
+        r->s_per_fracture_ms_min = v[0];
+        for (int k = 0; k < n; k++) {
+            r->s_per_fracture_ms_min = fmin(r->s_per_fracture_ms_min, v[k]);
+            r->tet_steps_per_s = fmax(r->tet_steps_per_s, s[k].fracture_wall > 0
+                                      ? (double)s[k].tet_steps / s[k].fracture_wall : 0);
+        }
+        for (int k = 0; k < n; k++)
+            v[k] = s[k].fracture_t > 0 ? s[k].fracture_cpu / (1e3 * s[k].fracture_t) : 0;
+        r->cpu_s_per_fracture_ms = median(v, n);
+        for (int k = 0; k < n; k++)
+            v[k] = s[k].rigid_steps > 0 ? 1e3 * s[k].rigid_wall / (double)s[k].rigid_steps : 0;
+        r->rigid_step_ms = median(v, n);
+        for (int k = 0; k < n; k++)
+            v[k] = s[k].wall;
+        r->wall_median = median(v, n);
+        r->wall_min = v[0];
+        for (int k = 0; k < n; k++)
+            r->wall_min = fmin(r->wall_min, v[k]);
+        if (o->log)
+            fprintf(o->log,
+                    "bench-scene: %s fracture_ms=%.3f s_per_fracture_ms_min=%.3f "
+                    "s_per_fracture_ms_median=%.3f cpu_s_per_fracture_ms=%.3f "
+                    "tet_steps_per_s=%.4g rigid_step_ms=%.4f wall_min=%.2f wall_median=%.2f "
+                    "repeats=%d\n",
+                    so->scene, r->fracture_ms, r->s_per_fracture_ms_min,
+                    r->s_per_fracture_ms_median, r->cpu_s_per_fracture_ms, r->tet_steps_per_s,
+                    r->rigid_step_ms, r->wall_min, r->wall_median, n);
+    }
+    free(s), free(v);
+    return st;
+}

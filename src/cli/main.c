@@ -120,6 +120,14 @@ static const struct {
      "      --peer                          also step Bullet's btSoftBody on the same mesh\n"
      "      --scaling[=M1,M2,...]           step time and memory per tet over meshes (default\n"
      "                                      bunny_small,bunny_80k,bunny,bunny_800k)\n"
+     "      --scene FILE                    instead: run a scene without output and give\n"
+     "                                      the wall and CPU time per simulated ms of\n"
+     "                                      fracture mode, Tet4 steps per second, and the\n"
+     "                                      rigid-only step (min and median of --repeats,\n"
+     "                                      default 1 here)\n"
+     "      -s, --set KEY=VALUE             with --scene: as for 'run'\n"
+     "      --fracture-ms X                 with --scene: stop after X simulated ms of\n"
+     "                                      fracture mode (default: the scene's duration)\n"
      "      -m, --mesh-dir DIR              as for 'run'\n"},
 };
 
@@ -524,7 +532,8 @@ static char *peer_path(void)
 
 static int cmd_bench(int argc, char **argv)
 {
-    enum { O_MESH = 256, O_STEPS, O_REPEATS, O_CRITERION, O_PEER, O_SCALING, O_WARMUP };
+    enum { O_MESH = 256, O_STEPS, O_REPEATS, O_CRITERION, O_PEER, O_SCALING, O_WARMUP, O_SCENE,
+           O_FRACTURE_MS };
     static const struct option lo[] = {{"mesh", required_argument, 0, O_MESH},
                                        {"steps", required_argument, 0, O_STEPS},
                                        {"warmup", required_argument, 0, O_WARMUP},
@@ -534,18 +543,37 @@ static int cmd_bench(int argc, char **argv)
                                        {"peer", no_argument, 0, O_PEER},
                                        {"scaling", optional_argument, 0, O_SCALING},
                                        {"mesh-dir", required_argument, 0, 'm'},
+                                       {"scene", required_argument, 0, O_SCENE},
+                                       {"set", required_argument, 0, 's'},
+                                       {"fracture-ms", required_argument, 0, O_FRACTURE_MS},
                                        {0, 0, 0, 0}};
+    static const char *sets[64];
+    cf_bench_scene_options so = {.overrides = sets};
+    int repeats_given = 0;
     cf_bench_options o = {.mesh = "bunny", .mesh_dir = cf_default_mesh_dir(), .steps = 60,
                           .warmup = 100, .repeats = 3, .criterion = CF_CRITERION_SOURCE,
                           .log = stdout};
     const char *scaling = NULL;
     int c, peer = 0;
-    while ((c = getopt_long(argc, argv, "m:t:", lo, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "m:t:s:", lo, NULL)) != -1) {
         switch (c) {
+        case O_SCENE: so.scene = optarg; break;
+        case 's':
+            if (so.n_overrides == 64)
+                return usage_error("at most 64 --set options");
+            sets[so.n_overrides++] = optarg;
+            break;
+        case O_FRACTURE_MS: {
+            char *end;
+            so.fracture_ms = strtod(optarg, &end);
+            if (*end || !(so.fracture_ms > 0) || !isfinite(so.fracture_ms))
+                return usage_error("--fracture-ms needs a number of milliseconds > 0");
+            break;
+        }
         case O_MESH: o.mesh = optarg; break;
         case O_STEPS: o.steps = count_arg("--steps", optarg, 1); break;
         case O_WARMUP: o.warmup = count_arg("--warmup", optarg, 0); break;
-        case O_REPEATS: o.repeats = count_arg("--repeats", optarg, 1); break;
+        case O_REPEATS: o.repeats = count_arg("--repeats", optarg, 1), repeats_given = 1; break;
         case 't': o.threads = count_arg("--threads", optarg, 1); break;
         case O_CRITERION:
             if (!strcmp(optarg, "none")) o.criterion = CF_CRITERION_NONE;
@@ -569,6 +597,14 @@ static int cmd_bench(int argc, char **argv)
         return cf_status_exit_code(CF_ERR_EXTERNAL);
     }
     cf_error err = {0};
+    if (so.scene) {
+        cf_bench_scene_result r;
+        if (!repeats_given)
+            o.repeats = 1;
+        return cf_bench_scene(&o, &so, &r, &err) == CF_OK ? 0 : fail(&err);
+    }
+    if (so.n_overrides > 0 || so.fracture_ms > 0)
+        return usage_error("--set and --fracture-ms go with --scene");
     if (scaling) {
         char *list = strdup(scaling), *save = NULL;
         if (!list)

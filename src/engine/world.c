@@ -981,6 +981,7 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
             if (cf_solver_step(sim, fi, sim->t + (double)k * h, h, 1) != CF_OK)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
             sim->steps_fracture++;
+            sim->tet_steps_fracture += sim->frag[fi].nt;
         }
         if (bodies) {
             double removed, t0 = cf_wall_time();
@@ -1198,9 +1199,12 @@ cf_status cf_world_step(cf_world *sim, cf_error *err)
         n_sub = sub_steps(sim, dt, &h);
     }
     int n_coh = sim->solid.n_coh;
+    long stepped = sim->steps_fracture;
     cf_status st = rigid_step(sim, dt, err);
     if (st == CF_OK)
         st = fracture_steps(sim, dt, n_sub, h, err);
+    if (sim->steps_fracture > stepped)
+        sim->t_fracture += dt;
     sim->step++;
     sim->t = !cut ? (double)sim->step * sim->dt_outer
                   : sc->solver.mode == CF_RUN_FRACTURE ? t0 + dt : sc->duration;
@@ -1249,6 +1253,7 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->mass_total = sim->solid.mass_total;
     o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(sim->solid.mass_scale_max) : 1.0;
     o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
+    o->tet_steps_fracture = sim->tet_steps_fracture, o->t_fracture = sim->t_fracture;
     o->threads = omp_get_max_threads();
     o->alive = alive_fragments(sim, &o->in_fracture);
     o->ever = sim->n_frag;

@@ -109,6 +109,8 @@ struct cf_world {
     double next_frame;       /* s */
     cf_profile prof;
     long steps_rigid, steps_fracture;
+    long long tet_steps_fracture; /* sum over fracture steps of the tets stepped */
+    double t_fracture;       /* s of simulated time with a fragment in fracture mode */
     cf_energy_flows flow;
     double e0;               /* J, initial kinetic + strain energy */
     double mx0[3];           /* kg m, initial sum m x */
