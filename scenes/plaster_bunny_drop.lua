@@ -29,7 +29,7 @@
 -- 8 and 8%), 19 of at least 1% and no chip of 4 tets or fewer; of the 78 J
 -- it lands with, about 39 J go into crushing and 4.2 J into the cracks;
 -- the fastest piece leaves at about 5.3 m/s against the bound 8.0 m/s of
--- tools/check_physics.py; about 4 s on one thread.  Seeds 2-5 give 2, 4,
+-- tools/check_physics.py; about 10 s on one thread.  Seeds 2-5 give 2, 4,
 -- 3 and 4 pieces of at least 5%, all within the bound; bunny_4k gives 1,
 -- 3, 3, 2 and 3 (docs/physics.md §14.10).
 return {

@@ -8,6 +8,7 @@
 #include "fixtures.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0};
@@ -48,6 +49,33 @@ static int inside_some_hull(const cf_hulls *h, const double p[3])
             return 1;
     }
     return 0;
+}
+
+/* Cut far past any bound (an error below zero is never met), so that tets
+ * are clipped by several planes each: the cells partition space, so the
+ * hulls of the parts inside them hold the whole L, and their volumes add
+ * up to its volume at least.  They hold 0.9999 of it here (the part not
+ * traced: parts too flat for a hull are left out); the clip that dropped
+ * crossing points past 12 made hulls of 0.959 of it. */
+static void test_deep_cuts_lose_no_volume(void **state)
+{
+    (void)state;
+    cf_solid s;
+    int *tets, nt;
+    l_shape(&s, &tets, &nt);
+    cf_hulls h;
+    assert_int_equal(cf_decompose(&s, tets, nt, -0.5, 48, 1, &h), 0);
+    printf("FIGURE deep cuts: %d hulls, hull volume %.12g for a volume of %.12g\n", h.n_hulls,
+           h.hull_volume, h.tet_volume);
+    assert_true(h.n_hulls >= 16);
+    assert_true(fabs(h.tet_volume - 3.0) < 1e-12);
+    assert_true(h.hull_volume >= 3.0 * (1 - 1e-3));
+    for (int t = 0; t < nt; t++)
+        for (int j = 0; j < 4; j++)
+            assert_true(inside_some_hull(&h, &s.X[3 * s.tet[4 * tets[t] + j]]));
+    cf_hulls_free(&h);
+    free(tets);
+    cf_solid_free(&s);
 }
 
 /* One hull over the L: error = 3.5/3 - 1 = 1/6 exactly. */
@@ -118,6 +146,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_single_hull_error_is_the_l_shapes_excess),
         cmocka_unit_test(test_decomposition_meets_the_error_bound),
+        cmocka_unit_test(test_deep_cuts_lose_no_volume),
         cmocka_unit_test(test_convex_block_keeps_one_hull),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
