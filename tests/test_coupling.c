@@ -399,7 +399,8 @@ static void test_debris_stays_rigid_and_conserves(void **state)
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("run: %s", err.msg);
         for (int i = 0; i < w->n_frag; i++)
-            debris_in_fracture += cf_fragment_is_debris(w, i) && w->frag[i].mode == CF_MODE_FRACTURE;
+            debris_in_fracture +=
+                cf_fragment_is_debris(w, &w->frag[i]) && w->frag[i].mode == CF_MODE_FRACTURE;
     }
     cf_world_stats st;
     cf_world_stats_get(w, &st);
@@ -413,7 +414,7 @@ static void test_debris_stays_rigid_and_conserves(void **state)
         if (f->mode == CF_MODE_DEAD)
             continue;
         mass += f->mass;
-        if (!cf_fragment_is_debris(w, i))
+        if (!cf_fragment_is_debris(w, f))
             continue;
         debris++, debris_mass += f->mass;
         hulls += f->hulls.n_hulls;

@@ -40,27 +40,17 @@ int cf_fragment_root(const cf_world *sim, int fi)
 
 static const double PI = 3.14159265358979323846;
 
-/* Rest volume of fragment f's tets, m^3. */
-static double fragment_volume(const cf_world *sim, const cf_fragment *f)
-{
-    double v = 0;
-    for (int i = 0; i < f->nt; i++)
-        v += sim->solid.vol[f->tets[i]];
-    return v;
-}
-
 /* Debris (docs/physics.md §9.2): a piece, not an initial body, of at most
  * solver.debris_tets tets (the mesh cannot resolve its breaking), or
  * whose sphere of equal volume is narrower than solver.debris_size.  A
  * property of the fragment's tets, so it holds from birth. */
-int cf_fragment_is_debris(const cf_world *sim, int fi)
+int cf_fragment_is_debris(const cf_world *sim, const cf_fragment *f)
 {
-    const cf_fragment *f = &sim->frag[fi];
     const cf_solver_settings *set = &sim->def.solver;
     if (f->parent < 0)
         return 0;
     return f->nt <= set->debris_tets ||
-           (set->debris_size > 0 && cbrt(6 * fragment_volume(sim, f) / PI) < set->debris_size);
+           (set->debris_size > 0 && cbrt(6 * f->volume / PI) < set->debris_size);
 }
 
 /* Mass and centre of mass from the tets (identical to the lumped ones); the
@@ -75,6 +65,9 @@ void cf_fragment_rest_props(cf_world *sim, int fi)
     double I[9];
     cf_tet_mass_props(&sim->solid, f->tets, f->nt, sim->solid.X, &mp);
     f->mass = mp.mass;
+    f->volume = 0;
+    for (int i = 0; i < f->nt; i++)
+        f->volume += sim->solid.vol[f->tets[i]];
     memcpy(f->com_rest, mp.com, sizeof mp.com);
     cf_nodes_inertia(&sim->solid, f->nodes.v, f->nodes.n, sim->solid.X, mp.com, I);
     sym3_eigen(I, f->principal, f->Q);
@@ -109,10 +102,9 @@ static int decompose_fragment(cf_world *sim, cf_fragment *f)
 /* Debris's sphere: of the piece's volume, shrunk where an obstacle is
  * nearer its centre of mass (a piece lying flat on the floor), so that
  * Bullet finds no overlap to push apart. */
-static double debris_radius(const cf_world *sim, int fi, const double com[3])
+static double debris_radius(const cf_world *sim, const cf_fragment *f, const double com[3])
 {
-    const cf_fragment *f = &sim->frag[fi];
-    double n[3], r = cbrt(3 * fragment_volume(sim, f) / (4 * PI));
+    double n[3], r = cbrt(3 * f->volume / (4 * PI));
     for (int j = 0; j < sim->obs.n; j++) {
         double d = cf_obstacle_distance(&sim->obs, j, sim->t, com, n);
         if (d > 0)
@@ -134,8 +126,8 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     memcpy(st.pos, pos, sizeof st.pos);
     memcpy(st.v, v, sizeof st.v);
     memcpy(st.w, w, sizeof st.w);
-    if (cf_fragment_is_debris(sim, fi))
-        f->body = cfb_add_sphere_body(sim->bullet, f->mass, f->principal, debris_radius(sim, fi, pos),
+    if (cf_fragment_is_debris(sim, f))
+        f->body = cfb_add_sphere_body(sim->bullet, f->mass, f->principal, debris_radius(sim, f, pos),
                                       &st, s->mat.friction, s->mat.restitution);
     else if (decompose_fragment(sim, f))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory decomposing fragment %d", fi);

@@ -388,7 +388,7 @@ int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
     o->n_tets = f->nt;
     memcpy(o->inertia_principal, f->principal, sizeof f->principal);
     o->n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
-    o->debris = cf_fragment_is_debris(sim, id);
+    o->debris = cf_fragment_is_debris(sim, f);
     o->hull_volume_error = cf_hulls_error(&f->hulls);
     o->decomposition_time = f->decompose_time;
     memcpy(o->com_rest, f->com_rest, sizeof o->com_rest);
@@ -805,7 +805,7 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 static int can_break(const cf_world *sim, const cf_fragment *f)
 {
     const cf_solid *s = &sim->solid;
-    if (sim->def.solver.criterion == CF_CRITERION_NONE || cf_fragment_is_debris(sim, (int)(f - sim->frag)))
+    if (sim->def.solver.criterion == CF_CRITERION_NONE || cf_fragment_is_debris(sim, f))
         return 0;
     for (int i = 0; i < f->nt; i++)
         for (int k = 0; k < 4; k++) {
@@ -1112,7 +1112,7 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         int timed_out = sim->t - f->t_enter >= set->max_fracture_time - 1e-12;
-        if (!timed_out && !cf_fragment_is_debris(sim, fi) &&
+        if (!timed_out && !cf_fragment_is_debris(sim, f) &&
             (f->quiet < set->quiet_steps || impact_unfinished(sim, fi)))
             continue;
         int first_new = sim->n_frag;
@@ -1271,7 +1271,7 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
         const cf_fragment *f = &sim->frag[fi];
         if (f->mode != CF_MODE_DEAD)
             o->mass_alive += f->mass;
-        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(sim, fi)) {
+        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(sim, f)) {
             o->debris++;
             o->debris_mass += f->mass;
             continue;

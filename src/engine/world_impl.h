@@ -39,6 +39,7 @@ typedef struct cf_fragment {
     cf_int_list nodes;
     /* Rest-shape mass properties: principal axes Q (columns), moments. */
     double mass, com_rest[3], Q[9], principal[3];
+    double volume;           /* m^3, its tets' rest volume */
     int body;                /* Bullet body id, -1 when none */
     double q_match[4];       /* shape-matching warm start */
     /* In-house solver state (fracture mode, or pbd rigid mode). */
@@ -144,8 +145,8 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
  * threshold (normal approach speed). */
 int cf_pbd_impact(const cf_world *sim, int fi, double dt);
 
-/* Whether fragment fi is debris (docs/physics.md §9.2): 1 or 0. */
-int cf_fragment_is_debris(const cf_world *sim, int fi);
+/* Whether fragment f is debris (docs/physics.md §9.2): 1 or 0. */
+int cf_fragment_is_debris(const cf_world *sim, const cf_fragment *f);
 
 /* Compute the rest-shape mass properties of fragment fi. */
 void cf_fragment_rest_props(cf_world *sim, int fi);
