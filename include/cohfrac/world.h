@@ -241,7 +241,9 @@ void cf_world_memory(const cf_world *sim, cf_memory *m);
  * per stage (s, as in the run summary), and the sizes of what the step
  * works on now (fracture-mode fragments only). */
 typedef struct cf_step_stats {
-    long fracture_steps;
+    long fracture_steps;                   /* fracture-mode fragment steps since creation */
+    long long tet_steps;                   /* tets stepped, summed over those steps */
+    double fracture_time;                  /* s simulated with a fragment in fracture mode */
     double stress, insertion, forces, pbd; /* s of wall time since creation */
     int tets, nodes, bars, cohesive;       /* in fracture mode now */
     int iterations;                        /* constraint iterations per step */
@@ -317,8 +319,6 @@ typedef struct cf_world_stats {
     double mass_added, mass_total;      /* kg: what it added; the bodies' mass with it (0: none) */
     double wave_speed_least;            /* the slowest scaled tet's wave speed over c_d */
     long steps_rigid, steps_fracture;   /* rigid steps; fracture-mode fragment steps */
-    long long tet_steps_fracture;       /* tets stepped, summed over fracture steps */
-    double t_fracture;                  /* s of simulated time with a fragment in fracture mode */
     int threads;
     int alive, in_fracture, ever;       /* fragments */
     int cohesive;

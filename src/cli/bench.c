@@ -56,6 +56,7 @@ static int by_value(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
+/* The median of v[n], which it sorts. */
 static double median(double *v, int n)
 {
     qsort(v, (size_t)n, sizeof *v, by_value);
@@ -389,16 +390,16 @@ static cf_status scene_once(const cf_bench_options *o, const cf_bench_scene_opti
     double w0 = cf_wall_time();
     while (st == CF_OK && !cf_sim_done(sim) &&
            !(so->fracture_ms > 0 && out->fracture_t >= 1e-3 * so->fracture_ms)) {
-        cf_world_stats a, b;
-        cf_world_stats_get(cf_sim_world(sim), &a);
+        cf_step_stats a, b;
+        cf_world_step_stats(cf_sim_world(sim), &a);
         double w = cf_wall_time(), c = cpu_time();
         st = cf_sim_advance(sim, err);
         w = cf_wall_time() - w, c = cpu_time() - c;
-        cf_world_stats_get(cf_sim_world(sim), &b);
-        if (b.steps_fracture > a.steps_fracture) {
+        cf_world_step_stats(cf_sim_world(sim), &b);
+        if (b.fracture_steps > a.fracture_steps) {
             out->fracture_wall += w, out->fracture_cpu += c;
-            out->fracture_t += b.t_fracture - a.t_fracture;
-            out->tet_steps += b.tet_steps_fracture - a.tet_steps_fracture;
+            out->fracture_t += b.fracture_time - a.fracture_time;
+            out->tet_steps += b.tet_steps - a.tet_steps;
         } else {
             out->rigid_wall += w, out->rigid_steps++;
         }
@@ -432,12 +433,10 @@ cf_status cf_bench_scene(const cf_bench_options *o, const cf_bench_scene_options
         for (int k = 0; k < n; k++)
             v[k] = s[k].fracture_t > 0 ? s[k].fracture_wall / (1e3 * s[k].fracture_t) : 0;
         r->s_per_fracture_ms_median = median(v, n);
-        r->s_per_fracture_ms_min = v[0];
-        for (int k = 0; k < n; k++) {
-            r->s_per_fracture_ms_min = fmin(r->s_per_fracture_ms_min, v[k]);
+        r->s_per_fracture_ms_min = v[0]; /* median sorted them */
+        for (int k = 0; k < n; k++)
             r->tet_steps_per_s = fmax(r->tet_steps_per_s, s[k].fracture_wall > 0
                                       ? (double)s[k].tet_steps / s[k].fracture_wall : 0);
-        }
         for (int k = 0; k < n; k++)
             v[k] = s[k].fracture_t > 0 ? s[k].fracture_cpu / (1e3 * s[k].fracture_t) : 0;
         r->cpu_s_per_fracture_ms = median(v, n);
@@ -448,8 +447,6 @@ cf_status cf_bench_scene(const cf_bench_options *o, const cf_bench_scene_options
             v[k] = s[k].wall;
         r->wall_median = median(v, n);
         r->wall_min = v[0];
-        for (int k = 0; k < n; k++)
-            r->wall_min = fmin(r->wall_min, v[k]);
         if (o->log)
             fprintf(o->log,
                     "bench-scene: %s fracture_ms=%.3f s_per_fracture_ms_min=%.3f "

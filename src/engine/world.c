@@ -1253,7 +1253,6 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->mass_total = sim->solid.mass_total;
     o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(sim->solid.mass_scale_max) : 1.0;
     o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
-    o->tet_steps_fracture = sim->tet_steps_fracture, o->t_fracture = sim->t_fracture;
     o->threads = omp_get_max_threads();
     o->alive = alive_fragments(sim, &o->in_fracture);
     o->ever = sim->n_frag;
@@ -1335,6 +1334,7 @@ void cf_world_step_stats(const cf_world *sim, cf_step_stats *o)
     const cf_solver_settings *set = &sim->def.solver;
     memset(o, 0, sizeof *o);
     o->fracture_steps = sim->steps_fracture;
+    o->tet_steps = sim->tet_steps_fracture, o->fracture_time = sim->t_fracture;
     o->stress = sim->prof.stress, o->insertion = sim->prof.insertion;
     o->forces = sim->prof.forces, o->pbd = sim->prof.pbd;
     for (int i = 0; i < sim->n_frag; i++) {
