@@ -440,6 +440,86 @@ static void test_debris_stays_rigid_and_conserves(void **state)
     cf_scene_free(&sc);
 }
 
+/* A block lands at 3 m/s on the ground with a compressive strength far
+ * below the impact stress rho c v (docs/physics.md §2.2): the tets under
+ * the contact flow, and those whose plastic strain reaches the crushing
+ * strain are crushed.  Each leaves as a one-tet debris piece that carries
+ * no stress; none of them is thrown faster than the block landed (its
+ * strain energy and the floor's springs under its nodes go to the crushing
+ * work instead of into its motion), mass and momentum pass the hand-offs
+ * to round-off and the ledger balances. */
+static const char *crush_scene =
+    "return {\n"
+    "  name = 'crush', duration = 0.08,\n"
+    "  material = {E = 1e8, nu = 0.3, rho = 1000, G_I = 100, sigma_max = 1e7,\n"
+    "              compressive_strength = %g, crushing_strain = %g},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {3, 3, 3},\n"
+    "                     tets_per_cell = 5},\n"
+    "             position = {0, 0, 0.0502}, velocity = {0, 0, -3}}},\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {dt_rigid = 2e-4, cfl_fraction = 0.5, quiet_steps = 200,\n"
+    "            constraints = 'none', obstacle_contact = 'penalty'},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void crush_run(double sc_strength, double eps, int *crushed, double *fastest,
+                      double *residual, double *plastic)
+{
+    char text[2048];
+    snprintf(text, sizeof text, crush_scene, sc_strength, eps);
+    cf_world_def sc;
+    cf_sim *sim = make_sim(text, &sc);
+    const cf_world *w = cf_sim_world(sim);
+    double mass0 = w->frag[0].mass;
+    run_to_end(sim);
+    *crushed = 0, *fastest = 0;
+    double mass = 0;
+    for (int i = 0; i < w->n_frag; i++) {
+        const cf_fragment *f = &w->frag[i];
+        if (f->mode == CF_MODE_DEAD)
+            continue;
+        mass += f->mass;
+        int powder = w->solid.crushed && w->solid.crushed[f->tets[0]];
+        if (!powder)
+            continue;
+        (*crushed)++;
+        assert_int_equal(f->nt, 1);
+        assert_true(cf_fragment_is_debris(w, f));
+        assert_int_equal(f->mode, CF_MODE_RIGID);
+        double com[3], R[9], v[3], om[3];
+        cf_fragment_pose((cf_world *)w, i, com, R, v, om);
+        *fastest = fmax(*fastest, sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    }
+    cf_world_stats st;
+    cf_world_stats_get(w, &st);
+    cf_ledger l;
+    cf_world_ledger(w, &l);
+    *residual = l.residual / (l.initial + l.work_gravity + l.work_obstacles);
+    *plastic = l.plastic_dissipated;
+    assert_true(fabs(mass - mass0) < 1e-12 * mass0);
+    assert_true(st.max_momentum_error < 1e-12);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
+static void test_crushed_tets_leave_as_powder(void **state)
+{
+    (void)state;
+    int crushed, none;
+    double fastest, residual, plastic, fastest0, residual0, plastic0;
+    crush_run(3e5, 0.005, &crushed, &fastest, &residual, &plastic);
+    crush_run(3e5, 0, &none, &fastest0, &residual0, &plastic0);
+    printf("FIGURE crushing: %d tets crushed into one-tet debris, the fastest at %.3g m/s "
+           "(landing 3 m/s); crushing work %.4g J (%.4g J without the crushing strain); "
+           "ledger residual %.2g (%.2g)\n",
+           crushed, fastest, plastic, plastic0, residual, residual0);
+    assert_true(crushed > 0);
+    assert_int_equal(none, 0);
+    assert_true(fastest < 3.0);
+    assert_true(fabs(residual) < 0.01);
+    assert_true(fabs(residual0) < 0.01);
+}
+
 /* An elastic box in fracture mode dropped on the ground: as a plane, and
  * as a triangle mesh through FCL. */
 static const char *ground_scene =
@@ -680,6 +760,7 @@ int main(void)
         cmocka_unit_test(test_determinism_hash_coloured),
         cmocka_unit_test(test_reentry_keeps_the_family_tree),
         cmocka_unit_test(test_debris_stays_rigid_and_conserves),
+        cmocka_unit_test(test_crushed_tets_leave_as_powder),
         cmocka_unit_test(test_resting_body_stays_rigid),
         cmocka_unit_test(test_mesh_obstacle_matches_plane),
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),

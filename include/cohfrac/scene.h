@@ -21,6 +21,10 @@
  *       (von Mises perfect plasticity at sigma_c in the element frame, the
  *       work booked as energy_plastic_dissipated; docs/physics.md §2.1);
  *       0 keeps them linear elastic,
+ *     crushing_strain [0]: with compressive_strength, a Tet4 whose
+ *       equivalent plastic strain (plastic work / (sigma_c V)) reaches this
+ *       is crushed: its facets are cut without cohesive elements and it
+ *       leaves as debris (docs/physics.md §2.2); 0 never,
  *     nucleation_radius [0] m: R_n; with solver.crack_growth "fronts", no
  *       crack nucleates within R_n / ratio^2 of a cracked facet (rest
  *       centroids; ratio: how far the facet exceeds its strength, >= 1):

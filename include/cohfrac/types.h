@@ -52,6 +52,9 @@ typedef struct cf_material {
     double nucleation_radius;      /* m, R_n: no crack nucleates within R_n / ratio^2 of
                                       a cracked facet (rest centroids; crack_growth
                                       "fronts"); 0: the cohesive length E G_I / sigma_max^2 */
+    double crushing_strain;        /* equivalent plastic strain at which a crushing Tet4
+                                      is crushed: cut free of its neighbours, it leaves
+                                      as debris (docs/physics.md §2.2); 0 never */
 } cf_material;
 
 typedef struct cf_body_def {

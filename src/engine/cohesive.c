@@ -162,6 +162,16 @@ double cf_cohesive_release(cf_solid *s, const int *elems, int n)
     return dropped;
 }
 
+void cf_cohesive_fail(cf_solid *s, int e)
+{
+    cf_cohesive *ce = &s->coh[e];
+    for (int i = 0; i < 3; i++) {
+        ce->failed[i] = 1;
+        ce->dissipated[i] += ce->stored[i];
+        ce->stored[i] = 0;
+    }
+}
+
 void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
 {
     for (int e = 0; e < n; e++) {

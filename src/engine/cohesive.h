@@ -52,6 +52,11 @@ void cf_cohesive_energy(const cf_solid *s, const int *elems, int n, double *stor
  * mode, whose openings reset): returns the energy dropped, J. */
 double cf_cohesive_release(cf_solid *s, const int *elems, int n);
 
+/* Fail every node pair of cohesive element e at once (a side crushed,
+ * docs/physics.md §2.2): what it stores is dissipated, and it carries no
+ * more traction (only the compression penalty of a failed pair). */
+void cf_cohesive_fail(cf_solid *s, int e);
+
 /* Where cohesive element e is now: its mid-surface centre (m), unit normal
  * (A -> B) and area (m^2), its normal and tangential openings (m, means of
  * its three node pairs) and whether every pair has failed. */

@@ -49,9 +49,98 @@ static double rayleigh_speed(const cf_solid *s)
     return sqrt(s->mu / s->mat.rho) * (0.862 + 1.14 * nu) / (1.0 + nu);
 }
 
+/* An explicit step: fracture mode without the constraint projection (no
+ * bars). */
+static int explicit_step(const cf_solver_settings *set, int fracture)
+{
+    return fracture && set->constraints == CF_CONSTRAINTS_NONE;
+}
+
+/* Whether obstacles act on this step's nodes by a penalty force rather
+ * than the projection (explicit fracture steps, docs/physics.md §7.1). */
+static int penalty_step(const cf_solver_settings *set, int fracture)
+{
+    return explicit_step(set, fracture) && set->obstacle_contact == CF_OBSTACLE_CONTACT_PENALTY;
+}
+
+#define CF_PENALTY_SCALE 0.01 /* k = CF_PENALTY_SCALE m / dt^2 (penalty_chunk) */
+
+/* Half k d^2 over the obstacles node a is under at time t (k from step dt). */
+static double node_springs(const cf_world *sim, int a, double t, double dt)
+{
+    const cf_solid *s = &sim->solid;
+    const double *x = &s->x[3 * a];
+    if (cf_obstacles_clear(&sim->obs, x))
+        return 0;
+    double k = CF_PENALTY_SCALE * s->m[a] / (dt * dt), e = 0;
+    for (int o = 0; o < sim->obs.n; o++) {
+        double n[3], d = cf_obstacle_distance(&sim->obs, o, t, x, n);
+        e += d < 0 ? 0.5 * k * d * d : 0;
+    }
+    return e;
+}
+
+double cf_fragment_spring_energy(const cf_world *sim, const cf_fragment *f)
+{
+    if (!penalty_step(&sim->def.solver, 1) || !(sim->h_fracture > 0))
+        return 0;
+    double e = 0;
+    for (int i = 0; i < f->nodes.n; i++)
+        e += node_springs(sim, f->nodes.v[i], sim->t, sim->h_fracture);
+    return e;
+}
+
+/* Crushing at this check (time t, s; step dt; docs/physics.md §2.2):
+ * the tets cf_crush_tets crushes come free as powder, without a cohesive
+ * element, so the pieces are labelled again although no element failed.
+ * Their strain energy, the cohesive elements on their faces (failed and
+ * dropped from the fragment's list: their compression penalty would kick
+ * the powder's light nodes) and, with the penalty contact, the springs of
+ * their nodes under an obstacle (moved onto its surface: the spring held
+ * the body's load, and would throw a node that now carries only its own
+ * share at 0.1 d / dt) are booked as crushing work.  Returns how many tets
+ * were crushed, or -1 out of memory. */
+static int crush(cf_world *sim, cf_fragment *f, double t, double dt)
+{
+    cf_solid *s = &sim->solid;
+    double released;
+    sim->crushed.n = 0;
+    int crushed = cf_crush_tets(s, f->tets, f->nt, t, &f->nodes, &sim->touched, &sim->crushed,
+                                &released);
+    if (crushed <= 0)
+        return crushed;
+    int kept = 0;
+    for (int i = 0; i < f->coh.n; i++) {
+        int e = f->coh.v[i];
+        if (s->crushed[s->coh[e].tet[0]] || s->crushed[s->coh[e].tet[1]])
+            cf_cohesive_fail(s, e);
+        else
+            f->coh.v[kept++] = e;
+    }
+    f->coh.n = kept;
+    f->separated = -1;
+    f->e_strain -= released; /* the tets' part, in this step's sum already */
+    if (!penalty_step(&sim->def.solver, 1))
+        return crushed;
+    /* The springs' part was in the last step's sum: it goes to the tet's
+     * crushing work. */
+    for (int i = 0; i < sim->crushed.n; i++)
+        for (int j = 0; j < 4; j++) {
+            int tt = sim->crushed.v[i], a = s->tet[4 * tt + j];
+            double *x = &s->x[3 * a];
+            s->wp[tt] += node_springs(sim, a, t, dt);
+            for (int o = 0; o < sim->obs.n && !cf_obstacles_clear(&sim->obs, x); o++) {
+                double n[3], d = cf_obstacle_distance(&sim->obs, o, t, x, n);
+                if (d < 0)
+                    v3_axpy(-d, n, x);
+            }
+        }
+    return crushed;
+}
+
 /* Extrinsic insertion at this check (time t, s) on the facets that qualify
  * and that the growth rule takes (cf_insertion_select). */
-static cf_status check_and_insert(cf_world *sim, cf_fragment *f, double t, int n_hot,
+static cf_status check_and_insert(cf_world *sim, cf_fragment *f, double t, double dt, int n_hot,
                                   int *inserted)
 {
     cf_solid *s = &sim->solid;
@@ -68,26 +157,16 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, double t, int n
         if (cf_crack_facet(s, sim->cand.v[i], &f->nodes, &sim->touched) ||
             cf_int_list_push(&f->coh, s->n_coh - 1))
             return CF_ERR_NOMEM;
+    int crushed = crush(sim, f, t, dt);
+    if (crushed < 0)
+        return CF_ERR_NOMEM;
     if (cf_bars_patch(&f->bars, s, sim->touched.v, sim->touched.n, &sim->bar_scratch))
         return CF_ERR_NOMEM;
-    *inserted = nc;
+    *inserted = nc + crushed;
     sim->prof.insertion += cf_wall_time() - t0;
     return CF_OK;
 }
 
-/* An explicit step: fracture mode without the constraint projection (no
- * bars). */
-static int explicit_step(const cf_solver_settings *set, int fracture)
-{
-    return fracture && set->constraints == CF_CONSTRAINTS_NONE;
-}
-
-/* Whether obstacles act on this step's nodes by a penalty force rather
- * than the projection (explicit fracture steps, docs/physics.md §7.1). */
-static int penalty_step(const cf_solver_settings *set, int fracture)
-{
-    return explicit_step(set, fracture) && set->obstacle_contact == CF_OBSTACLE_CONTACT_PENALTY;
-}
 
 /* Energy a velocity change takes out of node i, J: from `from` to `to`.
  * The ledger's kinetic energy is the leapfrog product 1/2 m v_old . v
@@ -238,8 +317,6 @@ static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
     return work;
 }
 
-#define CF_PENALTY_SCALE 0.01 /* k = CF_PENALTY_SCALE m / dt^2 (penalty_chunk) */
-
 /* The penalty contact on nodes i0..i1-1 at x_n: a node at signed distance
  * d < 0 from an obstacle gets the force k (-d) n along its outward normal,
  * k = CF_PENALTY_SCALE m / dt^2 from the node's lumped mass and the step
@@ -301,7 +378,7 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double t, double dt, int 
         sim->prof.stress += cf_wall_time() - t0;
         int inserted = 0;
         if (check) {
-            cf_status st = check_and_insert(sim, f, t, n_hot, &inserted);
+            cf_status st = check_and_insert(sim, f, t, dt, n_hot, &inserted);
             if (st != CF_OK)
                 return st;
         }

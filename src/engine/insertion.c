@@ -440,27 +440,37 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes, cf_int_list
     return rc;
 }
 
-int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched)
+/* Mark facet f cracked and duplicate the nodes whose star it disconnects;
+ * the facet's three slots in each of its tets go to `slot` (may be NULL). */
+static int separate_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched,
+                          int slot[2][3])
 {
     const int *F = &s->facet[4 * f];
     int ta = F[0], fa = F[1], tb = F[2];
     s->cracked[f] = 1;
-    cf_cohesive ce;
-    memset(&ce, 0, sizeof ce);
-    ce.tet[0] = ta, ce.tet[1] = tb;
-    ce.strength = s->strength ? s->strength[f] : 1.0;
     for (int i = 0; i < 3; i++) {
         int sa = CF_TET_FACE[fa][i];
-        int o = s->tet0[4 * ta + sa];
-        ce.slot[0][i] = sa;
-        ce.slot[1][i] = slot_of(s, tb, o);
+        int o = s->tet0[4 * ta + sa], sb = slot_of(s, tb, o);
+        if (slot)
+            slot[0][i] = sa, slot[1][i] = sb;
         int na = s->tet[4 * ta + sa];
-        int nb = s->tet[4 * tb + ce.slot[1][i]];
+        int nb = s->tet[4 * tb + sb];
         if (split_star(s, o, na, nodes, touched))
             return -1;
         if (nb != na && split_star(s, o, nb, nodes, touched))
             return -1;
     }
+    return 0;
+}
+
+int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched)
+{
+    cf_cohesive ce;
+    memset(&ce, 0, sizeof ce);
+    ce.tet[0] = s->facet[4 * f], ce.tet[1] = s->facet[4 * f + 2];
+    ce.strength = s->strength ? s->strength[f] : 1.0;
+    if (separate_facet(s, f, nodes, touched, ce.slot))
+        return -1;
     if (s->n_coh == s->cap_coh) {
         int cap = s->cap_coh ? 2 * s->cap_coh : 256;
         cf_cohesive *c = realloc(s->coh, (size_t)cap * sizeof *c);
@@ -650,4 +660,40 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
     cand->n = kept;
     cf_ints_sort(cand->v, kept);
     return kept;
+}
+
+int cf_crush_tets(cf_solid *s, const int *tets, int nt, double t, cf_int_list *nodes,
+                  cf_int_list *touched, cf_int_list *crushed_tets, double *released)
+{
+    double eps = s->mat.crushing_strain, sc = s->mat.compressive_strength;
+    *released = 0;
+    if (!s->crushed)
+        return 0;
+    int crushed = 0;
+    for (int i = 0; i < nt; i++) {
+        int tt = tets[i];
+        /* Plastic work over sigma_c V: the equivalent plastic strain of
+         * perfect plasticity, summed over every spell. */
+        if (s->crushed[tt] || s->wp[tt] < eps * sc * s->vol[tt])
+            continue;
+        for (int k = 0; k < 4; k++) {
+            int f = s->tet_facet[4 * tt + k];
+            if (s->facet[4 * f + 2] < 0 || s->cracked[f])
+                continue;
+            s->crack_time[f] = t;
+            if (separate_facet(s, f, nodes, touched, NULL))
+                return -1;
+        }
+        /* Powder stores nothing: the strain energy goes with the crushing
+         * work, and the tet pushes no more on its nodes from this step on. */
+        s->crushed[tt] = 1;
+        s->wp[tt] += s->tw[tt];
+        *released += s->tw[tt];
+        s->tw[tt] = 0;
+        memset(&s->tf[12 * tt], 0, 12 * sizeof(double));
+        if (cf_int_list_push(crushed_tets, tt))
+            return -1;
+        crushed++;
+    }
+    return crushed;
 }

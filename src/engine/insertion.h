@@ -72,4 +72,17 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
  * and add a cohesive element.  Returns 0, or -1 when out of memory. */
 int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched);
 
+/* Crushing (docs/physics.md §2.2): every tet of `tets` not yet crushed
+ * whose plastic work has reached crushing_strain * compressive_strength * V
+ * is crushed: its uncracked interior facets are marked cracked at time t
+ * (s) without cohesive elements and their nodes duplicated as by
+ * cf_crack_facet, so that it comes free; its strain energy (s->tw, from
+ * this step's force pass) moves to its plastic work, summed into
+ * *released (J), and its force on its nodes (s->tf) is zeroed, as
+ * cf_tet4_forces will keep it; each is appended to `crushed_tets`.
+ * Returns how many tets were crushed (0 without crushing, s->crushed
+ * NULL), or -1 when out of memory. */
+int cf_crush_tets(cf_solid *s, const int *tets, int nt, double t, cf_int_list *nodes,
+                  cf_int_list *touched, cf_int_list *crushed_tets, double *released);
+
 #endif

@@ -281,7 +281,9 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     if (mat->compressive_strength > 0) { /* crushing: a scene pays only for what it uses */
         s->ep = calloc((size_t)nt * 6, sizeof(double));
         s->wp = calloc((size_t)nt, sizeof(double));
-        if (!s->ep || !s->wp) {
+        if (mat->crushing_strain > 0)
+            s->crushed = calloc((size_t)nt, 1);
+        if (!s->ep || !s->wp || (mat->crushing_strain > 0 && !s->crushed)) {
             cf_solid_free(s);
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory for the plastic strain of %d tets",
                                 nt);
@@ -378,7 +380,7 @@ void cf_solid_free(cf_solid *s)
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->speed, s->mass_scale,
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
-                    s->nodal, s->tf, s->tw, s->ep, s->wp, s->bc, s->tet_frag, s->facet, s->tet_facet,
+                    s->nodal, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
                     s->cracked, s->crack_time, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);

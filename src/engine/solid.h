@@ -77,6 +77,8 @@ typedef struct cf_solid {
                                  xy xz yz), only with crushing (mat.compressive_strength
                                  > 0), else NULL */
     double *wp;               /* [nt] plastic work dissipated since t = 0, J (crushing) */
+    unsigned char *crushed;   /* [nt] crushed (cf_crush_tets): no stress, no force; only
+                                 with mat.crushing_strain > 0, else NULL */
     int *tet_frag;            /* [nt] fragment id */
 
     int n_facets;

@@ -293,12 +293,21 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
         for (int r = 0; r < 3; r++)
             f[3 * a + r] = v * (P[3 * r] * g[0] + P[3 * r + 1] * g[1] + P[3 * r + 2] * g[2]);
     }
+    vd live = splat(1); /* a crushed tet is powder: it carries nothing (§2.2) */
+    if (s->crushed) {
+        for (int l = 0; l < LANES; l++)
+            live[l] = !s->crushed[t[l]];
+        for (int k = 0; k < 12; k++)
+            f[k] *= live;
+        for (int k = 0; k < 9; k++)
+            P[k] *= live;
+    }
     lanes_store(f, 12, s->tf, t, n);
     if (kind == CF_ELASTICITY_COROTATIONAL)
         lanes_store(L.q, 4, s->rq, t, n);
     if (s->ep)
         lanes_store(L.ep, 6, s->ep, t, n);
-    vd w = L.w * vol, wp = L.wp * vol, det = lanes_det(L.F);
+    vd w = L.w * vol * live, wp = L.wp * vol * live, det = lanes_det(L.F);
     vm is_hot = {0};
     if (check) {
         lane9 sigma;
@@ -306,11 +315,12 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
         lanes_store(sigma, 9, s->sigma, t, n);
         vd lo, hi;
         principal_bounds(L.sig, &lo, &hi);
-        is_hot = (vm)(hi >= splat(check->s1)) | (vm)(0.5 * (hi - lo) >= splat(check->tau));
+        is_hot = ((vm)(hi >= splat(check->s1)) | (vm)(0.5 * (hi - lo) >= splat(check->tau))) &
+                 (vm)(live > 0);
     }
     for (int l = 0; l < n; l++) {
         int e = t[l];
-        *inverted += det[l] <= 0;
+        *inverted += det[l] <= 0 && live[l] > 0;
         s->tw[e] = w[l];
         if (s->ep)
             s->wp[e] += wp[l];

@@ -590,7 +590,7 @@ void cf_world_destroy(cf_world *sim)
     cf_obstacles_free(&sim->obs);
     free(sim->obstacle_body), free(sim->obstacle_moving);
     free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
-    free(sim->touched.v);
+    free(sim->touched.v), free(sim->crushed.v);
     cf_bars_scratch_free(&sim->bar_scratch);
     free(sim->def.obstacles), free(sim->def.boundaries);
     if (sim->bullet)
@@ -965,6 +965,7 @@ static long sub_steps(const cf_world *sim, double dt, double *h)
 static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, cf_error *err)
 {
     const cf_solver_settings *set = &sim->def.solver;
+    sim->h_fracture = h;
     int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
     int bodies = cf_body_contact_needed(sim);
     for (int fi = 0; fi < n; fi++) {

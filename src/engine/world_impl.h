@@ -105,6 +105,7 @@ struct cf_world {
     long step;               /* rigid steps done */
     long n_steps;            /* rigid steps in the scene's duration */
     double dt_fracture;      /* s: solver.dt_fracture, or cfl_fraction dt_cfl */
+    double h_fracture;       /* s: the last fracture step taken (the penalty's stiffness) */
     double dt_outer;         /* s: dt_rigid (fracture-only runs: a whole number of
                                 fracture steps) */
     double next_frame;       /* s */
@@ -126,6 +127,7 @@ struct cf_world {
                                 renumbered for locality at load: renumber.h) */
     cf_int_list cand;        /* facets that qualify at a check (scratch of the step) */
     cf_int_list touched;     /* nodes whose star the step's insertions changed (scratch) */
+    cf_int_list crushed;     /* tets the step's check crushed (scratch) */
     cf_bars_scratch bar_scratch; /* of cf_bars_patch */
     cf_initial_bounds bounds;/* taken at create */
     cf_event *ev;            /* events since the caller last drained them */
@@ -144,6 +146,12 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
  * obstacle during the next step of length dt faster than the impact
  * threshold (normal approach speed). */
 int cf_pbd_impact(const cf_world *sim, int fi, double dt);
+
+/* The energy (J) of the penalty contact's springs (docs/physics.md §7.1)
+ * under fragment f's nodes at their positions now (time sim->t, the
+ * stiffness of the last fracture step): the part of a fracture-mode
+ * fragment's e_strain beyond its tets'.  0 without the penalty contact. */
+double cf_fragment_spring_energy(const cf_world *sim, const cf_fragment *f);
 
 /* Whether fragment f is debris (docs/physics.md §9.2): 1 or 0. */
 int cf_fragment_is_debris(const cf_world *sim, const cf_fragment *f);

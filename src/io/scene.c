@@ -51,7 +51,7 @@ static const char *const top_keys[] = {"name",     "duration", "gravity",   "mat
 static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
                                             "sigma_max", "alpha", "G_II", "tau_max",
                                             "beta",  "friction", "restitution", "compressive_strength",
-                                            "strength", "nucleation_radius"};
+                                            "strength", "nucleation_radius", "crushing_strain"};
 static const char *const strength_keys[] = {"distribution", "modulus", "seed", "area"};
 static const char *const distribution_names[] = {"uniform", "weibull"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
@@ -839,6 +839,7 @@ static cf_status read_material(loader *ld, int t, cf_material *m)
     TRY(get_num(ld, t, "restitution", &restitution, &restitution_range, &m->restitution));
     TRY(get_num(ld, t, "compressive_strength", &none, &NON_NEGATIVE, &m->compressive_strength));
     TRY(get_num(ld, t, "nucleation_radius", &none, &NON_NEGATIVE, &m->nucleation_radius));
+    TRY(get_num(ld, t, "crushing_strain", &none, &NON_NEGATIVE, &m->crushing_strain));
     WITH_TABLE(ld, t, "strength", read_strength(ld, lua_gettop(ld->L), m));
     return CF_OK;
 }
@@ -1748,6 +1749,7 @@ static char *resolved_text(const cf_world_def *s)
     put_num(&b, 4, "restitution", m->restitution);
     put_num(&b, 4, "compressive_strength", m->compressive_strength);
     put_num(&b, 4, "nucleation_radius", m->nucleation_radius);
+    put_num(&b, 4, "crushing_strain", m->crushing_strain);
     put(&b, "    strength = {\n");
     put_str(&b, 6, "distribution", distribution_names[m->weibull]);
     put_num(&b, 6, "modulus", m->weibull_modulus);
