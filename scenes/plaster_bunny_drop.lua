@@ -25,13 +25,14 @@
 -- Floor: a penalty contact (docs/physics.md §7.1) that neither takes nor
 -- gives energy; the body's elasticity makes the rebound.  Fracture mode
 -- begins at the engine's impact threshold (0.2 m/s).
--- Expected (seed 1): four pieces of at least 5% of the mass (about 20, 9,
--- 8 and 8%), 19 of at least 1% and no chip of 4 tets or fewer; of the 78 J
--- it lands with, about 39 J go into crushing and 4.2 J into the cracks;
--- the fastest piece leaves at about 5.3 m/s against the bound 8.0 m/s of
--- tools/check_physics.py; about 10 s on one thread.  Seeds 2-5 give 2, 4,
--- 3 and 4 pieces of at least 5%, all within the bound; bunny_4k gives 1,
--- 3, 3, 2 and 3 (docs/physics.md §14.10).
+-- Expected (seed 1): 88 fragments, two pieces of at least 5% of the mass
+-- (about 22 and 11%), 28 of at least 1% and no chip of 4 tets or fewer;
+-- of the 78 J it lands with, about 36 J go into crushing and 4.6 J into
+-- the cracks; the fastest piece leaves at about 5.4 m/s against the bound
+-- 8.0 m/s of tools/check_physics.py; about 12 s on one thread.  Seeds 2-5
+-- give 2, 2, 2 and 3 pieces of at least 5%, all within the bound; bunny_4k
+-- splits into large chunks instead (seed 1: 59 and 34%; seed 2: 33, 31
+-- and 16%; docs/physics.md §14.13).
 return {
   name = "plaster_bunny_drop",
   duration = 0.65,

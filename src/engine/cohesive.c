@@ -86,7 +86,14 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
         double cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
         if (dn <= 0) { /* compression: penalty, while the faces still face each other */
-            double facing = kp >= 0 && v3_dot(d, d) <= 0.25 * area;
+            /* The penalty engages only on a pair that reaches the overlap
+             * facing (it was open, or just started) and holds while it
+             * stays engaged.  A pair that slid past its partner and comes
+             * back into view already overlapped would be kicked apart
+             * with energy 1/2 K_p dn^2 that no load put in. */
+            const double *L = ce->last[i];
+            int engaged = !ce->started[i] || L[0] > 0 || L[2] < 0;
+            double facing = kp >= 0 && engaged && v3_dot(d, d) <= 0.25 * area;
             Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
         }
         /* The tangential traction rises from zero with the capped
