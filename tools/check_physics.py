@@ -98,7 +98,9 @@ def read(path):
     return scene, p, o, pos, vel
 
 
-def check_file(path, quiet=False):
+def check_file(path, quiet=False, figures=None):
+    """Checks one output; True when all pass.  figures, a dict, receives the
+    ledger residual as a share of the input ("residual_share")."""
     scene, p, o, pos, vel = read(path)
     g = gravity_of(scene)
     gn = float(np.linalg.norm(g))
@@ -147,6 +149,8 @@ def check_file(path, quiet=False):
          f"last frame at t = {t_last:.6g} s against the duration {duration:.6g} s"
          + ("" if complete else " (the run stopped early: its exit status and log say why)")),
     ]
+    if figures is not None:
+        figures["residual_share"] = resid / input_ref
     ok = all(c[1] for c in checks)
     if not quiet or not ok:
         print(f"{path}:")
