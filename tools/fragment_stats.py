@@ -19,7 +19,10 @@ import h5py
 import numpy as np
 
 
-def stats(path, chip_tets):
+def last_frame(path):
+    """The fragments alive at the last frame: mass (kg), tets, speed (m/s)
+    and debris flag, one entry each, and the crack area (m^2, nan when the
+    file has none)."""
     with h5py.File(path, "r") as f:
         ids = f["particles/fragments/id/value"][-1]
         vel = f["particles/fragments/velocity/value"][-1]
@@ -28,20 +31,23 @@ def stats(path, chip_tets):
         debris = f["fragments/debris"][()] if "fragments/debris" in f else np.zeros_like(n_tets)
         crack = f["observables/crack_area/value"][-1] if "observables/crack_area" in f else float("nan")
     alive = ids >= 0
-    ids, vel = ids[alive], vel[alive]
-    m, nt = mass[ids], n_tets[ids]
+    ids = ids[alive]
+    return mass[ids], n_tets[ids], np.linalg.norm(vel[alive], axis=1), debris[ids], float(crack)
+
+
+def stats(path, chip_tets):
+    m, nt, speed, debris, crack = last_frame(path)
     total = m.sum()
     share = np.sort(m / total)[::-1]
-    speed = np.linalg.norm(vel, axis=1)
     return {
         "file": path,
-        "fragments": int(len(ids)),
+        "fragments": int(len(m)),
         "pieces_5pct": [round(float(s), 4) for s in share[share >= 0.05]],
         "pieces_1pct": int((share >= 0.01).sum()),
         "chip_share": float(m[nt <= chip_tets].sum() / total),
-        "debris_share": float(m[debris[ids] != 0].sum() / total),
+        "debris_share": float(m[debris != 0].sum() / total),
         "fastest": float(speed.max()) if len(speed) else 0.0,
-        "crack_area": float(crack),
+        "crack_area": crack,
     }
 
 

@@ -45,12 +45,12 @@ import os
 import subprocess
 import sys
 
-import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import check_physics  # noqa: E402
+import fragment_stats  # noqa: E402
 
 SCENE = os.path.join(HERE, "..", "scenes", "plaster_sphere_drop.lua")
 L_CH = 0.0125  # m, E G_I / sigma_max^2 of the scene's plaster
@@ -83,13 +83,7 @@ def run(exe, out_dir, diameter, speed, h, seed=1):
 
 
 def figures(h5):
-    with h5py.File(h5, "r") as f:
-        ids = f["particles/fragments/id/value"][-1]
-        mass = f["fragments/mass"][()]
-        n_tets = f["fragments/n_tets"][()]
-        crack = float(f["observables/crack_area/value"][-1])
-    ids = ids[ids >= 0]
-    m, nt = mass[ids], n_tets[ids]
+    m, nt, _, _, crack = fragment_stats.last_frame(h5)
     total = float(m.sum())
     m_e = total / float(nt.sum())
     bounds = {}
@@ -138,8 +132,9 @@ def main():
         for D, runs in ladder.items():
             broken = [r for r in runs if r["largest"] < 0.9]
             threshold[D] = broken[0] if broken else None
-        twice = {D: (run(a.cohfrac, out, D, 2 * t["speed"], h_ladder) if t else None)
-                 for D, t in threshold.items()}
+        broke = [D for D in DIAMETERS if threshold[D]]
+        twice = dict.fromkeys(DIAMETERS)
+        twice.update(zip(broke, many([(D, 2 * threshold[D]["speed"], h_ladder) for D in broke])))
         conv = []
         if threshold[DIAMETERS[0]]:
             v2 = 2 * threshold[DIAMETERS[0]]["speed"]

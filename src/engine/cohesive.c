@@ -78,6 +78,7 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         double Tn, Tt, e0n, e0t;
         law->envelope(p, 0, ce->dt_max[i], &e0n, &e0t);
         double t0plus = ce->dn_max[i] > 0 ? 0 : e0n; /* secant or envelope at 0+ */
+        double *L = ce->last[i]; /* dn, dt, Tn, Tt at the last evaluation */
         law->traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
         n_failed += ce->failed[i];
         /* Stability cap of a node pair at step dt: a node pair is shared
@@ -91,7 +92,6 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
              * stays engaged.  A pair that slid past its partner and comes
              * back into view already overlapped would be kicked apart
              * with energy 1/2 K_p dn^2 that no load put in. */
-            const double *L = ce->last[i];
             int engaged = !ce->started[i] || L[0] > 0 || L[2] < 0;
             double facing = kp >= 0 && engaged && v3_dot(d, d) <= 0.25 * area;
             Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
@@ -104,11 +104,10 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         Tt = fmin(Tt, cap * dtl);
         if (!ce->started[i]) {
             law->envelope(p, 0, 0, &e0n, &e0t);
-            ce->last[i][0] = 0, ce->last[i][1] = 0, ce->last[i][2] = e0n;
-            ce->last[i][3] = ce->dt_max[i] > 0 ? 0 : e0t; /* secant or envelope at 0 */
+            L[0] = 0, L[1] = 0, L[2] = e0n;
+            L[3] = ce->dt_max[i] > 0 ? 0 : e0t; /* secant or envelope at 0 */
             ce->started[i] = 1;
         }
-        double *L = ce->last[i];
         ce->work[i] += area / 3.0 *
                        (component_work(L[0], L[2], dn, Tn, t0plus) + 0.5 * (L[3] + Tt) * (dtl - L[1]));
         double elastic = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
