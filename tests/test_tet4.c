@@ -21,7 +21,7 @@
 
 static cf_material material(double E, double nu, double rho)
 {
-    cf_material m = {E, nu, rho, 22, 22, 1e4, 1e4, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0};
+    cf_material m = {E, nu, rho, 22, 22, 1e4, 1e4, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0};
     return m;
 }
 
@@ -163,6 +163,54 @@ static void test_crushing_uniaxial_strain(void **state)
     cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
     assert_near(s.wp[0], w_closed, 1e-9 * w_closed); /* the work done stays booked */
     assert_near(s.tw[0], 0.0, 1e-20);
+    cf_solid_free(&s);
+}
+
+/* Drucker-Prager crushing (docs/physics.md §2.1): with an internal
+ * friction angle phi the yield stress grows with the pressure p,
+ * q = k + beta p, beta = 6 sin phi / (3 - sin phi), k = sigma_c (1 - beta/3).
+ * In uniaxial strain to ten times von Mises' yield strain the pressure
+ * stays K |e| (the return keeps the volume), so sigma_xx - sigma_yy =
+ * -(k + beta K |e|), far above sigma_c, and the plastic work is the removed
+ * deviator's; in pure shear (p = 0) the tet yields at k / sqrt(3) < sigma_c
+ * / sqrt(3). */
+static void test_crushing_grows_with_pressure(void **state)
+{
+    (void)state;
+    cf_material mat = material(5e9, 0.2, 1200);
+    mat.compressive_strength = 15e6;
+    mat.internal_friction_angle = 30;
+    cf_solid s;
+    one_tet(&s, skew, &mat);
+    double sc = mat.compressive_strength, beta = 6 * 0.5 / (3 - 0.5), k = sc * (1 - beta / 3);
+    double K = s.lambda + 2 * s.mu / 3, V = s.vol[0], e = -10 * sc / (2 * s.mu);
+    assert_near(s.crush_beta, beta, 1e-12);
+    assert_near(s.crush_k, k, 1e-6);
+    int t = 0;
+    for (int i = 0; i < 4; i++)
+        s.x[3 * i] = (1 + e) * s.X[3 * i];
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    double sigma[9], q = k + beta * K * fabs(e);
+    cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
+    assert_near(sigma[0] - sigma[4], -q, 1e-9 * q);
+    assert_near((sigma[0] + sigma[4] + sigma[8]) / 3, K * e, 1e-9 * sc);
+    /* the trial deviator's equivalent stress is q_t = 2 mu |e|; the return
+     * scales it to q, and the work (q / q_t)(1 - q / q_t) s:s / 2 mu with
+     * s:s = 2/3 q_t^2 is q (q_t - q) / 3 mu */
+    double q_trial = 2 * s.mu * fabs(e), w_closed = q * (q_trial - q) / (3 * s.mu) * V;
+    assert_near(s.wp[0], w_closed, 1e-9 * w_closed);
+    printf("FIGURE Drucker-Prager: phi 30 deg, uniaxial strain %.3g: q %.4g MPa (von Mises %.4g)\n",
+           e, q / 1e6, sc / 1e6);
+    cf_solid_free(&s);
+    /* pure shear, no pressure: yields at k / sqrt(3) */
+    one_tet(&s, skew, &mat);
+    double g = 2 * (k / sqrt(3)) / s.mu; /* engineering shear strain, twice the yield */
+    for (int i = 0; i < 4; i++)
+        s.x[3 * i] = s.X[3 * i] + g * s.X[3 * i + 1];
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_LINEAR, NULL, NULL);
+    cf_tet4_stress(&s, 0, CF_ELASTICITY_LINEAR, sigma);
+    assert_near(sigma[1], k / sqrt(3), 1e-9 * k);
+    assert_true(s.wp[0] > 0);
     cf_solid_free(&s);
 }
 
@@ -431,6 +479,7 @@ int main(void)
         cmocka_unit_test(test_uniaxial_stretch_linear),
         cmocka_unit_test(test_rigid_rotation_is_stress_free),
         cmocka_unit_test(test_crushing_uniaxial_strain),
+        cmocka_unit_test(test_crushing_grows_with_pressure),
         cmocka_unit_test(test_no_crushing_no_plastic_state),
         cmocka_unit_test(test_lanes_equal_one_tet_at_a_time),
         cmocka_unit_test(test_cfl_of_regular_tet),

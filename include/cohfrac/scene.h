@@ -18,9 +18,13 @@
  *     G_II [=G_I] N/m, tau_max [=sigma_max] Pa, beta [=alpha],
  *     friction [0.5], restitution [0.0],
  *     compressive_strength [0] Pa: sigma_c > 0 makes the Tet4s crush
- *       (von Mises perfect plasticity at sigma_c in the element frame, the
- *       work booked as energy_plastic_dissipated; docs/physics.md §2.1);
- *       0 keeps them linear elastic,
+ *       (perfect plasticity with sigma_c the uniaxial compressive strength,
+ *       in the element frame, the work booked as energy_plastic_dissipated;
+ *       docs/physics.md §2.1); 0 keeps them linear elastic,
+ *     internal_friction_angle [0] degrees, 0-60: phi > 0 makes the crushing
+ *       strength grow with pressure (Drucker-Prager on Mohr-Coulomb's
+ *       compression meridian, q <= sigma_c (1 - beta/3) + beta p with
+ *       beta = 6 sin phi / (3 - sin phi)); 0 is von Mises at sigma_c,
  *     crushing_strain [0]: with compressive_strength, a Tet4 whose
  *       equivalent plastic strain (plastic work / (sigma_c V)) reaches this
  *       is crushed: its facets are cut without cohesive elements and it

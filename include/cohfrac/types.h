@@ -43,8 +43,9 @@ typedef struct cf_material {
     int weibull;                   /* strength distribution: 0 uniform, 1 Weibull */
     double weibull_modulus;        /* m, > 0 */
     int strength_seed;
-    double compressive_strength;   /* sigma_c, Pa: von Mises crushing of the Tet4s
-                                      (docs/physics.md §2.1); 0 none (linear elastic) */
+    double compressive_strength;   /* sigma_c, Pa: crushing of the Tet4s, the strength in
+                                      uniaxial compression (docs/physics.md §2.1); 0 none
+                                      (linear elastic) */
     double strength_area;          /* m^2: Weibull reference area A0; a facet of area A
                                       draws its factor at scale (A0/A)^(1/m) (Zhou and
                                       Molinari 2004); 0: the cohesive length squared,
@@ -55,6 +56,8 @@ typedef struct cf_material {
     double crushing_strain;        /* equivalent plastic strain at which a crushing Tet4
                                       is crushed: cut free of its neighbours, it leaves
                                       as debris (docs/physics.md §2.2); 0 never */
+    double internal_friction_angle; /* phi, degrees, [0, 60]: the crushing strength grows
+                                      with pressure (Drucker-Prager); 0 von Mises */
 } cf_material;
 
 typedef struct cf_body_def {

@@ -258,6 +258,12 @@ cf_status cf_solid_init(cf_solid *s, const cf_mesh *mesh, const cf_material *mat
     s->mat = *mat;
     s->lambda = mat->E * mat->nu / ((1 + mat->nu) * (1 - 2 * mat->nu));
     s->mu = mat->E / (2 * (1 + mat->nu));
+    /* Drucker-Prager on Mohr-Coulomb's compression meridian, through the
+     * uniaxial compressive strength (p = sigma_c / 3 there); phi = 0 is
+     * von Mises at sigma_c. */
+    double sphi = sin(mat->internal_friction_angle * acos(-1.0) / 180);
+    s->crush_beta = 6 * sphi / (3 - sphi);
+    s->crush_k = mat->compressive_strength * (1 - s->crush_beta / 3);
     int nn = mesh->n_nodes, nt = mesh->n_tets;
     s->n_nodes = s->n_verts0 = nn;
     s->cap_nodes = nn + nn / 4 + 16;

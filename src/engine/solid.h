@@ -42,6 +42,9 @@ typedef struct cf_cohesive {
 typedef struct cf_solid {
     cf_material mat;
     double lambda, mu;        /* Lamé, Pa */
+    double crush_k, crush_beta; /* crushing yield q <= k + beta p (Pa, -; p the pressure,
+                                   positive in compression): Drucker-Prager through the
+                                   uniaxial compressive strength, docs/physics.md §2.1 */
 
     int n_nodes, cap_nodes;
     double *X;                /* [n][3] rest positions, m */

@@ -9,21 +9,23 @@
 /* Voigt slots (xx yy zz xy xz yz) of the plastic strain, as row and column. */
 static const int VOIGT[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
-/* Crushing (docs/physics.md §2.1): von Mises perfect plasticity at the
- * compressive strength sigma_c.  A trial stress sig whose equivalent stress
- * sqrt(3/2 s:s) exceeds sigma_c has its deviator s scaled back onto the
- * yield surface (radial return); the elastic strain eps loses, and the
- * plastic strain ep (Voigt, tensor shear; NULL: not kept) gains, the
- * removed deviator over 2 mu.  Returns the plastic work density
- * sig : d ep >= 0 (J/m^3). */
+/* Crushing (docs/physics.md §2.1): perfect plasticity with the
+ * Drucker-Prager yield surface q <= k + beta p (q = sqrt(3/2 s:s) the
+ * equivalent stress of the deviator s, p = -tr(sig)/3 the pressure; von
+ * Mises at sigma_c when beta = 0).  A trial stress sig outside it has its
+ * deviator scaled back onto the surface at the same pressure (radial
+ * return without dilatancy); the elastic strain eps loses, and the plastic
+ * strain ep (Voigt, tensor shear; NULL: not kept) gains, the removed
+ * deviator over 2 mu.  Returns the plastic work density sig : d ep >= 0
+ * (J/m^3). */
 static inline double crush(const cf_solid *s, double sig[9], double eps[9], double *ep)
 {
-    double p = (sig[0] + sig[4] + sig[8]) / 3, dev[9], ss = 0;
+    double m = (sig[0] + sig[4] + sig[8]) / 3, dev[9], ss = 0;
     for (int k = 0; k < 9; k++) {
-        dev[k] = sig[k] - ((k % 4) == 0 ? p : 0);
+        dev[k] = sig[k] - ((k % 4) == 0 ? m : 0);
         ss += dev[k] * dev[k];
     }
-    double seq = sqrt(1.5 * ss), sc = s->mat.compressive_strength;
+    double seq = sqrt(1.5 * ss), sc = fmax(0, s->crush_k - s->crush_beta * m);
     if (!(seq > sc))
         return 0;
     double back = 1 - sc / seq; /* share of the deviator removed */

@@ -106,6 +106,7 @@ typedef struct interval {
 
 static const interval POSITIVE = {0.0, INFINITY, 0, 0};
 static const interval NON_NEGATIVE = {0.0, INFINITY, 1, 0};
+static const interval FRICTION_ANGLE = {0.0, 60.0, 1, 1}; /* degrees */
 static const interval AT_LEAST_ONE = {1.0, INFINITY, 1, 0};
 static const interval UNIT = {0.0, 1.0, 1, 1};
 static const interval POISSON = {-1.0, 0.5, 0, 0};
@@ -227,6 +228,7 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("material.strength.modulus", m->weibull_modulus, POSITIVE);
     CHECK("material.strength.area", m->strength_area, NON_NEGATIVE);
     CHECK("material.nucleation_radius", m->nucleation_radius, NON_NEGATIVE);
+    CHECK("material.internal_friction_angle", m->internal_friction_angle, FRICTION_ANGLE);
     CHECK("solver.dt_rigid", s->dt_rigid, POSITIVE);
     CHECK("solver.rigid_substeps", s->rigid_substeps, ITERATIONS);
     CHECK("solver.dt_fracture", s->dt_fracture, POSITIVE);

@@ -51,7 +51,8 @@ static const char *const top_keys[] = {"name",     "duration", "gravity",   "mat
 static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
                                             "sigma_max", "alpha", "G_II", "tau_max",
                                             "beta",  "friction", "restitution", "compressive_strength",
-                                            "strength", "nucleation_radius", "crushing_strain"};
+                                            "internal_friction_angle", "strength", "nucleation_radius",
+                                            "crushing_strain"};
 static const char *const strength_keys[] = {"distribution", "modulus", "seed", "area"};
 static const char *const distribution_names[] = {"uniform", "weibull"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
@@ -138,6 +139,7 @@ static const range NON_NEGATIVE = {0.0, INFINITY, 1, 0, NULL};
 static const range AT_LEAST_ONE = {1.0, INFINITY, 1, 0, NULL};
 static const range PIECE_TETS = {0.0, CF_MAX_PIECE_TETS, 1, 1, NULL};
 static const range UNIT = {0.0, 1.0, 1, 1, NULL};
+static const range FRICTION_ANGLE = {0.0, 60.0, 1, 1, NULL};
 static const range POISSON = {-1.0, 0.5, 0, 0,
                               "(Poisson's ratio of a stable isotropic solid)"};
 static const range ANY = {-INFINITY, INFINITY, 0, 0, NULL};
@@ -838,6 +840,8 @@ static cf_status read_material(loader *ld, int t, cf_material *m)
     TRY(get_num(ld, t, "friction", &friction, &NON_NEGATIVE, &m->friction));
     TRY(get_num(ld, t, "restitution", &restitution, &restitution_range, &m->restitution));
     TRY(get_num(ld, t, "compressive_strength", &none, &NON_NEGATIVE, &m->compressive_strength));
+    TRY(get_num(ld, t, "internal_friction_angle", &none, &FRICTION_ANGLE,
+                &m->internal_friction_angle));
     TRY(get_num(ld, t, "nucleation_radius", &none, &NON_NEGATIVE, &m->nucleation_radius));
     TRY(get_num(ld, t, "crushing_strain", &none, &NON_NEGATIVE, &m->crushing_strain));
     WITH_TABLE(ld, t, "strength", read_strength(ld, lua_gettop(ld->L), m));
@@ -1748,6 +1752,7 @@ static char *resolved_text(const cf_world_def *s)
     put_num(&b, 4, "friction", m->friction);
     put_num(&b, 4, "restitution", m->restitution);
     put_num(&b, 4, "compressive_strength", m->compressive_strength);
+    put_num(&b, 4, "internal_friction_angle", m->internal_friction_angle);
     put_num(&b, 4, "nucleation_radius", m->nucleation_radius);
     put_num(&b, 4, "crushing_strain", m->crushing_strain);
     put(&b, "    strength = {\n");
