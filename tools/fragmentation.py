@@ -2,6 +2,7 @@
 """Fragmentation benchmarks: the plaster sphere drop ladder and its mesh convergence.
 
 usage: fragmentation.py COHFRAC [--size ci|full] [-o DIR] [-j N] [--known FILE]
+                          [--set KEY=VALUE ...]
 
 Runs scenes/plaster_sphere_drop.lua (a gypsum plaster sphere striking a
 rigid floor) as Wu, Chau and Yu (Powder Technology 2004) dropped theirs:
@@ -31,13 +32,15 @@ its range is log10(largest fitted mass / m_min) decades.
 Writes DIR/fragmentation.json (every run's figures), DIR/fragmentation.md
 (the tables) and DIR/fragmentation.png (the cumulative mass distributions
 on log-log axes beside the slopes of tau = 1.45 and 1.85); runs are cached
-in DIR/runs/ (rerun when the program is newer).  Checks named in the
+in DIR/runs/ (rerun when the program is newer; a variant made with --set,
+passed to every run as `cohfrac run --set`, is cached under its own name).  Checks named in the
 --known file (one "name reason..." per line; "name@ci" or "name@full" for
 one size only) are known not to hold yet: they must fail, and the exit
 status is 0 when the failing checks are exactly those; 1 otherwise; 2 on a
 run that could not be made or read.
 """
 import argparse
+import hashlib
 import concurrent.futures
 import json
 import math
@@ -62,9 +65,12 @@ SIZES = {
 DIAMETERS = (0.050, 0.075)  # m
 
 
-def run(exe, out_dir, diameter, speed, h, seed=1):
-    """One drop; returns its figures (cached by name in out_dir/runs)."""
+def run(exe, out_dir, extra, diameter, speed, h, seed=1):
+    """One drop, with the settings `extra` (cohfrac run --set) on top;
+    returns its figures (cached by name in out_dir/runs)."""
     tag = f"D{1000 * diameter:g}_v{speed:g}_h{1000 * h:.3g}_s{seed}"
+    if extra:
+        tag += "_" + hashlib.sha1("\n".join(extra).encode()).hexdigest()[:8]
     h5 = os.path.join(out_dir, "runs", tag + ".h5")
     R = diameter / 2
     done = h5 + ".done"  # written after a run that finished
@@ -72,6 +78,7 @@ def run(exe, out_dir, diameter, speed, h, seed=1):
         sets = [f"bodies[1].mesh.radius={R!r}", f"bodies[1].mesh.mesh_size={h!r}",
                 f"bodies[1].position={{0,0,{R + 0.0005!r}}}",
                 f"bodies[1].velocity={{0,0,{-speed!r}}}", f"material.strength.seed={seed}"]
+        sets += extra
         cmd = [exe, "run", SCENE, "-t", "1", "-q", "-o", h5, "--force"]
         for s in sets:
             cmd += ["--set", s]
@@ -116,6 +123,8 @@ def main():
     ap.add_argument("-o", "--output", default=None)
     ap.add_argument("-j", "--jobs", type=int, default=1)
     ap.add_argument("--known", default=None)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene setting for every run (cohfrac run --set)")
     a = ap.parse_args()
     out = a.output or os.path.join("build", "fragmentation", a.size)
     os.makedirs(os.path.join(out, "runs"), exist_ok=True)
@@ -123,7 +132,7 @@ def main():
     pool = concurrent.futures.ThreadPoolExecutor(max(1, a.jobs))
 
     def many(cases):
-        futs = [pool.submit(run, a.cohfrac, out, *c) for c in cases]
+        futs = [pool.submit(run, a.cohfrac, out, a.set, *c) for c in cases]
         return [f.result() for f in futs]
 
     try:
