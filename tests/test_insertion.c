@@ -702,6 +702,101 @@ static void test_front_rule_reads_the_stress_ahead(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* Original vertices of facet f. */
+static void facet_vertices(const cf_solid *s, int f, int o[3])
+{
+    const int *F = &s->facet[4 * f];
+    for (int j = 0; j < 3; j++)
+        o[j] = s->tet0[4 * F[0] + CF_TET_FACE[F[1]][j]];
+}
+
+/* Cracked facets holding the edge of original vertices a and b. */
+static int cracked_on_edge(const cf_solid *s, int a, int b)
+{
+    int n = 0;
+    for (int f = 0; f < s->n_facets; f++) {
+        int o[3];
+        facet_vertices(s, f, o);
+        int has_a = o[0] == a || o[1] == a || o[2] == a, has_b = o[0] == b || o[1] == b || o[2] == b;
+        n += s->cracked[f] && has_a && has_b;
+    }
+    return n;
+}
+
+/* A crack grows from its front, the edges where its surface ends, and does
+ * not branch (docs/physics.md §5.1): in a box overloaded in every
+ * direction, a crack of two facets f0 and f1 that share an edge e, checked
+ * once, takes facets across its four outer edges, at most one across each
+ * (so no edge of the crack holds three cracked facets), and none across e,
+ * which two cracked facets already share.  The nucleation radius is longer
+ * than the box, and a front takes far longer than one check to cross a
+ * cell: every facet taken is a front of f0 and f1. */
+static void test_fronts_do_not_branch(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    fixture_box(&m, 4, 4, 4, 1, 1, 1);
+    cf_solid s;
+    int *all = stressed_box(&s, &m, 0, 1.0, 1e9);
+    for (int t = 0; t < s.n_tets; t++)
+        s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
+    int f0 = -1, f1 = -1, o0[3], o1[3], e[2] = {-1, -1};
+    for (int f = 0; f < s.n_facets && f0 < 0; f++) { /* an interior facet at the middle */
+        double y[3];
+        facet_vertices(&s, f, o0);
+        for (int j = 0; j < 3; j++)
+            y[j] = s.X[3 * o0[j] + 1];
+        if (s.facet[4 * f + 2] >= 0 && y[0] == 0.5 && y[1] == 0.5 && y[2] == 0.5)
+            f0 = f;
+    }
+    assert_true(f0 >= 0);
+    facet_vertices(&s, f0, o0);
+    for (int f = 0; f < s.n_facets && f1 < 0; f++) { /* an interior neighbour across an edge */
+        int shared = 0;
+        facet_vertices(&s, f, o1);
+        for (int j = 0; j < 3; j++)
+            shared += o1[j] == o0[0] || o1[j] == o0[1] || o1[j] == o0[2];
+        if (f != f0 && s.facet[4 * f + 2] >= 0 && shared == 2)
+            f1 = f;
+    }
+    assert_true(f1 >= 0);
+    facet_vertices(&s, f1, o1);
+    for (int j = 0, k = 0; j < 3; j++)
+        if (o0[j] == o1[0] || o0[j] == o1[1] || o0[j] == o1[2])
+            e[k++] = o0[j];
+    s.cracked[f0] = s.cracked[f1] = 1;
+    s.crack_time[f0] = s.crack_time[f1] = -1e9;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = (s.X[3 * o0[0] + k] + s.X[3 * o0[1] + k] + s.X[3 * o0[2] + k]) / 3;
+    assert_int_equal(cf_crack_grid_add(&s.cracks, c), 0);
+    assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0.0};
+    cf_int_list cand = {0};
+    int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, &cand);
+    assert_true(n > 0);
+    n = cf_insertion_select(&s, &cand, CF_CRITERION_TRACTION, &g);
+    int outer = 0, most = 0;
+    for (int a = 0; a < 2; a++) /* the four outer edges: each corner with each end of e */
+        for (int j = 0; j < 3; j++) {
+            const int *o = a ? o1 : o0;
+            if (o[j] == e[0] || o[j] == e[1])
+                continue;
+            for (int q = 0; q < 2; q++) {
+                int k = cracked_on_edge(&s, o[j], e[q]);
+                outer += k - 1, most = k > most ? k : most;
+            }
+        }
+    printf("FIGURE branching: %d facets taken, %d across the outer edges, at most %d cracked "
+           "facets on an edge of the crack, %d on the shared edge\n",
+           n, outer, most, cracked_on_edge(&s, e[0], e[1]));
+    assert_true(outer >= 1);
+    assert_true(most <= 2);
+    assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
+    free(cand.v), free(all);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
 /* Weakest-link strength (Zhou and Molinari 2004): facet f of area A_f
  * draws w_f with P(w > x) = exp(-(A_f / A0) x^m), so z_f = (A_f / A0) w_f^m
  * is exponential with mean 1 and variance 1 whatever the facet's size.
@@ -773,6 +868,7 @@ int main(void)
         cmocka_unit_test(test_fronts_close_no_small_piece),
         cmocka_unit_test(test_front_moves_no_faster_than_its_speed),
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
+        cmocka_unit_test(test_fronts_do_not_branch),
         cmocka_unit_test(test_weibull_strength_scales_with_facet_area),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

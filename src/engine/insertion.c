@@ -531,17 +531,19 @@ static double centroid_distance(const cf_solid *s, const double c[3], const int 
 }
 
 /* How facet f (original vertices o, rest centroid c) meets the cracks at
- * time t: CF_FRONT when it shares an edge
- * with a cracked facet inserted at least d / speed earlier (d between their
- * rest centroids: a front moves no faster than `speed`); CF_TOUCH when it
- * meets a cracked facet otherwise (at a vertex, or across an edge the crack
- * reached too recently, this check's insertions included); CF_CLEAR when it
- * meets none. */
+ * time t: CF_FRONT when one of its edges is the edge of exactly one cracked
+ * facet (the crack surface ends there: a front), inserted at least d / speed
+ * earlier (d between their rest centroids: a front moves no faster than
+ * `speed`); CF_TOUCH when it meets a cracked facet otherwise (at a vertex,
+ * across an edge the crack reached too recently, this check's insertions
+ * included, or across an edge inside a crack surface, which two cracked
+ * facets already share: a branch); CF_CLEAR when it meets none. */
 enum { CF_CLEAR, CF_TOUCH, CF_FRONT };
+enum { EDGE_FACETS = 8 }; /* cracked facets told apart per edge; more is a branch */
 static int crack_contact(const cf_solid *s, int f, const int o[3], const double c[3], double t,
                          double speed)
 {
-    int touch = CF_CLEAR;
+    int touch = CF_CLEAR, on_edge[3][EDGE_FACETS], n_edge[3] = {0, 0, 0}, ready[3] = {0, 0, 0};
     for (int a = 0; a < 3; a++)
         for (int j = s->vt_start[o[a]]; j < s->vt_start[o[a] + 1]; j++) {
             int slot = s->vt_slot[j], tt = slot / 4;
@@ -549,15 +551,29 @@ static int crack_contact(const cf_solid *s, int f, const int o[3], const double 
                 int g = s->tet_facet[4 * tt + k];
                 if (k == slot % 4 || g == f || !s->cracked[g])
                     continue;
-                int og[3], shared = 0;
-                face_vertices(s, tt, k, og);
-                for (int p = 0; p < 3; p++)
-                    shared += og[p] == o[0] || og[p] == o[1] || og[p] == o[2];
-                if (shared == 2 && t - s->crack_time[g] >= centroid_distance(s, c, og) / speed)
-                    return CF_FRONT;
                 touch = CF_TOUCH;
+                int og[3], shared = 0, off = 0; /* off: o's vertex not on g */
+                face_vertices(s, tt, k, og);
+                for (int p = 0; p < 3; p++) {
+                    int in = og[0] == o[p] || og[1] == o[p] || og[2] == o[p];
+                    shared += in;
+                    if (!in)
+                        off = p;
+                }
+                if (shared != 2)
+                    continue;
+                int known = 0; /* g is met once per tet around each vertex */
+                for (int q = 0; q < n_edge[off]; q++)
+                    known |= on_edge[off][q] == g;
+                if (known || n_edge[off] == EDGE_FACETS)
+                    continue;
+                on_edge[off][n_edge[off]++] = g;
+                ready[off] = t - s->crack_time[g] >= centroid_distance(s, c, og) / speed;
             }
         }
+    for (int e = 0; e < 3; e++)
+        if (n_edge[e] == 1 && ready[e])
+            return CF_FRONT;
     return touch;
 }
 
