@@ -648,6 +648,28 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* Original vertices of facet f. */
+static void facet_vertices(const cf_solid *s, int f, int o[3])
+{
+    const int *F = &s->facet[4 * f];
+    for (int j = 0; j < 3; j++)
+        o[j] = s->tet0[4 * F[0] + CF_TET_FACE[F[1]][j]];
+}
+
+/* An interior facet on the plane y = 0.5 (the middle of fixture_box's
+ * unit box), or -1. */
+static int middle_facet(const cf_solid *s)
+{
+    for (int f = 0; f < s->n_facets; f++) {
+        int o[3];
+        facet_vertices(s, f, o);
+        if (s->facet[4 * f + 2] >= 0 && s->X[3 * o[0] + 1] == 0.5 && s->X[3 * o[1] + 1] == 0.5 &&
+            s->X[3 * o[2] + 1] == 0.5)
+            return f;
+    }
+    return -1;
+}
+
 /* The source's rule at a crack front reads the stress ahead of it
  * (docs/physics.md §5.1): beside a cracked facet whose neighbourhood has
  * unloaded (every tet at one of its vertices at zero stress, the rest under
@@ -664,19 +686,9 @@ static void test_front_rule_reads_the_stress_ahead(void **state)
     cf_solid s;
     double strength = 1.0, thr = 0.9 * strength;
     int *all = stressed_box(&s, &m, 10.0 * thr, strength, 1e-9);
-    int f0 = -1; /* an interior facet normal to y near the middle */
-    for (int f = 0; f < s.n_facets && f0 < 0; f++) {
-        const int *F = &s.facet[4 * f];
-        double y[3];
-        for (int j = 0; j < 3; j++)
-            y[j] = s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][j]] + 1];
-        if (F[2] >= 0 && y[0] == 0.5 && y[1] == 0.5 && y[2] == 0.5)
-            f0 = f;
-    }
+    int f0 = middle_facet(&s), o0[3]; /* an interior facet normal to y near the middle */
     assert_true(f0 >= 0);
-    int o0[3];
-    for (int j = 0; j < 3; j++)
-        o0[j] = s.tet0[4 * s.facet[4 * f0] + CF_TET_FACE[s.facet[4 * f0 + 1]][j]];
+    facet_vertices(&s, f0, o0);
     s.cracked[f0] = 1;
     for (int t = 0; t < s.n_tets; t++)
         for (int j = 0; j < 4; j++)
@@ -700,14 +712,6 @@ static void test_front_rule_reads_the_stress_ahead(void **state)
     assert_true(fronts >= 2);
     free(cand.v), free(all);
     cf_solid_free(&s), cf_mesh_free(&m);
-}
-
-/* Original vertices of facet f. */
-static void facet_vertices(const cf_solid *s, int f, int o[3])
-{
-    const int *F = &s->facet[4 * f];
-    for (int j = 0; j < 3; j++)
-        o[j] = s->tet0[4 * F[0] + CF_TET_FACE[F[1]][j]];
 }
 
 /* Cracked facets holding the edge of original vertices a and b. */
@@ -740,15 +744,7 @@ static void test_fronts_do_not_branch(void **state)
     int *all = stressed_box(&s, &m, 0, 1.0, 1e9);
     for (int t = 0; t < s.n_tets; t++)
         s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
-    int f0 = -1, f1 = -1, o0[3], o1[3], e[2] = {-1, -1};
-    for (int f = 0; f < s.n_facets && f0 < 0; f++) { /* an interior facet at the middle */
-        double y[3];
-        facet_vertices(&s, f, o0);
-        for (int j = 0; j < 3; j++)
-            y[j] = s.X[3 * o0[j] + 1];
-        if (s.facet[4 * f + 2] >= 0 && y[0] == 0.5 && y[1] == 0.5 && y[2] == 0.5)
-            f0 = f;
-    }
+    int f0 = middle_facet(&s), f1 = -1, o0[3], o1[3], e[2] = {-1, -1};
     assert_true(f0 >= 0);
     facet_vertices(&s, f0, o0);
     for (int f = 0; f < s.n_facets && f1 < 0; f++) { /* an interior neighbour across an edge */

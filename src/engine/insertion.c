@@ -539,11 +539,12 @@ static double centroid_distance(const cf_solid *s, const double c[3], const int 
  * included, or across an edge inside a crack surface, which two cracked
  * facets already share: a branch); CF_CLEAR when it meets none. */
 enum { CF_CLEAR, CF_TOUCH, CF_FRONT };
-enum { EDGE_FACETS = 8 }; /* cracked facets told apart per edge; more is a branch */
 static int crack_contact(const cf_solid *s, int f, const int o[3], const double c[3], double t,
                          double speed)
 {
-    int touch = CF_CLEAR, on_edge[3][EDGE_FACETS], n_edge[3] = {0, 0, 0}, ready[3] = {0, 0, 0};
+    /* Per edge of f (named by o's vertex off it): the first cracked facet
+     * met on it, and whether there are none, one, or more (a branch). */
+    int touch = CF_CLEAR, first[3], n_edge[3] = {0, 0, 0}, ready[3] = {0, 0, 0};
     for (int a = 0; a < 3; a++)
         for (int j = s->vt_start[o[a]]; j < s->vt_start[o[a] + 1]; j++) {
             int slot = s->vt_slot[j], tt = slot / 4;
@@ -562,13 +563,12 @@ static int crack_contact(const cf_solid *s, int f, const int o[3], const double 
                 }
                 if (shared != 2)
                     continue;
-                int known = 0; /* g is met once per tet around each vertex */
-                for (int q = 0; q < n_edge[off]; q++)
-                    known |= on_edge[off][q] == g;
-                if (known || n_edge[off] == EDGE_FACETS)
-                    continue;
-                on_edge[off][n_edge[off]++] = g;
-                ready[off] = t - s->crack_time[g] >= centroid_distance(s, c, og) / speed;
+                if (n_edge[off] == 0) { /* g is met again through every tet at the edge */
+                    first[off] = g, n_edge[off] = 1;
+                    ready[off] = t - s->crack_time[g] >= centroid_distance(s, c, og) / speed;
+                } else if (first[off] != g) {
+                    n_edge[off] = 2;
+                }
             }
         }
     for (int e = 0; e < 3; e++)
