@@ -706,6 +706,59 @@ static void test_resting_body_stays_rigid(void **state)
     cf_scene_free(&sc);
 }
 
+/* The cube of examples/drop.c lands from 1 m, takes the impact in fracture
+ * mode without breaking, and goes back to rigid mode on its way up.  A
+ * fragment that stays whole keeps the principal frame its hulls were built
+ * in: computed again at the hand-back, the cube's equal principal moments
+ * gave other axes from round-off, its hulls were posed turned 5 cm deep in
+ * the ground, Bullet's push-out read as a 20 m/s impact, and the cube went
+ * back to fracture mode at every rigid step (28 hand-offs in 0.6 s).  Now
+ * it hands off twice and then flies: v_z = v_back - g (t - t_back). */
+static const char *cube_drop_scene =
+    "return {\n"
+    "  name = 'cube_drop', duration = 0.55,\n"
+    "  material = {E = 1e5, sigma_max = 3e3, tau_max = 3e3},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.2, 0.2, 0.2}, cells = {4, 4, 4}},\n"
+    "             position = {0, 0, 1.0}}},\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {constraints = 'xpbd'},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void test_handback_in_flight_stays_rigid(void **state)
+{
+    (void)state;
+    cf_world_def sc;
+    cf_sim *sim = make_sim(cube_drop_scene, &sc);
+    cf_error err = {0};
+    int entries = 0, was = 0;
+    double t_back = -1, v_back = 0, worst = 0;
+    while (!cf_sim_done(sim)) {
+        if (cf_sim_advance(sim, &err) != CF_OK)
+            fail_msg("run: %s", err.msg);
+        cf_world *w = cf_sim_world(sim);
+        int now = any_in_fracture_mode(sim);
+        entries += now && !was;
+        cf_fragment_state f[1];
+        assert_int_equal(cf_world_fragments(w, f, 1), 1);
+        if (was && !now && t_back < 0)
+            t_back = cf_world_time(w), v_back = f[0].v[2];
+        else if (t_back >= 0 && !now)
+            worst = fmax(worst, fabs(f[0].v[2] - (v_back - 9.81 * (cf_world_time(w) - t_back))));
+        was = now;
+    }
+    const cf_world *w = cf_sim_world(sim);
+    printf("FIGURE hand-back in flight: %d entry into fracture mode, %d hand-offs; back at "
+           "t = %.3f s rising at %.3f m/s, then |v_z - (v_back - g t)| <= %.2e m/s\n",
+           entries, w->n_handoffs, t_back, v_back, worst);
+    assert_int_equal(entries, 1);
+    assert_int_equal(w->n_handoffs, 2);
+    assert_true(t_back > 0 && v_back > 0.5); /* it rebounds */
+    assert_true(worst < 1e-6);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
 /* scenes/expanding_bar.lua (fracture mode only): pieces alive at the end
  * and the state hash, for a strength setting and a thread count. */
 static int expanding_bar(const char *strength, int threads, uint64_t *hash)
@@ -762,6 +815,7 @@ int main(void)
         cmocka_unit_test(test_debris_stays_rigid_and_conserves),
         cmocka_unit_test(test_crushed_tets_leave_as_powder),
         cmocka_unit_test(test_resting_body_stays_rigid),
+        cmocka_unit_test(test_handback_in_flight_stays_rigid),
         cmocka_unit_test(test_mesh_obstacle_matches_plane),
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),
         cmocka_unit_test(test_no_return_while_driving_in),

@@ -604,7 +604,13 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
         }
         cf_fragment *g = &sim->frag[ci];
-        cf_fragment_rest_props(sim, ci);
+        /* A fragment that stays itself keeps its tets, so its mass, centre
+         * and principal frame: its hulls, kept from its last hand-off, are
+         * in that frame.  Computed again, a body of equal principal
+         * moments (a cube) got other axes from the round-off of the node
+         * order, and its hulls were posed turned, deep in the ground. */
+        if (k > 1)
+            cf_fragment_rest_props(sim, ci);
         g->mode = CF_MODE_RIGID;
         memcpy(g->q_match, sim->frag[fi].q_match, sizeof g->q_match);
         cf_node_state ns;
