@@ -744,8 +744,28 @@ static void library_exit(void)
 
 static int dispatch(int argc, char **argv);
 
+/* OpenMP's threads meet at every barrier of a step, and libgomp spins
+ * 300,000 times by default before a waiting thread sleeps.  On a host whose
+ * cores are busy the thread it waits for is often descheduled, and the
+ * spinning takes the core it needs: beside two busy processes the first
+ * 10 ms of the plaster drop took 19-29 s on two threads against 14 s on
+ * one.  A spin of 5,000 takes 15 s there, as a passive wait does, and
+ * keeps the idle speed, which a passive wait loses (`cohfrac bench`:
+ * 1.7-1.9 times on two threads, against 1.2 passive; docs/performance.md).
+ * libgomp reads the setting when it loads, before main, so the program
+ * sets it and starts itself again, unless the user chose a spin or a wait
+ * policy. */
+static void limit_openmp_spin(char **argv)
+{
+    if (getenv("GOMP_SPINCOUNT") || getenv("OMP_WAIT_POLICY"))
+        return;
+    if (setenv("GOMP_SPINCOUNT", "5000", 1) == 0)
+        execv("/proc/self/exe", argv); /* returns only when it failed: run as we are */
+}
+
 int main(int argc, char **argv)
 {
+    limit_openmp_spin(argv);
     atexit(library_exit);
     int rc = dispatch(argc, argv);
     main_returned = 1;
