@@ -37,7 +37,7 @@
 -- of the 305 J it lands with, about 201 J go into crushing and 4.4 J into
 -- the cracks, and 50 J of strain energy are dropped (and booked) at the
 -- hand-offs; the fastest piece leaves at 7.7 m/s against the bound
--- 15.2 m/s of tools/check_physics.py; about 11 s.  Seeds 2-5 give 1, 5, 2
+-- 15.2 m/s of tools/check_physics.py; about 5 s.  Seeds 2-5 give 1, 5, 2
 -- and 3 pieces of at least 5%, bunny_4k 4, 2, 3, 1 and 1 for seeds 1-5
 -- (docs/physics.md §14.14).
 return {

@@ -85,8 +85,10 @@ static int decompose_fragment(cf_world *sim, cf_fragment *f)
         return 0;
     double t0 = cf_wall_time();
     cf_hulls_free(&f->hulls);
-    if (cf_decompose(&sim->solid, f->tets, f->nt, CF_HULL_MAX_ERROR, CF_HULL_MAX_COUNT,
-                     CF_HULL_MIN_TETS, &f->hulls))
+    int most = f->nt / CF_HULL_TETS_PER_HULL;
+    most = most < 1 ? 1 : most > CF_HULL_MAX_COUNT ? CF_HULL_MAX_COUNT : most;
+    if (cf_decompose(&sim->solid, f->tets, f->nt, CF_HULL_MAX_ERROR, most, CF_HULL_MIN_TETS,
+                     &f->hulls))
         return -1;
     for (int i = 0; i < f->hulls.start[f->hulls.n_hulls]; i++) {
         double r[3];

@@ -81,11 +81,13 @@ typedef struct cf_fragment {
 } cf_fragment;
 
 /* Convex decomposition settings (docs/physics.md §9): split until the hulls exceed
- * the tet volume by at most this fraction, into at most this many hulls of
- * at least this many tets each. */
+ * the tet volume by at most this fraction, into at most this many hulls (and
+ * at most one per CF_HULL_TETS_PER_HULL tets of the fragment), cutting no
+ * cell of fewer than twice CF_HULL_MIN_TETS tets. */
 #define CF_HULL_MAX_ERROR 0.05
 #define CF_HULL_MAX_COUNT 64
 #define CF_HULL_MIN_TETS 4
+#define CF_HULL_TETS_PER_HULL 2
 
 
 typedef struct cf_profile {
