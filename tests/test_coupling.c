@@ -92,12 +92,18 @@ static cf_sim *make_sim(const char *text, cf_world_def *sc)
 }
 
 /* Advance sim to the scene's duration; a failed step fails the test. */
-static void run_to_end(cf_sim *sim)
+/* One step of the run; an error fails the test. */
+static void advance(cf_sim *sim)
 {
     cf_error err = {0};
+    if (cf_sim_advance(sim, &err) != CF_OK)
+        fail_msg("run: %s", err.msg);
+}
+
+static void run_to_end(cf_sim *sim)
+{
     while (!cf_sim_done(sim))
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
 }
 
 static cf_sim *impact_sim(double duration, int threads, cf_world_def *sc)
@@ -144,8 +150,7 @@ static void test_momentum_across_fracture_mode_contact(void **state)
     cf_error err = {0};
     while (!cf_sim_done(sim)) {
         double before = anvil_momentum(sim);
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
         if (any_in_fracture_mode(sim)) {
             fracture_steps++;
             pushed += anvil_momentum(sim) - before;
@@ -344,8 +349,7 @@ static void test_reentry_keeps_the_family_tree(void **state)
     int reentered = 0;
     cf_error err = {0};
     while (!cf_sim_done(sim)) {
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
         int n = cf_world_fragments(cf_sim_world(sim), fs, CAP);
         assert_true(n <= CAP);
         for (int i = 0; i < n; i++) {
@@ -396,8 +400,7 @@ static void test_debris_stays_rigid_and_conserves(void **state)
     int debris_in_fracture = 0;
     cf_error err = {0};
     while (!cf_sim_done(sim)) {
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
         for (int i = 0; i < w->n_frag; i++)
             debris_in_fracture +=
                 cf_fragment_is_debris(w, &w->frag[i]) && w->frag[i].mode == CF_MODE_FRACTURE;
@@ -592,8 +595,7 @@ static void test_handoff_clears_obstacle_overlap(void **state)
     double ke_max = 0;
     int entered = 0;
     while (!cf_sim_done(sim)) {
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
         cf_ledger l;
         cf_world_ledger(cf_sim_world(sim), &l);
         ke_max = fmax(ke_max, l.kinetic);
@@ -634,8 +636,7 @@ static void test_no_return_while_driving_in(void **state)
     cf_error err = {0};
     int entries = 0, was = 0;
     while (!cf_sim_done(sim)) {
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
         int now = any_in_fracture_mode(sim);
         entries += now && !was;
         was = now;
@@ -681,8 +682,7 @@ static void test_resting_body_stays_rigid(void **state)
     int entries = 0, was = 0, after_rest = 0, handoffs_at_rest = -1;
     double rest_time = -1;
     while (!cf_sim_done(sim)) {
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
         cf_world *w = cf_sim_world(sim);
         int now = any_in_fracture_mode(sim);
         entries += now && !was;
@@ -734,8 +734,7 @@ static void test_handback_in_flight_stays_rigid(void **state)
     int entries = 0, was = 0;
     double t_back = -1, v_back = 0, worst = 0;
     while (!cf_sim_done(sim)) {
-        if (cf_sim_advance(sim, &err) != CF_OK)
-            fail_msg("run: %s", err.msg);
+        advance(sim);
         cf_world *w = cf_sim_world(sim);
         int now = any_in_fracture_mode(sim);
         entries += now && !was;
