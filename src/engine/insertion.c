@@ -631,25 +631,23 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
      * stays so through the check, as the facets it takes are not yet old
      * enough to be fronts: those, nine in ten of the candidates in a
      * cracked body, are dropped first, in parallel, before the ranking. */
-    unsigned char *touch = malloc((size_t)nc);
     ranked *r = malloc((size_t)nc * sizeof *r);
-    if (!r || !touch) {
-        free(r), free(touch);
+    if (!r)
         return -1;
-    }
 #pragma omp parallel for schedule(dynamic, 64) if (nc >= STAR_PARALLEL_MIN)
     for (int i = 0; i < nc; i++) {
         int f = cand->v[i], o[3];
         double c[3];
         face_vertices(s, s->facet[4 * f], s->facet[4 * f + 1], o);
         centroid(s, o, c);
-        touch[i] = crack_contact(s, f, o, c, g->t, g->front_speed) == CF_TOUCH;
+        int touch = crack_contact(s, f, o, c, g->t, g->front_speed) == CF_TOUCH;
+        r[i].facet = touch ? -1 : f;
+        r[i].ratio = touch ? 0 : facet_ratio(s, f, rule);
     }
     int nr = 0;
     for (int i = 0; i < nc; i++)
-        if (!touch[i])
-            r[nr].ratio = facet_ratio(s, cand->v[i], rule), r[nr++].facet = cand->v[i];
-    free(touch);
+        if (r[i].facet >= 0)
+            r[nr++] = r[i];
     nc = nr;
     qsort(r, (size_t)nc, sizeof *r, by_ratio);
     int kept = 0;
