@@ -7,7 +7,7 @@
 -- rho = 3900 kg/m^3 (alumina's density, a softened stiffness), sigma_max
 -- 30 MPa, G_I 50 N/m: a brittle solid at a strain rate where the
 -- fragment count is set by the strength and its scatter.
--- Strength: per-facet Weibull scatter, modulus 6, seed 1 (material.strength);
+-- Strength: a Weibull strength field, modulus 6, seed 1 (material.strength);
 -- set distribution = "uniform" to compare (every facet cracks where the
 -- stress first reaches sigma_max: at the middle, where the load is the same
 -- everywhere, or in one step everywhere).

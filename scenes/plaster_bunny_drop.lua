@@ -3,7 +3,7 @@
 -- starts 1 mm above the floor at the landing speed, 10 m/s (v^2 = 2 g h),
 -- so it pays for the impact and the 0.15 s of flight after it, not for
 -- the second of free fall.  Why 5.1 m: the plaster sphere ladder
--- (docs/physics.md §15) breaks at 9-10 m/s, and the 1.3 m drop this scene
+-- (docs/physics.md §15) breaks at 8-10 m/s, and the 1.3 m drop this scene
 -- used to make (5 m/s) lies below it: the bunny then keeps 72-99 % in one
 -- piece.
 -- Material: gypsum plaster (plaster of Paris), E 5 GPa, nu 0.2,
@@ -20,8 +20,8 @@
 -- the vertex ahead of it, with cracks that grow from their fronts, without
 -- branching, no faster than the Rayleigh speed, nucleate only clear of
 -- other cracks (radius l_ch = E G_I / sigma^2 = 12.5 mm) and never close a
--- piece of 4 tets or fewer; a Weibull strength of weakest-link areas
--- (docs/physics.md §5.1); a fragment stays in fracture mode until 500
+-- piece of 4 tets or fewer; a Weibull strength field of the material,
+-- correlated over l_ch (docs/physics.md §5.1); a fragment stays in fracture mode until 500
 -- steps (0.21 ms, about a wave's return trip through its 0.23 m height)
 -- pass with no insertion and its landing is over, and goes back to rigid
 -- mode as the pieces still held by a cohesive element.  Pieces of 4 tets
@@ -32,14 +32,13 @@
 -- Floor: a penalty contact (docs/physics.md §7.1) that neither takes nor
 -- gives energy; the body's elasticity makes the rebound.  Fracture mode
 -- begins at the engine's impact threshold (0.2 m/s).
--- Expected (seed 1): 54 fragments, three pieces of at least 5% of the mass
--- (23.5, 21.8 and 6.2%), 17 more of 1-5% and no chip of 4 tets or fewer;
--- of the 305 J it lands with, about 201 J go into crushing and 4.4 J into
--- the cracks, and 50 J of strain energy are dropped (and booked) at the
--- hand-offs; the fastest piece leaves at 7.7 m/s against the bound
--- 15.2 m/s of tools/check_physics.py; about 5 s.  Seeds 2-5 give 1, 5, 2
--- and 3 pieces of at least 5%, bunny_4k 4, 2, 3, 1 and 1 for seeds 1-5
--- (docs/physics.md §14.14).
+-- Expected (seed 1): 64 fragments, three pieces of at least 5% of the mass
+-- (20.7, 9.0 and 8.2%), 21 more of 1-5% and no chip of 4 tets or fewer;
+-- of the 305 J it lands with, about 208 J go into crushing and 5.0 J into
+-- the cracks, and 44 J of strain energy are dropped (and booked) at the
+-- hand-offs; the fastest piece leaves at 10.1 m/s against the bound
+-- 15.0 m/s of tools/check_physics.py; about 6 s.  Seeds 2-5 give 1, 2, 1
+-- and 4 pieces of at least 5% (docs/physics.md §14.17).
 return {
   name = "plaster_bunny_drop",
   duration = 0.15,

@@ -4,8 +4,8 @@
 -- above the floor at the impact speed (5 m/s here); the run ends 4 ms
 -- later, when the pieces have left the floor.
 -- Material: the plaster of plaster_bunny_drop.lua (E 5 GPa, nu 0.2,
--- rho 1200 kg/m^3, tensile strength 2 MPa with Weibull scatter of
--- weakest-link areas, G_I 10 N/m, compressive strength 15 MPa), whose
+-- rho 1200 kg/m^3, tensile strength 2 MPa with a Weibull strength field
+-- correlated over l_ch, G_I 10 N/m, compressive strength 15 MPa), whose
 -- cohesive length l_ch = E G_I / sigma^2 is 12.5 mm.
 -- Mesh: gmsh's sphere at mesh_size l_ch/2 (1,464 tets for 50 mm, 4,430
 -- for 75 mm).  Method: explicit fracture mode at 0.5 dt_cfl, cracks that

@@ -793,62 +793,108 @@ static void test_fronts_do_not_branch(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
-/* Weakest-link strength (Zhou and Molinari 2004): facet f of area A_f
- * draws w_f with P(w > x) = exp(-(A_f / A0) x^m), so z_f = (A_f / A0) w_f^m
- * is exponential with mean 1 and variance 1 whatever the facet's size.
- * On a coarse and a fine box (facet areas 8 and 2 times apart from each
- * other) the mean of z over the interior facets is 1 within four standard
- * errors, and the mean strength factor falls with the facet size as
- * (A_fine / A_coarse)^(-1/m) predicts: a mesh-independent strength of a
- * surface, where a per-facet draw would make the fine mesh weaker. */
-static void test_weibull_strength_scales_with_facet_area(void **state)
+/* The size-free strength factor of facet f of area A_f on the box of
+ * `cells` per edge (seed `seed`, reference area A0, modulus m), its rest
+ * centroid and (A_f / A0) w_f^m (for a facet larger than A0).  Returns the
+ * number of interior facets written. */
+static int box_strengths(int cells, int seed, double A0, double modulus, double *w, double *cen,
+                         double *area)
+{
+    cf_mesh m;
+    fixture_box(&m, cells, cells, cells, 1, 1, 1);
+    cf_material mt = mat;
+    mt.weibull = 1, mt.weibull_modulus = modulus, mt.strength_seed = seed, mt.strength_area = A0;
+    int *body = calloc((size_t)m.n_tets, sizeof(int));
+    cf_solid s;
+    assert_int_equal(cf_solid_init(&s, &m, &mt, body, NULL), CF_OK);
+    assert_int_equal(cf_solid_init_facets(&s, NULL), CF_OK);
+    int n = 0;
+    for (int f = 0; f < s.n_facets; f++) {
+        const int *F = &s.facet[4 * f];
+        if (F[2] < 0)
+            continue;
+        const double *p[3];
+        for (int i = 0; i < 3; i++)
+            p[i] = &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][i]]];
+        double e1[3], e2[3], nrm[3];
+        v3_sub(p[1], p[0], e1), v3_sub(p[2], p[0], e2), v3_cross(e1, e2, nrm);
+        area[n] = 0.5 * v3_norm(nrm);
+        for (int k = 0; k < 3; k++)
+            cen[3 * n + k] = (p[0][k] + p[1][k] + p[2][k]) / 3.0;
+        w[n] = s.strength[f] * pow(fmax(area[n] / A0, 1.0), 1.0 / modulus);
+        n++;
+    }
+    free(body);
+    cf_solid_free(&s), cf_mesh_free(&m);
+    return n;
+}
+
+/* The strength is a field of the material (docs/physics.md §5.1, rule 2).
+ * With A0 = 0.02 m^2 (L = 0.14 m) the coarse box's facets (4 cells per
+ * edge) are all larger than A0 and the fine box's (8 per edge) all
+ * smaller:
+ * - the fine facets' factors are Weibull of scale 1 (w^m exponential,
+ *   mean 1) and the coarse ones are weakest links, (A/A0) w^m of mean 1,
+ *   over 16 seeds within four standard errors of the independent regions;
+ * - the two meshes see the same material: the factors of a fine and a
+ *   coarse facet whose (distinct) centroids are less than L/2 apart
+ *   correlate (log-strength correlation above 0.7), those 2 L apart do
+ *   not (below 0.25 in magnitude).  A per-facet draw gives 0 for both. */
+static void test_strength_is_a_field_of_the_material(void **state)
 {
     (void)state;
-    const double modulus = 6, A0 = 1e-3;
-    double mean_w[2];
-    for (int level = 0; level < 2; level++) {
-        int n = 4 << level; /* cells per edge: 4, then 8 */
-        cf_mesh m;
-        fixture_box(&m, n, n, n, 1, 1, 1);
-        cf_material mt = mat;
-        mt.weibull = 1, mt.weibull_modulus = modulus, mt.strength_seed = 7, mt.strength_area = A0;
-        int *body = calloc((size_t)m.n_tets, sizeof(int));
-        cf_solid s;
-        assert_int_equal(cf_solid_init(&s, &m, &mt, body, NULL), CF_OK);
-        assert_int_equal(cf_solid_init_facets(&s, NULL), CF_OK);
-        double z = 0, w = 0;
-        int count = 0;
-        for (int f = 0; f < s.n_facets; f++) {
-            const int *F = &s.facet[4 * f];
-            if (F[2] < 0)
-                continue;
-            const double *a = &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][0]]],
-                         *b = &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][1]]],
-                         *c = &s.X[3 * s.tet0[4 * F[0] + CF_TET_FACE[F[1]][2]]];
-            double e1[3], e2[3], nrm[3];
-            v3_sub(b, a, e1), v3_sub(c, a, e2), v3_cross(e1, e2, nrm);
-            double area = 0.5 * v3_norm(nrm);
-            z += area / A0 * pow(s.strength[f], modulus);
-            w += s.strength[f] * pow(area / A0, 1.0 / modulus); /* the size taken out */
-            count++;
+    const double modulus = 6, A0 = 0.02, L = sqrt(A0);
+    enum { MAX = 20000, SEEDS = 16 };
+    double *w[2], *cen[2], *area[2];
+    int n[2];
+    for (int i = 0; i < 2; i++)
+        w[i] = malloc(MAX * sizeof(double)), cen[i] = malloc(3 * MAX * sizeof(double)),
+        area[i] = malloc(MAX * sizeof(double));
+    double zsum[2] = {0, 0}, cnum[2] = {0, 0};
+    double pair[2][6] = {{0}}; /* near, far: count and sums of a, b, ab, a^2, b^2 (log w) */
+    for (int seed = 1; seed <= SEEDS; seed++) {
+        for (int i = 0; i < 2; i++) {
+            n[i] = box_strengths(4 << i, seed, A0, modulus, w[i], cen[i], area[i]);
+            for (int f = 0; f < n[i]; f++) {
+                assert_true(i == 0 ? area[i][f] > A0 : area[i][f] < A0);
+                zsum[i] += pow(w[i][f], modulus), cnum[i]++;
+            }
         }
-        z /= count, w /= count;
-        mean_w[level] = 0;
-        for (int f = 0; f < s.n_facets; f++)
-            mean_w[level] += s.facet[4 * f + 2] >= 0 ? s.strength[f] / count : 0;
-        printf("FIGURE weibull area: %d cells per edge, %d facets, mean (A/A0) w^m %.4f (1 +- %.4f), "
-               "mean size-free factor %.4f (Gamma(1 + 1/m) = %.4f), mean w %.4f\n",
-               n, count, z, 4 / sqrt(count), w, tgamma(1 + 1 / modulus), mean_w[level]);
-        assert_true(fabs(z - 1) <= 4 / sqrt(count));
-        /* the size-free factor is Weibull of scale 1: mean Gamma(1 + 1/m), sd about 0.2 */
-        assert_true(fabs(w - tgamma(1 + 1 / modulus)) <= 4 * 0.2 / sqrt(count));
-        free(body);
-        cf_solid_free(&s), cf_mesh_free(&m);
+        for (int f = 0; f < n[1]; f++)
+            for (int g = 0; g < n[0]; g++) {
+                double d[3];
+                v3_sub(&cen[1][3 * f], &cen[0][3 * g], d);
+                double r = v3_norm(d);
+                int k = r > 1e-9 && r < 0.5 * L ? 0 : fabs(r - 2 * L) < 0.05 * L ? 1 : -1;
+                if (k < 0)
+                    continue;
+                double a = log(w[1][f]), b = log(w[0][g]);
+                double add[6] = {1, a, b, a * b, a * a, b * b};
+                for (int j = 0; j < 6; j++)
+                    pair[k][j] += add[j];
+            }
     }
-    /* The fine mesh's facets are a quarter of the coarse ones' area: each is
-     * stronger by 4^(1/m), 1.26 at m = 6 (within 5 %: the draws scatter). */
-    double want = pow(4.0, 1.0 / modulus);
-    assert_true(fabs(mean_w[1] / mean_w[0] / want - 1) < 0.05);
+    /* independent regions: the box's volume over L^3, per seed */
+    double regions = SEEDS / (L * L * L);
+    for (int i = 0; i < 2; i++) {
+        double z = zsum[i] / cnum[i];
+        printf("FIGURE strength field: %s mesh, mean %s %.4f (1 +- %.4f)\n", i ? "fine" : "coarse",
+               i ? "w^m" : "(A/A0) w^m", z, 4 / sqrt(regions));
+        assert_true(fabs(z - 1) <= 4 / sqrt(regions));
+    }
+    double corr[2];
+    for (int k = 0; k < 2; k++) {
+        const double *p = pair[k];
+        double ma = p[1] / p[0], mb = p[2] / p[0];
+        corr[k] = (p[3] / p[0] - ma * mb) /
+                  sqrt((p[4] / p[0] - ma * ma) * (p[5] / p[0] - mb * mb));
+        printf("FIGURE strength field: facets of the two meshes %s, %.0f pairs, log-strength "
+               "correlation %.3f\n", k ? "2 L apart" : "apart by less than L/2", p[0], corr[k]);
+    }
+    assert_true(corr[0] > 0.7);
+    assert_true(fabs(corr[1]) < 0.25);
+    for (int i = 0; i < 2; i++)
+        free(w[i]), free(cen[i]), free(area[i]);
 }
 
 int main(void)
@@ -865,7 +911,7 @@ int main(void)
         cmocka_unit_test(test_front_moves_no_faster_than_its_speed),
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
         cmocka_unit_test(test_fronts_do_not_branch),
-        cmocka_unit_test(test_weibull_strength_scales_with_facet_area),
+        cmocka_unit_test(test_strength_is_a_field_of_the_material),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

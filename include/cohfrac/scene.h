@@ -38,14 +38,15 @@
  *                  modulus [10] (Weibull modulus m > 0), seed [1] (integer),
  *                  area [0] m^2 (Weibull reference area A0; 0: l_ch^2 with
  *                  l_ch = E G_I / sigma_max^2, the cohesive length) } }
- *       per-facet strength scatter: with "weibull" each interior facet f of
- *       rest area A_f gets sigma_max_f = sigma_max w_f, tau_max_f = tau_max w_f,
- *       w_f drawn from the Weibull distribution of a weakest-link area,
- *       P(w <= x) = 1 - exp(-(A_f/A0) x^m) (Zhou and Molinari 2004: a surface
- *       has the same strength statistics however the mesh divides it; a
- *       facet of area A0 is weaker than sigma_max with probability 63%), the
- *       same for a given seed and mesh on any thread count; the facet's
- *       cohesive law keeps G_I, G_II
+ *       strength scatter: with "weibull" each interior facet f gets
+ *       sigma_max_f = sigma_max w_f, tau_max_f = tau_max w_f, w_f the value
+ *       at its rest centroid of a Weibull random field of the material,
+ *       P(w <= x) = 1 - exp(-x^m) at every point, correlated over
+ *       L = sqrt(A0) (the same weak regions on any mesh of the body);
+ *       a facet of rest area A_f > A0 is the weakest link of its regions,
+ *       w_f scaled by (A0/A_f)^(1/m) (Zhou and Molinari 2004); the same for
+ *       a given seed and placement on any thread count (docs/physics.md
+ *       §5.1); the facet's cohesive law keeps G_I, G_II
  *       (its final openings scale with 1/w_f).  Weibull 1951, J Appl Mech
  *       18:293; for dynamic fragmentation Zhou, Molinari, Ramesh 2006, IJIE
  *       33:880.

@@ -46,9 +46,10 @@ typedef struct cf_material {
     double compressive_strength;   /* sigma_c, Pa: crushing of the Tet4s, the strength in
                                       uniaxial compression (docs/physics.md §2.1); 0 none
                                       (linear elastic) */
-    double strength_area;          /* m^2: Weibull reference area A0; a facet of area A
-                                      draws its factor at scale (A0/A)^(1/m) (Zhou and
-                                      Molinari 2004); 0: the cohesive length squared,
+    double strength_area;          /* m^2: Weibull reference area A0: the strength field
+                                      is correlated over sqrt(A0), and a facet of area
+                                      A > A0 is scaled by (A0/A)^(1/m) (Zhou and Molinari
+                                      2004); 0: the cohesive length squared,
                                       (E G_I / sigma_max^2)^2 */
     double nucleation_radius;      /* m, R_n: no crack nucleates within R_n / ratio^2 of
                                       a cracked facet (rest centroids; crack_growth

@@ -173,17 +173,52 @@ double cf_mesh_dt_cfl(const cf_mesh *m, double scale, const cf_material *mat)
     return dt;
 }
 
-/* A Weibull draw of scale 1 and modulus m for facet f: w = (-ln(1 - u))^(1/m),
- * u uniform in (0, 1) from SplitMix64 of (seed, f) (Steele, Lea, Flood 2014),
- * so that it depends on nothing but the seed and the facet. */
-static double weibull_factor(int seed, int f, double m)
+/* SplitMix64's finaliser (Steele, Lea, Flood 2014): a well-mixed 64-bit
+ * hash of z. */
+static uint64_t mix64(uint64_t z)
 {
-    uint64_t z = (uint64_t)(uint32_t)seed * 0x9e3779b97f4a7c15ull + (uint64_t)f + 1;
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    double u = ((double)(z >> 11) + 0.5) / 9007199254740992.0; /* (0, 1) */
-    return pow(-log1p(-u), 1.0 / m);
+    return z ^ (z >> 31);
+}
+
+/* A standard normal at lattice point (i, j, k) for `seed` (Box-Muller from
+ * two hashed uniforms in (0, 1)): a function of nothing but the seed and
+ * the point. */
+static double lattice_normal(int seed, int64_t i, int64_t j, int64_t k)
+{
+    uint64_t z = mix64((uint64_t)(uint32_t)seed * 0x9e3779b97f4a7c15ull + (uint64_t)i);
+    z = mix64(z + (uint64_t)j * 0xc2b2ae3d27d4eb4full);
+    z = mix64(z + (uint64_t)k * 0x165667b19e3779f9ull);
+    double u1 = ((double)(z >> 11) + 0.5) / 9007199254740992.0;
+    double u2 = ((double)(mix64(z) >> 11) + 0.5) / 9007199254740992.0;
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2) /* 2 pi */;
+}
+
+/* The strength field's Weibull factor at rest point x: standard normals on
+ * a cubic lattice of spacing L, blended trilinearly and rescaled to unit
+ * variance (so the value is N(0, 1) everywhere and correlated over about
+ * L), then mapped through the normal and Weibull distributions (a
+ * translation field, Grigoriu 1995): P(w <= x) = 1 - exp(-x^m). */
+static double strength_field(int seed, double L, double m, const double x[3])
+{
+    double q[3], sum = 0, norm = 0;
+    int64_t c[3];
+    for (int a = 0; a < 3; a++) {
+        double y = x[a] / L, fl = floor(y);
+        c[a] = (int64_t)fl, q[a] = y - fl;
+    }
+    for (int n = 0; n < 8; n++) {
+        double w = 1;
+        for (int a = 0; a < 3; a++)
+            w *= (n >> a & 1) ? q[a] : 1.0 - q[a];
+        sum += w * lattice_normal(seed, c[0] + (n & 1), c[1] + (n >> 1 & 1), c[2] + (n >> 2 & 1));
+        norm += w * w;
+    }
+    double z = sum / sqrt(norm);
+    /* 1 - Phi(z), without the cancellation of 1 - Phi near z = +inf */
+    double survive = 0.5 * erfc(z * 0.7071067811865476) /* z / sqrt 2 */;
+    return pow(-log(survive), 1.0 / m);
 }
 
 cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
@@ -207,15 +242,22 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
         s->strength = malloc((size_t)(s->n_facets > 0 ? s->n_facets : 1) * sizeof(float));
         if (!s->strength)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory for facet strengths");
-        /* Weakest-link scaling (Zhou and Molinari 2004): a facet of area A
-         * draws at scale (A0/A)^(1/m), so the strength of a surface does not
-         * depend on how many facets the mesh divides it into. */
-        double A0 = mt->strength_area > 0 ? mt->strength_area : l_ch * l_ch;
+        /* A strength field of the material, not of the mesh (docs/physics.md
+         * §5.1): the factor at the facet's rest centroid, correlated over
+         * L = sqrt(A0), so two meshes of one body see the same weak regions
+         * and a finer mesh offers no more weak spots per volume.  A facet
+         * larger than A0 spans several independent regions and is their
+         * weakest link (Zhou and Molinari 2004): scale (A0/A)^(1/m). */
+        double A0 = mt->strength_area > 0 ? mt->strength_area : l_ch * l_ch, L = sqrt(A0);
         for (int f = 0; f < s->n_facets; f++) {
             const int *T = &s->tet0[4 * s->facet[4 * f]], *k = CF_TET_FACE[s->facet[4 * f + 1]];
-            double A = tri_area(&s->X[3 * T[k[0]]], &s->X[3 * T[k[1]]], &s->X[3 * T[k[2]]]);
-            double size = A > 0 ? pow(A0 / A, 1.0 / mt->weibull_modulus) : 1.0;
-            s->strength[f] = (float)(size * weibull_factor(mt->strength_seed, f, mt->weibull_modulus));
+            const double *a = &s->X[3 * T[k[0]]], *b = &s->X[3 * T[k[1]]], *c = &s->X[3 * T[k[2]]];
+            double A = tri_area(a, b, c), x[3];
+            for (int i = 0; i < 3; i++)
+                x[i] = (a[i] + b[i] + c[i]) / 3.0;
+            double size = A > A0 ? pow(A0 / A, 1.0 / mt->weibull_modulus) : 1.0;
+            s->strength[f] =
+                (float)(size * strength_field(mt->strength_seed, L, mt->weibull_modulus, x));
             s->strength_min = fmin(s->strength_min, s->strength[f]);
             s->strength_max = fmax(s->strength_max, s->strength[f]);
         }
