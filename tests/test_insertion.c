@@ -543,10 +543,12 @@ static int grow(cf_solid *s, const int *all, cf_growth g, double dt, int checks)
 }
 
 /* Tets in the smallest piece that the crack faces and the boundary close
- * (tets joined through uncracked interior facets). */
-static int smallest_closed_piece(const cf_solid *s)
+ * (tets joined through uncracked interior facets); the least volume of
+ * such a piece (m^3) in *volume when not NULL. */
+static int smallest_closed_piece(const cf_solid *s, double *volume)
 {
     int *parent = malloc((size_t)s->n_tets * sizeof(int)), *size = calloc((size_t)s->n_tets, sizeof(int));
+    double *vol = calloc((size_t)s->n_tets, sizeof(double));
     for (int t = 0; t < s->n_tets; t++)
         parent[t] = t;
     for (int f = 0; f < s->n_facets; f++) {
@@ -564,42 +566,57 @@ static int smallest_closed_piece(const cf_solid *s)
         int r = t;
         while (parent[r] != r)
             r = parent[r];
-        size[r]++;
+        size[r]++, vol[r] += s->vol[t];
     }
     int least = s->n_tets;
+    double least_vol = INFINITY;
     for (int t = 0; t < s->n_tets; t++)
-        if (size[t] > 0 && size[t] < least)
-            least = size[t];
-    free(parent), free(size);
+        if (size[t] > 0) {
+            least = size[t] < least ? size[t] : least;
+            least_vol = fmin(least_vol, vol[t]);
+        }
+    if (volume)
+        *volume = least_vol;
+    free(parent), free(size), free(vol);
     return least;
 }
 
 /* Every facet of a box overloaded in every direction qualifies at every
  * check.  The source's rule (all) then cracks every one at once and cuts
  * the box into single tets; the front rule, given all the time it wants,
- * cracks many facets but never closes a piece of 4 tets or fewer. */
+ * cracks many facets but never closes a piece of 4 tets or fewer, and
+ * with a least piece volume (min_piece_size) of two cells, 12 tets, none
+ * of less volume. */
 static void test_fronts_close_no_small_piece(void **state)
 {
     (void)state;
     cf_mesh m;
     fixture_box(&m, 4, 4, 4, 1, 1, 1);
-    int least[2], cracked[2];
-    for (int rule = 0; rule < 2; rule++) {
+    const double two_cells = 2.0 / 64.0;
+    int least[3], cracked[3];
+    double least_vol[3];
+    for (int rule = 0; rule < 3; rule++) {
         cf_solid s;
         int *all = stressed_box(&s, &m, 0, 1.0, 1e-9);
         for (int t = 0; t < s.n_tets; t++) /* hydrostatic tension: every normal */
             s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
-        cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4, 0};
+        cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4,
+                       rule == 2 ? two_cells : 0, 0};
         cracked[rule] = grow(&s, all, g, 1.0, 200);
-        least[rule] = smallest_closed_piece(&s);
+        least[rule] = smallest_closed_piece(&s, &least_vol[rule]);
         free(all);
         cf_solid_free(&s);
     }
     printf("FIGURE fronts: all: %d facets, smallest piece %d tets; fronts: %d facets, smallest "
-           "piece %d tets\n", cracked[0], least[0], cracked[1], least[1]);
+           "piece %d tets; with a least volume of %g m^3: %d facets, smallest piece %g m^3 "
+           "(%d tets)\n", cracked[0], least[0], cracked[1], least[1], two_cells, cracked[2],
+           least_vol[2], least[2]);
     assert_int_equal(least[0], 1);
     assert_true(least[1] > 4);
     assert_true(cracked[1] > cracked[0] / 4); /* the front rule does crack */
+    assert_true(least_vol[2] >= two_cells * (1 - 1e-12));
+    assert_true(least[2] < 96);               /* it does close pieces */
+    assert_true(cracked[2] > cracked[0] / 8); /* and crack */
     cf_mesh_free(&m);
 }
 
@@ -618,7 +635,7 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid s;
     int *all = stressed_box(&s, &m, 1.4, 1.0, 100.0);
     double speed = 10.0, dt = 0.01, cell = sqrt(3.0);
-    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0};
     cf_int_list cand = {0}, nodes = {0}, touched = {0};
     double first[3] = {0, 0, 0}, worst = -INFINITY;
     int nuclei = 0, total = 0;
@@ -767,7 +784,7 @@ static void test_fronts_do_not_branch(void **state)
         c[k] = (s.X[3 * o0[0] + k] + s.X[3 * o0[1] + k] + s.X[3 * o0[2] + k]) / 3;
     assert_int_equal(cf_crack_grid_add(&s.cracks, c), 0);
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0.0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0};
     cf_int_list cand = {0};
     int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, &cand);
     assert_true(n > 0);

@@ -145,6 +145,9 @@
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
+ *     min_piece_size [0] m: with "fronts", nor around a piece whose sphere
+ *       of equal volume is narrower (a size of the material rather than a
+ *       count of elements, docs/physics.md §5.1 rule 4; 0: no bound)
  *     debris_tets [4] (integer >= 0) and debris_size [0] m: a piece of at
  *       most debris_tets tets, or whose sphere of equal volume is narrower
  *       than debris_size, is debris (docs/physics.md §9.2): it leaves

@@ -152,6 +152,8 @@ typedef struct cf_solver_settings {
     cf_crack_growth crack_growth;
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
+    double min_piece_size;        /* m: nor one whose equal-volume sphere is narrower;
+                                     0: no bound */
     int debris_tets;              /* a piece of at most this many tets is debris; 0: none */
     double debris_size;           /* m: a piece whose equal-volume sphere is narrower is
                                      debris; 0: no size rule */

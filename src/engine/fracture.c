@@ -147,7 +147,9 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, double t, doubl
     const cf_solver_settings *set = &sim->def.solver;
     double t0 = cf_wall_time();
     int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, &sim->cand);
-    cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets, t};
+    double d = set->min_piece_size; /* a sphere of diameter d */
+    cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets,
+                        0.5235987755982988 * d * d * d /* pi d^3 / 6 */, t};
     if (nc > 0)
         nc = cf_insertion_select(s, &sim->cand, set->criterion, &growth);
     if (nc < 0)

@@ -578,28 +578,32 @@ static int crack_contact(const cf_solid *s, int f, const int o[3], const double 
 }
 
 /* Whether cracking facet f would close crack faces (and the boundary)
- * around a piece of at most `most` tets on either side: a search through
- * the uncracked interior facets from each of its tets, which stops once it
- * has found more. */
-static int closes_small_piece(const cf_solid *s, int f, int most)
+ * around a small piece on either side: one of at most `most` tets, or of
+ * less volume than `least_volume` (m^3).  A search through the uncracked
+ * interior facets from each of its tets, which stops once the piece it has
+ * found is large on both counts. */
+static int closes_small_piece(cf_solid *s, int f, int most, double least_volume)
 {
-    int seen[CF_MAX_PIECE_TETS + 1];
-    for (int side = 0; side < 2 && most > 0; side++) {
-        int n = 0;
-        seen[n++] = s->facet[4 * f + 2 * side];
-        for (int i = 0; i < n && n <= most; i++)
-            for (int k = 0; k < 4 && n <= most; k++) {
-                int g = s->tet_facet[4 * seen[i] + k];
+    for (int side = 0; side < 2 && (most > 0 || least_volume > 0); side++) {
+        unsigned stamp = ++s->piece_stamp;
+        if (stamp == 0) { /* wrapped: clear the marks once in 2^32 searches */
+            memset(s->piece_mark, 0, (size_t)s->n_tets * sizeof(unsigned));
+            stamp = s->piece_stamp = 1;
+        }
+        int n = 0, t0 = s->facet[4 * f + 2 * side];
+        double vol = s->vol[t0];
+        s->piece[n++] = t0, s->piece_mark[t0] = stamp;
+        for (int i = 0; i < n && (n <= most || vol < least_volume); i++)
+            for (int k = 0; k < 4; k++) {
+                int g = s->tet_facet[4 * s->piece[i] + k];
                 const int *G = &s->facet[4 * g];
                 if (g == f || G[2] < 0 || s->cracked[g])
                     continue;
-                int other = G[0] == seen[i] ? G[2] : G[0], known = 0;
-                for (int q = 0; q < n; q++)
-                    known |= seen[q] == other;
-                if (!known)
-                    seen[n++] = other;
+                int other = G[0] == s->piece[i] ? G[2] : G[0];
+                if (s->piece_mark[other] != stamp)
+                    s->piece[n++] = other, s->piece_mark[other] = stamp, vol += s->vol[other];
             }
-        if (n <= most)
+        if (n <= most || vol < least_volume)
             return 1;
     }
     return 0;
@@ -671,7 +675,7 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
         double shield = s->nucleation_radius / (q * q);
         if (contact == CF_TOUCH ||
             (contact == CF_CLEAR && cf_crack_grid_near(&s->cracks, c, shield)) ||
-            closes_small_piece(s, f, g->min_piece_tets))
+            closes_small_piece(s, f, g->min_piece_tets, g->min_piece_volume))
             continue;
         if (cf_crack_grid_add(&s->cracks, c)) {
             for (int j = 0; j < kept; j++) { /* nothing marked */

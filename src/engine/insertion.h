@@ -50,6 +50,7 @@ typedef struct cf_growth {
     cf_crack_growth rule;  /* fronts, or all (the source's) */
     double front_speed;    /* m/s: the fastest a crack front may move (Rayleigh speed) */
     int min_piece_tets;    /* no insertion closes a piece of at most this many tets */
+    double min_piece_volume; /* m^3: nor one of less volume (0: no bound) */
     double t;              /* s: now */
 } cf_growth;
 

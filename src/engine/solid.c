@@ -230,7 +230,11 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     s->qualify = calloc((size_t)s->n_tets, 1);
     s->node_mark = calloc((size_t)s->cap_nodes, 1);
     s->nodal = malloc((size_t)s->cap_nodes * sizeof(double));
-    if (!s->sigma || !s->hot || !s->qualify || !s->node_mark || !s->nodal || build_facets(s))
+    s->piece = malloc((size_t)s->n_tets * sizeof(int));
+    s->piece_mark = calloc((size_t)s->n_tets, sizeof(unsigned));
+    s->piece_stamp = 0;
+    if (!s->sigma || !s->hot || !s->qualify || !s->node_mark || !s->nodal || !s->piece ||
+        !s->piece_mark || build_facets(s))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
                             s->n_tets);
     const cf_material *mt = &s->mat;
@@ -428,7 +432,7 @@ void cf_solid_free(cf_solid *s)
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->speed, s->mass_scale,
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
-                    s->nodal, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
+                    s->nodal, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
                     s->cracked, s->crack_time, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);

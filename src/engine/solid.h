@@ -102,6 +102,9 @@ typedef struct cf_solid {
                                  (fracture state) */
     double *nodal;            /* [cap_nodes] the source criterion's nodal values, Pa
                                  (fracture state) */
+    int *piece;               /* [nt] scratch of the small-piece search: tets reached */
+    unsigned *piece_mark;     /* [nt] the search's stamp of each tet reached */
+    unsigned piece_stamp;     /* the last stamp used */
     int *vt_start, *vt_slot;  /* original vertex -> its slots 4 t + j in the tets that
                                  hold it (CSR, ascending t) */
 

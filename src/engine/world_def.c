@@ -251,6 +251,7 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     CHECK("solver.check_interval", s->check_interval, AT_LEAST_ONE);
     CHECK("solver.quiet_steps", s->quiet_steps, AT_LEAST_ONE);
     CHECK("solver.min_piece_tets", s->min_piece_tets, PIECE_TETS);
+    CHECK("solver.min_piece_size", s->min_piece_size, NON_NEGATIVE);
     CHECK("solver.debris_tets", s->debris_tets, PIECE_TETS);
     CHECK("solver.debris_size", s->debris_size, NON_NEGATIVE);
     CHECK("solver.max_fracture_time", s->max_fracture_time, POSITIVE);

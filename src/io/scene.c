@@ -81,7 +81,8 @@ static const char *const solver_keys[] = {
     "dt_fracture",       "cfl_fraction",     "check_interval", "quiet_steps",
     "max_fracture_time",
     "impact_threshold",  "elasticity",       "criterion",      "crack_plane",
-    "crack_growth",      "min_piece_tets",   "debris_tets",    "debris_size",
+    "crack_growth",      "min_piece_tets",   "min_piece_size", "debris_tets",
+    "debris_size",
     "constraints",       "pbd",              "xpbd",           "contact_stiffness",
     "obstacle_contact",  "mass_scaling",
     "guard",             "threads"};
@@ -1189,7 +1190,7 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
 {
     static const double dt_rigid = 1e-3, dt_fracture = 5e-6, max_fracture_time = 0.05,
                         impact_threshold = 0.2, contact_stiffness = 0.0, cfl_fraction = 0.0,
-                        mass_scaling = 0.0, debris_size = 0.0;
+                        mass_scaling = 0.0, debris_size = 0.0, min_piece_size = 0.0;
     lua_State *L = ld->L;
     int mode, backend, elasticity, criterion, growth, constraints, obstacle_contact;
     TRY(check_keys(ld, t, solver_keys, COUNT(solver_keys)));
@@ -1228,6 +1229,7 @@ static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
     s->obstacle_contact = (cf_obstacle_contact)obstacle_contact;
     TRY(get_num(ld, t, "mass_scaling", &mass_scaling, &UNIT, &s->mass_scaling));
     TRY(get_int(ld, t, "min_piece_tets", 4, &PIECE_TETS, &s->min_piece_tets));
+    TRY(get_num(ld, t, "min_piece_size", &min_piece_size, &NON_NEGATIVE, &s->min_piece_size));
     TRY(get_int(ld, t, "debris_tets", 4, &PIECE_TETS, &s->debris_tets));
     TRY(get_num(ld, t, "debris_size", &debris_size, &NON_NEGATIVE, &s->debris_size));
     s->has_crack_plane = 0;
@@ -1835,6 +1837,7 @@ static char *resolved_text(const cf_world_def *s)
     put_str(&b, 4, "criterion", criterion_names[v->criterion]);
     put_str(&b, 4, "crack_growth", growth_names[v->crack_growth]);
     put(&b, "    min_piece_tets = %d,\n", v->min_piece_tets);
+    put_num(&b, 4, "min_piece_size", v->min_piece_size);
     put(&b, "    debris_tets = %d,\n", v->debris_tets);
     put_num(&b, 4, "debris_size", v->debris_size);
     put_str(&b, 4, "obstacle_contact", obstacle_contact_names[v->obstacle_contact]);
