@@ -151,9 +151,12 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     return CF_OK;
 }
 
-void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double v[3], double w[3])
+/* Fragment fi's pose, its shape matching warm-started from (and leaving
+ * its rotation in) q. */
+static void pose_from(const cf_world *sim, int fi, double q[4], double com[3], double R[9],
+                      double v[3], double w[3])
 {
-    cf_fragment *f = &sim->frag[fi];
+    const cf_fragment *f = &sim->frag[fi];
     if (f->body >= 0) {
         cfb_state st;
         double Rb[9];
@@ -166,11 +169,24 @@ void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double 
         return;
     }
     cf_node_state ns;
-    cf_nodes_state(&sim->solid, f->nodes.v, f->nodes.n, f->q_match, &ns);
+    cf_nodes_state(&sim->solid, f->nodes.v, f->nodes.n, q, &ns);
     memcpy(com, ns.com, sizeof ns.com);
     memcpy(R, ns.R, sizeof ns.R);
     memcpy(v, ns.v, sizeof ns.v);
     cf_nodes_angular_velocity(&sim->solid, f->nodes.v, f->nodes.n, ns.com, ns.L, w);
+}
+
+void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double v[3], double w[3])
+{
+    pose_from(sim, fi, sim->frag[fi].q_match, com, R, v, w);
+}
+
+void cf_fragment_pose_peek(const cf_world *sim, int fi, double com[3], double R[9], double v[3],
+                           double w[3])
+{
+    double q[4];
+    memcpy(q, sim->frag[fi].q_match, sizeof q);
+    pose_from(sim, fi, q, com, R, v, w);
 }
 
 typedef struct {

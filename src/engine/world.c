@@ -689,7 +689,7 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
             o->mode = f->mode, o->n_tets = f->nt, o->mass = f->mass;
             memcpy(o->principal, f->principal, sizeof o->principal);
             memcpy(o->axes, f->Q, sizeof o->axes);
-            cf_fragment_pose(sim, fi, o->com, R, o->v, o->w);
+            cf_fragment_pose_peek(sim, fi, o->com, R, o->v, o->w);
             mat_to_quat(R, o->quat);
             for (int k = 0; k < 3; k++)
                 o->momentum[k] = f->mass * o->v[k];
@@ -718,7 +718,7 @@ double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
         return 0;
     const cf_fragment *f = &sim->frag[id];
     double com[3], R[9], v[3], w[3], Rd[3], best = -INFINITY;
-    cf_fragment_pose(sim, id, com, R, v, w);
+    cf_fragment_pose_peek(sim, id, com, R, v, w);
     m3_tmulv(R, d, Rd); /* (R r).d = r.(R^T d), r from the rest centre of mass */
     for (int i = 0; i < f->nodes.n; i++) {
         double r[3];
@@ -754,7 +754,7 @@ int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
     const cf_fragment *f = &sim->frag[fi];
     double com[3], R[9], v[3], w[3];
     if (f->body >= 0) /* rigid in Bullet: the nodes are not moved, the pose is */
-        cf_fragment_pose((cf_world *)sim, fi, com, R, v, w);
+        cf_fragment_pose_peek(sim, fi, com, R, v, w);
     for (int j = 0; j < 4; j++) {
         int a = s->tet[4 * st + j];
         if (f->body < 0) {

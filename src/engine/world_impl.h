@@ -184,8 +184,14 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first);
 cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const double R[9],
                                const double v[3], const double w[3], cf_error *err);
 
-/* Centre of mass, rotation, velocities of fragment fi, whatever its mode. */
+/* Centre of mass, rotation, velocities of fragment fi, whatever its mode.
+ * In fracture mode the rotation is the shape matching's, warm-started from
+ * and written back to the fragment's q_match: the step's own calls.
+ * cf_fragment_pose_peek leaves q_match alone, so that reading a pose
+ * (output frames, queries) never changes a run's bits. */
 void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double v[3], double w[3]);
+void cf_fragment_pose_peek(const cf_world *sim, int fi, double com[3], double R[9], double v[3],
+                           double w[3]);
 
 /* The ledger state of fragment fi from its nodes now: exact kinetic energy,
  * zero strain energy, sum m x. */
