@@ -191,6 +191,51 @@ static void test_determinism_hash(void **state)
     assert_true(h[0] == STORED_HASH);
 }
 
+/* Heartbeats of one rigid step: how many, and the latest time given. */
+typedef struct {
+    int calls;
+    double latest;
+} heartbeat;
+
+static void count_tick(void *user, double t)
+{
+    heartbeat *h = user;
+    h->calls++, h->latest = fmax(h->latest, t);
+}
+
+/* The world's heartbeat (cf_world_set_tick, what keeps a progress display
+ * moving inside a long step): in every rigid step that a fragment spends
+ * in fracture mode it comes after each of the dt_rigid / dt_fracture = 10
+ * sub-steps, the latest at the end of the step; and it changes nothing
+ * (the state hash of test_determinism_hash). */
+static void test_heartbeat_inside_a_step(void **state)
+{
+    (void)state;
+    cf_world_def sc;
+    cf_sim *sim = impact_sim(0.06, 1, &sc);
+    cf_world *w = (cf_world *)cf_sim_world(sim);
+    heartbeat h;
+    cf_world_set_tick(w, count_tick, &h);
+    int spells = 0, short_of = 0, beats = 0;
+    while (!cf_sim_done(sim)) {
+        int fracture = any_in_fracture_mode(sim);
+        h.calls = 0, h.latest = -INFINITY;
+        advance(sim);
+        beats += h.calls;
+        if (!fracture)
+            continue;
+        spells++;
+        short_of += h.calls < 10 || fabs(h.latest - cf_world_time(w)) > 1e-12;
+    }
+    printf("FIGURE heartbeat: %d steps in fracture mode, %d heartbeats, %d steps short of 10 "
+           "or of the step's end\n", spells, beats, short_of);
+    assert_true(spells > 0);
+    assert_int_equal(short_of, 0);
+    assert_true(cf_world_state_hash(w) == STORED_HASH);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
 /* Reading every fragment's pose before each step (cf_world_fragments, as
  * output frames do) changes nothing: the state hash of
  * test_determinism_hash.  (Reading a pose in fracture mode once moved the
@@ -833,6 +878,7 @@ int main(void)
         cmocka_unit_test(test_momentum_across_fracture_mode_contact),
         cmocka_unit_test(test_determinism_hash),
         cmocka_unit_test(test_reading_poses_changes_nothing),
+        cmocka_unit_test(test_heartbeat_inside_a_step),
         cmocka_unit_test(test_determinism_hash_coloured),
         cmocka_unit_test(test_reentry_keeps_the_family_tree),
         cmocka_unit_test(test_debris_stays_rigid_and_conserves),

@@ -98,6 +98,8 @@ static int decompose_fragment(cf_world *sim, cf_fragment *f)
     double dt = cf_wall_time() - t0;
     sim->prof.decompose += dt;
     f->decompose_time = dt;
+    if (sim->tick)
+        sim->tick(sim->tick_user, sim->t);
     return 0;
 }
 

@@ -992,6 +992,8 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
             sim->flow.contact += removed;
             sim->prof.bodies += cf_wall_time() - t0;
         }
+        if (sim->tick)
+            sim->tick(sim->tick_user, sim->t + (double)(k + 1) * h);
     }
     for (int fi = 0; fi < n; fi++) {
         cf_fragment *f = &sim->frag[fi];
@@ -1161,6 +1163,11 @@ static cf_status split_fragments(cf_world *sim, cf_error *err)
 const cf_world_def *cf_world_definition(const cf_world *sim) { return &sim->def; }
 
 int cf_world_done(const cf_world *sim) { return sim->step >= sim->n_steps; }
+
+void cf_world_set_tick(cf_world *sim, cf_world_tick_fn fn, void *user)
+{
+    sim->tick = fn, sim->tick_user = user;
+}
 
 void cf_world_set_threads(cf_world *sim, int n)
 {

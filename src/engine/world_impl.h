@@ -104,6 +104,8 @@ struct cf_world {
     int n_frag, cap_frag;
     cfb_world *bullet;       /* NULL for the pbd rigid backend */
     double t;                /* s */
+    cf_world_tick_fn tick;   /* heartbeat inside a step (cf_world_set_tick), or NULL */
+    void *tick_user;
     long step;               /* rigid steps done */
     long n_steps;            /* rigid steps in the scene's duration */
     double dt_fracture;      /* s: solver.dt_fracture, or cfl_fraction dt_cfl */

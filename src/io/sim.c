@@ -51,6 +51,7 @@ struct cf_sim {
     double wall_start;          /* s, wall clock at create */
     double loop_start;          /* s, wall clock at the first step */
     double last_progress;       /* s, wall clock of the last progress display */
+    double t_inner;             /* s, simulated time reached inside the current step */
     int bar_shown;              /* a progress bar is on the terminal's last line */
     double output_time;         /* s of wall time writing the file */
     unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
@@ -279,6 +280,8 @@ static void close_after_error(cf_sim *sim, cf_error *err)
     sim->h5 = NULL;
 }
 
+static void tick(void *user, double t);
+
 cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
                         cf_error *err)
 {
@@ -320,6 +323,8 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
         st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
     if (st == CF_OK)
         st = cf_world_create(&w, &sim->world, err);
+    if (st == CF_OK)
+        cf_world_set_tick(sim->world, tick, sim);
     if (st == CF_OK && w.solver.threads == 0) { /* the default: adapts to the host */
         cf_world_stats ws;
         cf_world_stats_get(sim->world, &ws);
@@ -492,7 +497,7 @@ static void progress(cf_sim *sim, int final)
     cf_world_stats ws;
     cf_world_stats_get(w, &ws);
     double left = final ? 0 : eta(sim, &ws);
-    double t = fmin(cf_world_time(w), sim->duration);
+    double t = fmin(fmax(cf_world_time(w), sim->t_inner), sim->duration);
     const char *mode = ws.in_fracture ? "fracture" : "rigid";
     if (term) {
         char bar[31];
@@ -509,6 +514,16 @@ static void progress(cf_sim *sim, int final)
         fprintf(stderr, "t=%.4f/%.4g s (%3.0f%%)  %s  fragments %d  cohesive %d  ETA %.0f s\n",
                 t, sim->duration, 100 * frac, mode, ws.alive, ws.cohesive, left);
     }
+}
+
+/* The world's heartbeat inside a long step (a fracture spell of many
+ * sub-steps, the decomposition of many pieces): the display moves on
+ * between rigid steps too. */
+static void tick(void *user, double t)
+{
+    cf_sim *sim = user;
+    sim->t_inner = t;
+    progress(sim, 0);
 }
 
 /* Runnable tasks of other processes now: the count in /proc/loadavg less
