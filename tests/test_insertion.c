@@ -522,12 +522,14 @@ static int *stressed_box(cf_solid *s, cf_mesh *m, double sy, double strength, do
 /* Checks at times 0, dt, 2 dt, ... under growth rule g, each inserting
  * what cf_insertion_select takes, until a check takes nothing (at most
  * `checks`).  Returns the facets inserted. */
-static int grow(cf_solid *s, const int *all, cf_growth g, double dt, int checks)
+static int grow_memo(cf_solid *s, const int *all, cf_growth g, double dt, int checks, int forget)
 {
     cf_int_list cand = {0}, nodes = {0}, touched = {0};
     int total = 0;
     for (int c = 0; c < checks; c++) {
         g.t = c * dt;
+        if (forget) /* the growth rule's memo of how facets meet the cracks */
+            memset(s->contact_key, 0, (size_t)s->n_facets * sizeof *s->contact_key);
         int n = cf_insertion_candidates(s, all, s->n_tets, CF_CRITERION_TRACTION, s->n_tets, &cand);
         assert_true(n >= 0);
         n = cf_insertion_select(s, &cand, CF_CRITERION_TRACTION, &g);
@@ -540,6 +542,11 @@ static int grow(cf_solid *s, const int *all, cf_growth g, double dt, int checks)
     }
     free(cand.v), free(nodes.v), free(touched.v);
     return total;
+}
+
+static int grow(cf_solid *s, const int *all, cf_growth g, double dt, int checks)
+{
+    return grow_memo(s, all, g, dt, checks, 0);
 }
 
 /* Tets in the smallest piece that the crack faces and the boundary close
@@ -618,6 +625,52 @@ static void test_fronts_close_no_small_piece(void **state)
     assert_true(least[2] < 96);               /* it does close pieces */
     assert_true(cracked[2] > cracked[0] / 8); /* and crack */
     cf_mesh_free(&m);
+}
+
+/* The growth rule remembers how each facet meets the cracks (front,
+ * touching, clear) until a facet on its vertices cracks or a crack on its
+ * edges comes of age.  Forgetting it before every check gives the same
+ * cracks at the same times: in the box overloaded in every direction (no
+ * waiting) and in the bar whose single crack grows at a finite speed (a
+ * memo that lives until a crack is old enough). */
+static void test_contact_memo_changes_nothing(void **state)
+{
+    (void)state;
+    for (int scene = 0; scene < 2; scene++) {
+        cf_mesh m;
+        if (scene == 0)
+            fixture_box(&m, 4, 4, 4, 1, 1, 1);
+        else
+            fixture_box(&m, 8, 2, 2, 8, 2, 2);
+        unsigned char *cracked[2];
+        double *when[2];
+        int n[2], nf = 0;
+        for (int forget = 0; forget < 2; forget++) {
+            cf_solid s;
+            int *all = scene == 0 ? stressed_box(&s, &m, 0, 1.0, 1e-9) : stressed_box(&s, &m, 1.4, 1.0, 100.0);
+            if (scene == 0)
+                for (int t = 0; t < s.n_tets; t++)
+                    s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
+            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0};
+            n[forget] = grow_memo(&s, all, g, scene == 0 ? 1.0 : 0.01, 200, forget);
+            nf = s.n_facets;
+            cracked[forget] = malloc((size_t)nf), when[forget] = malloc((size_t)nf * sizeof(double));
+            memcpy(cracked[forget], s.cracked, (size_t)nf);
+            memcpy(when[forget], s.crack_time, (size_t)nf * sizeof(double));
+            free(all);
+            cf_solid_free(&s);
+        }
+        printf("FIGURE contact memo: %s, %d facets cracked with it, %d without\n",
+               scene == 0 ? "box overloaded in every direction" : "bar, one crack at 10 m/s",
+               n[0], n[1]);
+        assert_true(n[0] > 0);
+        assert_int_equal(n[0], n[1]);
+        assert_memory_equal(cracked[0], cracked[1], (size_t)nf);
+        assert_memory_equal(when[0], when[1], (size_t)nf * sizeof(double));
+        for (int i = 0; i < 2; i++)
+            free(cracked[i]), free(when[i]);
+        cf_mesh_free(&m);
+    }
 }
 
 /* A bar 8 m long under tension across one plane: the facets of the plane
@@ -706,7 +759,7 @@ static void test_front_rule_reads_the_stress_ahead(void **state)
     int f0 = middle_facet(&s), o0[3]; /* an interior facet normal to y near the middle */
     assert_true(f0 >= 0);
     facet_vertices(&s, f0, o0);
-    s.cracked[f0] = 1;
+    cf_mark_cracked(&s, f0, 1);
     for (int t = 0; t < s.n_tets; t++)
         for (int j = 0; j < 4; j++)
             if (s.tet0[4 * t + j] == o0[0] || s.tet0[4 * t + j] == o0[1] ||
@@ -777,7 +830,7 @@ static void test_fronts_do_not_branch(void **state)
     for (int j = 0, k = 0; j < 3; j++)
         if (o0[j] == o1[0] || o0[j] == o1[1] || o0[j] == o1[2])
             e[k++] = o0[j];
-    s.cracked[f0] = s.cracked[f1] = 1;
+    cf_mark_cracked(&s, f0, 1), cf_mark_cracked(&s, f1, 1);
     s.crack_time[f0] = s.crack_time[f1] = -1e9;
     double c[3];
     for (int k = 0; k < 3; k++)
@@ -928,6 +981,7 @@ int main(void)
         cmocka_unit_test(test_front_moves_no_faster_than_its_speed),
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
         cmocka_unit_test(test_fronts_do_not_branch),
+        cmocka_unit_test(test_contact_memo_changes_nothing),
         cmocka_unit_test(test_strength_is_a_field_of_the_material),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -44,6 +44,11 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
                             cf_int_list *out);
 
+/* Set facet f's cracked flag (1 or 0), and move on the crack version of
+ * its three original vertices, which the growth rule's memo keys on: every
+ * change of a facet's flag goes through here. */
+void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked);
+
 /* How a check chooses among the facets that meet the criterion
  * (docs/physics.md §5.1). */
 typedef struct cf_growth {

@@ -69,7 +69,13 @@ static int build_facets(cf_solid *s)
     s->n_facets = nf;
     s->cracked = calloc((size_t)nf, 1);
     s->crack_time = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
-    return s->cracked && s->crack_time ? 0 : -1;
+    s->contact_key = calloc((size_t)(nf > 0 ? nf : 1), sizeof(uint64_t));
+    s->contact_kind = calloc((size_t)(nf > 0 ? nf : 1), 1);
+    s->contact_until = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
+    return s->cracked && s->crack_time && s->contact_key && s->contact_kind &&
+                   s->contact_until
+               ? 0
+               : -1;
 }
 
 int cf_boundary_faces(const int *tet_nodes, const int *list, int nt, int *faces)
@@ -109,7 +115,8 @@ static int build_vertex_tets(cf_solid *s)
     int nv = s->n_verts0, nt = s->n_tets;
     s->vt_start = calloc((size_t)nv + 1, sizeof(int));
     s->vt_slot = malloc((size_t)nt * 4 * sizeof(int));
-    if (!s->vt_start || !s->vt_slot)
+    s->vert_cracks = calloc((size_t)nv + 1, sizeof(unsigned));
+    if (!s->vt_start || !s->vt_slot || !s->vert_cracks)
         return -1;
     for (int i = 0; i < 4 * nt; i++)
         s->vt_start[s->tet0[i] + 1]++;
@@ -433,7 +440,8 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->crack_time, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh};
+                    s->cracked, s->crack_time, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh,
+                    s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
     cf_crack_grid_free(&s->cracks);

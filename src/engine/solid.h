@@ -9,6 +9,7 @@
 #ifndef COHFRAC_SOLID_H
 #define COHFRAC_SOLID_H
 
+#include <stdint.h>
 #include "cohfrac/tetmesh.h"
 #include "cohfrac/types.h"
 #include "crack_grid.h"
@@ -89,6 +90,14 @@ typedef struct cf_solid {
     int *tet_facet;           /* [nt][4] facet of face k */
     unsigned char *cracked;   /* [nf] */
     double *crack_time;       /* [nf] s, when each cracked facet was inserted */
+    unsigned *vert_cracks;    /* [n_verts0] times a facet on each original vertex was
+                                 marked cracked (or unmarked): a version of the cracks
+                                 around it */
+    uint64_t *contact_key;    /* [nf] the growth rule's memo of how each facet meets
+                                 the cracks: its vertices' versions (summed, + 1) when
+                                 last found, 0 never */
+    unsigned char *contact_kind; /* [nf] what was found (front, touch) */
+    double *contact_until;    /* [nf] s, until when it holds */
     double nucleation_radius; /* m (material.nucleation_radius, l_ch when 0) */
     cf_crack_grid cracks;     /* rest centroids of the cracked facets, by place
                                  (crack_growth "fronts") */
