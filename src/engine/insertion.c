@@ -183,6 +183,8 @@ static int slot_of(const cf_solid *s, int t, int o)
  * vertices a and b: a face with both of them, of a tet in a's star. */
 static int edge_cracked(const cf_solid *s, int f, int a, int b)
 {
+    if (!s->vert_cracks[a] || !s->vert_cracks[b]) /* no cracked facet was ever on one end */
+        return 0;
     for (int j = s->vt_start[a]; j < s->vt_start[a + 1]; j++) {
         int slot = s->vt_slot[j], t = slot / 4, sb = slot_of(s, t, b);
         if (sb < 0)
