@@ -91,7 +91,6 @@ static cf_sim *make_sim(const char *text, cf_world_def *sc)
     return sim;
 }
 
-/* Advance sim to the scene's duration; a failed step fails the test. */
 /* One step of the run; an error fails the test. */
 static void advance(cf_sim *sim)
 {
@@ -100,6 +99,7 @@ static void advance(cf_sim *sim)
         fail_msg("run: %s", err.msg);
 }
 
+/* Advance sim to the scene's duration; a failed step fails the test. */
 static void run_to_end(cf_sim *sim)
 {
     while (!cf_sim_done(sim))
@@ -147,7 +147,6 @@ static void test_momentum_across_fracture_mode_contact(void **state)
     cf_world_ledger(cf_sim_world(sim), &l0);
     double P0 = l0.momentum[0], pushed = 0, worst = 0;
     int fracture_steps = 0;
-    cf_error err = {0};
     while (!cf_sim_done(sim)) {
         double before = anvil_momentum(sim);
         advance(sim);
@@ -415,7 +414,6 @@ static void test_reentry_keeps_the_family_tree(void **state)
     for (int i = 0; i < CAP; i++)
         parent[i] = -2;
     int reentered = 0;
-    cf_error err = {0};
     while (!cf_sim_done(sim)) {
         advance(sim);
         int n = cf_world_fragments(cf_sim_world(sim), fs, CAP);
@@ -466,7 +464,6 @@ static void test_debris_stays_rigid_and_conserves(void **state)
     const cf_world *w = cf_sim_world(sim);
     double mass0 = w->frag[0].mass;
     int debris_in_fracture = 0;
-    cf_error err = {0};
     while (!cf_sim_done(sim)) {
         advance(sim);
         for (int i = 0; i < w->n_frag; i++)
@@ -659,7 +656,6 @@ static void test_handoff_clears_obstacle_overlap(void **state)
     (void)state;
     cf_world_def sc;
     cf_sim *sim = make_sim(overlap_scene, &sc);
-    cf_error err = {0};
     double ke_max = 0;
     int entered = 0;
     while (!cf_sim_done(sim)) {
@@ -701,7 +697,6 @@ static void test_no_return_while_driving_in(void **state)
     (void)state;
     cf_world_def sc;
     cf_sim *sim = make_sim(chatter_scene, &sc);
-    cf_error err = {0};
     int entries = 0, was = 0;
     while (!cf_sim_done(sim)) {
         advance(sim);
@@ -746,7 +741,6 @@ static void test_resting_body_stays_rigid(void **state)
     (void)state;
     cf_world_def sc;
     cf_sim *sim = make_sim(resting_scene, &sc);
-    cf_error err = {0};
     int entries = 0, was = 0, after_rest = 0, handoffs_at_rest = -1;
     double rest_time = -1;
     while (!cf_sim_done(sim)) {
@@ -798,7 +792,6 @@ static void test_handback_in_flight_stays_rigid(void **state)
     (void)state;
     cf_world_def sc;
     cf_sim *sim = make_sim(cube_drop_scene, &sc);
-    cf_error err = {0};
     int entries = 0, was = 0;
     double t_back = -1, v_back = 0, worst = 0;
     while (!cf_sim_done(sim)) {
