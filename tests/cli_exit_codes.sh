@@ -20,6 +20,10 @@ expect 0 "--version" "$exe" --version
 expect 0 "a tiny run" "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q
 expect 1 "no command" "$exe"
 expect 1 "unknown option" "$exe" run --bogus "$tmp/drop.lua"
+expect 1 "unknown command" "$exe" rnu "$tmp/drop.lua"
+# One line that names the word and the nearest command, not the usage.
+[ "$(wc -l <"$tmp/log")" -eq 1 ] && grep -q "unknown command 'rnu'; did you mean 'run'" "$tmp/log" ||
+    { echo "FAIL  the unknown command's message"; fails=$((fails + 1)); }
 expect 0 "bench --scene: the cost of fracture mode" "$exe" bench --scene "$tmp/drop.lua" \
     -m "$meshes" --set duration=0.001
 expect 1 "bench --fracture-ms that is no number" "$exe" bench --scene "$tmp/drop.lua" \
@@ -29,6 +33,11 @@ expect 2 "bench --scene with a bad value" "$exe" bench --scene "$tmp/bad.lua" -m
 expect 2 "scene value out of range" "$exe" run "$tmp/bad.lua" --mesh-dir "$meshes"
 expect 2 "missing scene file" "$exe" run "$tmp/none.lua"
 expect 2 "open surface" "$exe" mesh "$tmp/open.obj" -o "$tmp/m"
+# A closed surface with a stray vertex: refused before tetgen, naming it.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e10\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' >"$tmp/far.obj"
+expect 2 "a vertex far out" "$exe" mesh "$tmp/far.obj" -o "$tmp/far"
+grep -q 'vertex 3 (0-based) at (0, 0, 1e+10)' "$tmp/log" ||
+    { echo "FAIL  the far vertex is not named"; fails=$((fails + 1)); }
 expect 3 "divergence (dt far above the CFL step, no PBD iterations to hold it)" \
     "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q --set bodies[1].position='{0,0,0.78}' --set bodies[1].velocity='{0,0,-3}' \
     --set material.E=1e9 --set solver.dt_fracture=1e-3 --set solver.dt_rigid=1e-3 \
@@ -40,6 +49,13 @@ expect 1 "tools/check_physics.py on the diverged run's file" \
 grep -q 'FAIL  complete' "$tmp/log" || { echo "FAIL  no failed 'complete' check"; fails=$((fails + 1)); }
 expect 4 "output under a regular file" "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q \
     -o "$tmp/file/x.h5"
+mkdir "$tmp/dir"
+expect 4 "output path that is a directory" "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q \
+    -o "$tmp/dir"
+# --force cannot write over a directory: the advice is a file in it.
+grep -q "it is a directory (give a file in it, e.g. -o $tmp/dir/tiny.h5)" "$tmp/log" &&
+    ! grep -q -- --force "$tmp/log" ||
+    { echo "FAIL  the directory output's advice"; fails=$((fails + 1)); }
 expect 5 "tetgen missing" env COHFRAC_TETGEN=/nonexistent/tetgen "$exe" mesh \
     /usr/share/glmark2/models/bunny.obj -o "$tmp/b" --target-tets 15000
 [ "$fails" -eq 0 ]

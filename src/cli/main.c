@@ -772,12 +772,61 @@ int main(int argc, char **argv)
     return rc;
 }
 
+/* A subcommand: its name and what runs it. */
+typedef struct {
+    const char *name;
+    int (*run)(int, char **);
+} cli_command;
+
+/* Edit distance between two short words (insertions, deletions and
+ * substitutions), for the suggestion after an unknown command. */
+static int edit_distance(const char *a, const char *b)
+{
+    enum { MAX = 32 };
+    size_t na = strlen(a), nb = strlen(b);
+    if (na >= MAX || nb >= MAX)
+        return MAX;
+    int row[MAX + 1];
+    for (size_t j = 0; j <= nb; j++)
+        row[j] = (int)j;
+    for (size_t i = 1; i <= na; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= nb; j++) {
+            int up = row[j], best = diag + (a[i - 1] != b[j - 1]);
+            best = up + 1 < best ? up + 1 : best;
+            best = row[j - 1] + 1 < best ? row[j - 1] + 1 : best;
+            diag = up, row[j] = best;
+        }
+    }
+    return row[nb];
+}
+
+/* One line for a word that is no command: it, the nearest command when one
+ * is near (at most two edits, or a prefix), and where the usage is. */
+static int unknown_command(const char *word, const cli_command *table, size_t n)
+{
+    const char *near = NULL;
+    int best = 3;
+    for (size_t i = 0; i < n; i++) {
+        int d = edit_distance(word, table[i].name);
+        if (*word && !strncmp(table[i].name, word, strlen(word)))
+            d = 1; /* a prefix of the command */
+        if (d < best)
+            best = d, near = table[i].name;
+    }
+    if (near)
+        fprintf(stderr, "cohfrac: unknown command '%s'; did you mean '%s'? (cohfrac --help lists "
+                        "the commands)\n", word, near);
+    else
+        fprintf(stderr, "cohfrac: unknown command '%s' (cohfrac --help lists the commands)\n",
+                word);
+    return cf_status_exit_code(CF_ERR_USAGE);
+}
+
 static int dispatch(int argc, char **argv)
 {
-    static const struct {
-        const char *name;
-        int (*run)(int, char **);
-    } table[] = {{"run", cmd_run},         {"compare", cmd_compare},     {"mesh", cmd_mesh},
+    static const cli_command table[] = {{"run", cmd_run},         {"compare", cmd_compare},     {"mesh", cmd_mesh},
                  {"study", cmd_study},     {"stability", cmd_stability}, {"bench", cmd_bench},
                  {"render", cmd_render},   {"export", cmd_export}};
     if (argc < 2)
@@ -809,5 +858,5 @@ static int dispatch(int argc, char **argv)
             cf_mpi_finish();
         return rc;
     }
-    return usage_error("unknown command");
+    return unknown_command(argv[1], table, sizeof table / sizeof table[0]);
 }

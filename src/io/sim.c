@@ -11,6 +11,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* A triangle's three node indices, ascending (a face seen from either side). */
@@ -311,6 +312,13 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
     /* The file first, with the scene in it: a run stopped during mesh
      * preparation or convex decomposition (minutes on a large mesh) still
      * leaves a readable file that says what was run. */
+    struct stat out_stat;
+    if (st == CF_OK && def->output.file[0] && stat(def->output.file, &out_stat) == 0 &&
+        S_ISDIR(out_stat.st_mode))
+        st = cf_error_set(err, CF_ERR_OUTPUT,
+                          "cannot write the output to %s: it is a directory (give a file "
+                          "in it, e.g. -o %s/%s.h5)",
+                          def->output.file, def->output.file, def->name);
     if (st == CF_OK && def->output.file[0] && !opt->force &&
         access(def->output.file, F_OK) == 0 && !cf_h5_is_output(def->output.file))
         st = cf_error_set(err, CF_ERR_OUTPUT,

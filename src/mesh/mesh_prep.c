@@ -301,6 +301,75 @@ static cf_status check_intersections(const cf_surface *s, const char *what, int 
                         what, list);
 }
 
+static int by_double(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* The widest span of a surface that tetgen meshes in double precision,
+ * against its short edges: beyond it a stray vertex (one at 1e10 in a file
+ * of metres) has stretched the box, and tetgen's predicates lose the small
+ * features or tetgen crashes. */
+#define CF_SURFACE_SPAN_RATIO 1e7
+
+/* Refuses, naming the vertex, a surface whose bounding box is more than
+ * CF_SURFACE_SPAN_RATIO times its short edges (the 10th percentile of the
+ * edge lengths, so that a few degenerate edges of a scan do not count). */
+static cf_status check_span(const cf_surface *s, const char *what, cf_error *err)
+{
+    int ne = 3 * s->n_tris;
+    double *len = malloc((size_t)(ne > 0 ? ne : 1) * sizeof *len);
+    if (!len)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    for (int t = 0; t < s->n_tris; t++)
+        for (int k = 0; k < 3; k++) {
+            const double *a = &s->v[3 * s->tri[3 * t + k]], *b = &s->v[3 * s->tri[3 * t + (k + 1) % 3]];
+            len[3 * t + k] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                                  (a[2] - b[2]) * (a[2] - b[2]));
+        }
+    qsort(len, (size_t)ne, sizeof *len, by_double);
+    double edge = ne > 0 ? len[ne / 10] : 0;
+    free(len);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < s->n_verts; i++)
+        for (int k = 0; k < 3; k++)
+            lo[k] = fmin(lo[k], s->v[3 * i + k]), hi[k] = fmax(hi[k], s->v[3 * i + k]);
+    double span = 0;
+    for (int k = 0; k < 3; k++)
+        span = fmax(span, hi[k] - lo[k]);
+    if (!(span <= CF_SURFACE_SPAN_RATIO * edge) || !isfinite(span)) {
+        /* The vertex farthest from the median point names the likely stray
+         * (the box's centre would sit halfway to it). */
+        double c[3], *x = malloc((size_t)s->n_verts * sizeof *x);
+        if (!x)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+        for (int k = 0; k < 3; k++) {
+            for (int i = 0; i < s->n_verts; i++)
+                x[i] = s->v[3 * i + k];
+            qsort(x, (size_t)s->n_verts, sizeof *x, by_double);
+            c[k] = x[s->n_verts / 2];
+        }
+        free(x);
+        int far = 0;
+        double best = -1;
+        for (int i = 0; i < s->n_verts; i++) {
+            double d = 0;
+            for (int k = 0; k < 3; k++)
+                d = fmax(d, fabs(s->v[3 * i + k] - c[k]));
+            if (d > best)
+                best = d, far = i;
+        }
+        const double *p = &s->v[3 * far];
+        return cf_error_set(err, CF_ERR_MESH_PARSE,
+                            "%s spans %.3g (file units) but its short edges are %.3g long, "
+                            "more than %.0e times shorter: vertex %d (0-based) at (%.6g, %.6g, "
+                            "%.6g) is the farthest out. Move or remove stray vertices, then retry",
+                            what, span, edge, CF_SURFACE_SPAN_RATIO, far, p[0], p[1], p[2]);
+    }
+    return CF_OK;
+}
+
 /* Load, repair, close-check and orient the input surface. */
 static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, cf_error *err)
 {
@@ -311,6 +380,8 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, c
     if (v)
         fprintf(stderr, "cohfrac mesh: %s: %d vertices, %d triangles\n", o->input, s->n_verts,
                 s->n_tris);
+    if ((st = check_span(s, o->input, err)) != CF_OK)
+        return st;
     int pairs[2 * 64];
     int n = cf_surface_self_intersections(s, pairs, 64);
     if (n < 0)
