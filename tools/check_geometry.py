@@ -14,7 +14,9 @@ For every fragment alive at the end:
     mesh's own boundary;
 and the posed surfaces at the last frame lie in the box the run's
 parameters allow (above any floor plane, less a tolerance).  Also: every
-observable's value has a unit attribute or is a count.
+observable's value has a unit attribute or is a count, and every unit in
+the file is spelled one way, UDUNITS style as H5MD asks ("m s-1", "kg m2":
+powers as trailing integers, no "/" or "^").
 
 Exit status 0 when everything holds, 1 otherwise (each failure printed).
 """
@@ -80,6 +82,14 @@ def main(path):
     for name, s in run.observables.items():
         if not s.unit and name not in COUNTS:
             fails.append(f"/observables/{name} has no unit attribute")
+    units = []
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, o: units.append((name, o.attrs["unit"]))
+                     if "unit" in o.attrs else None)
+    for name, u in units:
+        u = u.decode() if isinstance(u, bytes) else str(u)
+        if "/" in u or "^" in u or "*" in u:
+            fails.append(f"/{name}: unit '{u}' is not UDUNITS style (write 'm s-1', 'kg m2')")
     print(f"{path}: {len(alive)} fragments alive, surfaces closed and outward, enclosed "
           f"volume = tet volume within {worst_vol:.2g} (relative), {n_crack} crack faces, "
           f"lowest posed vertex z = {zmin:.4g} m")

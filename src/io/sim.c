@@ -239,7 +239,7 @@ static cf_status write_obstacles(cf_sim *sim, cf_error *err)
         char name[64];
         snprintf(name, sizeof name, "obstacle_%s", names[q]);
         st = cf_h5_write_parameter(sim->h5, name, &vec[3 * q * n], 3 * n,
-                                   q == 1 ? NULL : q == 4 ? "m/s" : "m", err);
+                                   q == 1 ? NULL : q == 4 ? "m s-1" : "m", err);
     }
     free(buf);
     return st;
@@ -259,9 +259,9 @@ static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
              {"initial_upper", b.upper, 3, "m"},
              {"total_mass", &b.mass, 1, "kg"},
              {"initial_energy", &b.energy, 1, "J"},
-             {"max_initial_speed", &b.max_speed, 1, "m/s"},
-             {"max_obstacle_speed", &b.max_obstacle_speed, 1, "m/s"},
-             {"release_speed", &b.release_speed, 1, "m/s"}};
+             {"max_initial_speed", &b.max_speed, 1, "m s-1"},
+             {"max_obstacle_speed", &b.max_obstacle_speed, 1, "m s-1"},
+             {"release_speed", &b.release_speed, 1, "m s-1"}};
     cf_status st = CF_OK;
     for (size_t i = 0; i < sizeof p / sizeof p[0] && st == CF_OK; i++)
         st = cf_h5_write_parameter(sim->h5, p[i].name, p[i].v, p[i].n, p[i].unit, err);
