@@ -14,7 +14,8 @@ For every fragment alive at the end:
     mesh's own boundary;
 and the posed surfaces at the last frame lie in the box the run's
 parameters allow (above any floor plane, less a tolerance).  Also: every
-observable's value has a unit attribute or is a count, and every unit in
+fragment has at least one tet and a positive mass, every observable's
+value has a unit attribute or is a count, and every unit in
 the file is spelled one way, UDUNITS style as H5MD asks ("m s-1", "kg m2":
 powers as trailing integers, no "/" or "^").
 
@@ -39,6 +40,11 @@ def main(path):
     fails = []
     with h5py.File(path, "r") as f:
         tet_frag = f["mesh/tet_fragment/value"][-1]
+        n_tets, mass = f["fragments/n_tets"][:], f["fragments/mass"][:]
+    # Every fragment ever made is made of tets and has their mass (a record
+    # with no tets would be a glTF node with no mesh, a body of no shape).
+    for i in np.flatnonzero((n_tets < 1) | ~(mass > 0)):
+        fails.append(f"fragment {i}: {n_tets[i]} tets, mass {mass[i]:.4g} kg")
     X, tets = run.rest_nodes, run.rest_tets
     # The rest mesh's own boundary faces, as sorted triples.
     faces = np.concatenate([tets[:, [0, 1, 2]], tets[:, [0, 1, 3]], tets[:, [0, 2, 3]],
