@@ -3,7 +3,11 @@
 # set up, build, run every test.  `make bench`: time the fracture-mode step.
 BUILD     ?= build
 BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
-MESHES    := $(BUILD)/meshes
+# Prepared meshes: the program's default mesh directory (the XDG cache,
+# include/cohfrac/surface.h cf_default_mesh_dir), so that `cohfrac run`
+# finds them from anywhere without --mesh-dir.
+XDG_CACHE := $(if $(filter /%,$(XDG_CACHE_HOME)),$(XDG_CACHE_HOME),$(HOME)/.cache)
+MESHES    ?= $(or $(COHFRAC_MESH_DIR),$(XDG_CACHE)/cohfrac/meshes)
 JOBS      ?= 2
 
 .PHONY: all deps build build-fuzz meshes run test test-sanitize fuzz bench bench-scaling install clean

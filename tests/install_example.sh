@@ -28,3 +28,30 @@ echo "find_package build: $(grep 'fragments at' "$tmp/cmake.txt")"
 grep -q 'fragments at t = 0.60 s' "$tmp/pkgconfig.txt"
 cmp "$tmp/pkgconfig.txt" "$tmp/cmake.txt"
 echo "both builds ran and printed the same fragments"
+
+# The installed program, run from /: `run` (a sphere meshed by gmsh and
+# cached in the XDG cache, not the build tree), then `render` and `export` with the helpers
+# installed beside it (a marker in the installed copy shows which ran).
+export XDG_CACHE_HOME="$tmp/cache"
+unset COHFRAC_MESH_DIR
+py="$prefix/share/cohfrac/python"
+for f in render.py cohfrac_h5.py; do
+    sed -i '/^if __name__ == "__main__":/i print("installed helper", file=__import__("sys").stderr)' "$py/$f"
+done
+cp "$src/tests/data/box_break.lua" "$tmp/box.lua"
+cd /
+"$prefix/bin/cohfrac" run "$tmp/box.lua" -q --set duration=0.05 -o "$tmp/box.h5" \
+    --set 'bodies[1].mesh={type="sphere", radius=0.1, mesh_size=0.05}' > "$tmp/run.txt"
+ls "$tmp/cache/cohfrac/meshes/"sphere_*.msh >/dev/null 2>&1 ||
+    { echo "FAIL: the sphere was not meshed in the XDG cache"; exit 1; }
+"$prefix/bin/cohfrac" export "$tmp/box.h5" --format gltf -o "$tmp/box.glb"
+"$prefix/bin/cohfrac" export "$tmp/box.h5" --format pvd -o "$tmp/pvd" 2> "$tmp/pvd.txt"
+grep -q 'installed helper' "$tmp/pvd.txt" || { echo "FAIL: export pvd did not run the installed helper"; exit 1; }
+[ -f "$tmp/pvd/box_break.pvd" ] && [ -s "$tmp/box.glb" ]
+echo "installed run from /: $(grep -m1 '^fragments' "$tmp/run.txt"); export gltf and pvd written"
+if command -v ffmpeg >/dev/null; then
+    "$prefix/bin/cohfrac" render "$tmp/box.h5" --fps 10 --size 320x240 -o "$tmp/movie" 2> "$tmp/render.txt"
+    grep -q 'installed helper' "$tmp/render.txt" || { echo "FAIL: render did not run the installed helper"; exit 1; }
+    [ -s "$tmp/movie/box_break.mp4" ]
+    echo "installed render from /: a $(du -k "$tmp/movie/box_break.mp4" | cut -f1) kB MP4"
+fi

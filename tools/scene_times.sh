@@ -4,7 +4,8 @@
 # simulated time, wall time, fragments at the end, and how the run ended.
 #
 # usage: [SCENE_TIMEOUT=S] tools/scene_times.sh [COHFRAC_EXE [MESH_DIR [SCENES_DIR]]]
-#   defaults: build/cohfrac, build/meshes (or $COHFRAC_MESH_DIR), scenes/
+#   defaults: build/cohfrac, the program's mesh directory ($COHFRAC_MESH_DIR or
+#   ~/.cache/cohfrac/meshes, as `make run` prepares them), scenes/
 #   SCENE_TIMEOUT: stop a run after S seconds of wall time (default 0: no
 #   limit); its row then gives how far it got, read from its HDF5 file
 #   (needs /usr/bin/python3 with h5py, as tools/check_run.py).
@@ -20,7 +21,7 @@
 set -u
 here=$(dirname "$0")
 exe=${1:-$here/../build/cohfrac}
-meshes=${2:-${COHFRAC_MESH_DIR:-$here/../build/meshes}}
+meshes=${2:-${COHFRAC_MESH_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/cohfrac/meshes}}
 scenes=${3:-$here/../scenes}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

@@ -168,8 +168,8 @@ typedef struct cf_world_meshes {
 
 /* Make what `def` needs and point def->bodies[i].tet_mesh and the mesh
  * obstacles' vertices/triangles at it (those already set are kept).
- * `mesh_dir`: where primitives are meshed and cached (NULL: the build's
- * mesh directory, cf_default_mesh_dir).  Errors: those of cf_mesh_load,
+ * `mesh_dir`: where primitives are meshed and cached (NULL: the user's
+ * mesh cache, cf_default_mesh_dir).  Errors: those of cf_mesh_load,
  * cf_mesh_primitive, cf_mesh_hollow (the message names the body) and
  * cf_surface_load; CF_ERR_SCENE_VALUE for a surface with no triangle.
  * On error `out` is left empty and `def` unchanged. */
@@ -178,9 +178,12 @@ cf_status cf_world_meshes_load(cf_world_def *def, const char *mesh_dir, cf_world
 void cf_world_meshes_free(cf_world_meshes *m);
 
 /* Where prepared meshes and meshed primitives live when no directory is
- * given: $COHFRAC_MESH_DIR, else the build's mesh directory (an absolute
- * path fixed at build time), so that it does not depend on the working
- * directory. */
+ * given, following the XDG base directory convention for caches:
+ * $COHFRAC_MESH_DIR, else $XDG_CACHE_HOME/cohfrac/meshes (an absolute
+ * XDG_CACHE_HOME), else $HOME/.cache/cohfrac/meshes, else
+ * /tmp/cohfrac-meshes.  Never the working directory or the build tree, so
+ * an installed program finds the same meshes from anywhere.  The string
+ * lives until the program ends. */
 const char *cf_default_mesh_dir(void);
 
 #endif

@@ -42,7 +42,7 @@ static const struct {
      "                                      SIGTERM: the output is closed, exit 130 or 143)\n"
      "      -s, --set KEY.PATH=VALUE        override a scene key (Lua value), repeatable\n"
      "      -m, --mesh-dir DIR              where prepared meshes live (default: $COHFRAC_MESH_DIR,\n"
-     "                                      else the build's mesh directory)\n"
+     "                                      else ~/.cache/cohfrac/meshes)\n"
      "      -o, --output FILE               output file, relative to the working directory\n"
      "                                      (default: the scene's output.file, relative to the\n"
      "                                      scene file: out/<name>.h5 beside the scene)\n"

@@ -40,25 +40,37 @@ cf_status cf_out_close(cf_outfile *o, cf_error *err)
     return CF_OK;
 }
 
-/* The script: the given path, ./tools/, or ../tools/ next to the executable. */
+/* The Python helpers the program runs, where the build put them: the
+ * source tree's tools/ (build tree), and the install's
+ * share/cohfrac/python relative to the executable's bin/. */
+#ifndef COHFRAC_TOOLS_DIR
+#define COHFRAC_TOOLS_DIR "tools"
+#endif
+#ifndef COHFRAC_INSTALLED_PYTHON
+#define COHFRAC_INSTALLED_PYTHON "../share/cohfrac/python"
+#endif
+
+/* The script: the given path; else next to the executable as installed
+ * (bin/../share/cohfrac/python); else the source tree's tools/ the program
+ * was built from; so it is found from any working directory. */
 static int find_script(const char *script, const char *given, char *out, size_t n)
 {
     if (given) {
         snprintf(out, n, "%s", given);
         return access(out, R_OK) == 0;
     }
-    snprintf(out, n, "tools/%s", script);
-    if (access(out, R_OK) == 0)
-        return 1;
     char exe[900];
     ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (len <= 0)
-        return 0;
-    exe[len] = 0;
-    char *slash = strrchr(exe, '/');
-    if (slash)
-        *slash = 0;
-    snprintf(out, n, "%s/../tools/%s", exe, script);
+    if (len > 0) {
+        exe[len] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash)
+            *slash = 0;
+        snprintf(out, n, "%s/%s/%s", exe, COHFRAC_INSTALLED_PYTHON, script);
+        if (access(out, R_OK) == 0)
+            return 1;
+    }
+    snprintf(out, n, "%s/%s", COHFRAC_TOOLS_DIR, script);
     return access(out, R_OK) == 0;
 }
 
@@ -67,8 +79,9 @@ int cf_report_plot(const char *script, const char *script_path, const char *cons
 {
     char path[1024];
     if (!find_script(script, script_path, path, sizeof path)) {
-        fprintf(stderr, "cohfrac: warning: tools/%s not found: no plot (%s are written)\n",
-                script, others);
+        fprintf(stderr, "cohfrac: warning: %s not found (looked beside the program in %s and "
+                        "in %s): no plot (%s are written)\n",
+                script, COHFRAC_INSTALLED_PYTHON, COHFRAC_TOOLS_DIR, others);
         return 0;
     }
     const char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";

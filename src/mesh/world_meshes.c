@@ -4,17 +4,24 @@
 #include "cohfrac/mesh.h"
 #include "cohfrac/surface.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#ifndef COHFRAC_MESH_DIR
-#define COHFRAC_MESH_DIR "build/meshes"
-#endif
-
 const char *cf_default_mesh_dir(void)
 {
+    static char dir[4096];
     const char *env = getenv("COHFRAC_MESH_DIR");
-    return env && *env ? env : COHFRAC_MESH_DIR;
+    if (env && *env)
+        return env;
+    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    if (xdg && xdg[0] == '/') /* the spec ignores a relative XDG_CACHE_HOME */
+        snprintf(dir, sizeof dir, "%s/cohfrac/meshes", xdg);
+    else if (home && home[0] == '/')
+        snprintf(dir, sizeof dir, "%s/.cache/cohfrac/meshes", home);
+    else
+        snprintf(dir, sizeof dir, "/tmp/cohfrac-meshes");
+    return dir;
 }
 
 static cf_status body_mesh(const cf_body_def *bd, int b, const char *mesh_dir, cf_mesh *m,
