@@ -235,8 +235,11 @@ static int cmd_mesh(int argc, char **argv)
         switch (c) {
         case 'o': o.output = optarg; break;
         case 't':
-            if ((o.target_tets = count_arg("--target-tets", optarg, 4)) < 0)
+            if ((o.target_tets = count_arg("--target-tets", optarg, 0)) < 0)
                 return cf_status_exit_code(CF_ERR_USAGE);
+            if (o.target_tets > 0 && o.target_tets < 4)
+                return usage_error("--target-tets needs 0 (tetgen's own choice) or a whole "
+                                   "number from 4 to 1000000");
             break;
         case 'L':
             if (real_arg("--time-limit", optarg, 0, &o.time_limit))

@@ -57,7 +57,7 @@
 #define TOL 0.05
 #define MAX_A_RUNS 8
 #define MAX_SUBDIVISIONS 3 /* 64 x the triangles at most */
-#define MISS_ALLOWED 0.25  /* the target met within 25 %, or an error */
+#define MISS_ALLOWED 0.25  /* the target met within 25 %, or a warning */
 #define PEEL_FRACTION 0.25 /* boundary caps thinner than this x the median h are peeled */
 
 static char *str_cat(const char *a, const char *b)
@@ -509,6 +509,26 @@ static cf_status tetgen_trial(const prep *p, const char *opts, trial *t, cf_erro
 
 static double miss(int n, int target) { return fabs(log((double)n / (double)target)); }
 
+/* Whether the size search may go on after a tetgen trial that failed with
+ * `st`: it crashed or failed on this surface and options (not a stop or
+ * the time limit, which end the search) while a valid mesh is in hand,
+ * which is then kept.  Says so on stderr, with tetgen's reason. */
+static int survive_failed_trial(cf_status st, const prep *p, int have_mesh, cf_error *err)
+{
+    if (st != CF_ERR_EXTERNAL || !have_mesh || cf_wall_time() >= p->deadline)
+        return 0;
+    char first[200];
+    snprintf(first, sizeof first, "%.199s", err ? err->msg : "");
+    char *end = strstr(first, ". "); /* its first sentence: what happened */
+    if (end)
+        *end = 0;
+    if ((end = strchr(first, '\n')) != NULL)
+        *end = 0;
+    fprintf(stderr, "cohfrac mesh: warning: a tetgen trial failed (%s); the size search goes on "
+                    "with the closest valid mesh so far\n", first);
+    return 1;
+}
+
 /* Surface choice and tetgen runs for target_tets > 0; see the top comment.
  * `s` is the clean full surface; on success `best` holds the mesh and
  * `used` the surface it was made from (a decimated copy or `s` itself). */
@@ -529,19 +549,44 @@ static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_su
         /* Clearly too fine: decimate right away from the estimate. */
         n_tris = (int)(0.9 * target / TETS_PER_TRI) & ~1;
     }
+    trial prev = {{0}, {0}}; /* the last valid trial, kept if the next one fails */
+    cf_surface prev_dec = {0};
+    const cf_surface *prev_cur = NULL;
     for (int round = 0; round < 4; round++) {
-        cf_mesh_free(&t.m);
+        if (t.m.n_tets > 0) {
+            cf_mesh_free(&prev.m);
+            cf_surface_free(&prev_dec);
+            prev = t, t = (trial){{0}, {0}};
+            prev_cur = cur == s ? s : &prev_dec;
+            if (cur != s && (st = copy_surface(cur, &prev_dec, err)) != CF_OK)
+                break;
+        }
         if (n_tris < s->n_tris) {
             cf_surface_free(dec);
             if ((st = coarsen(s, n_tris < 8 ? 8 : n_tris, dec, verbose, err)) != CF_OK)
-                return st;
+                break;
             cur = dec;
         } else {
             cur = s;
         }
-        if ((st = cf_surface_write_off(cur, off, err)) != CF_OK ||
-            (st = tetgen_trial(p, BASE_OPTS "F", &t, err)) != CF_OK)
-            return st;
+        if ((st = cf_surface_write_off(cur, off, err)) != CF_OK)
+            break;
+        if ((st = tetgen_trial(p, BASE_OPTS "F", &t, err)) != CF_OK) {
+            if (!survive_failed_trial(st, p, prev.m.n_tets > 0, err))
+                break;
+            st = CF_OK; /* back to the previous trial and its surface */
+            cf_mesh_free(&t.m);
+            t = prev, prev = (trial){{0}, {0}};
+            if (prev_cur == s) {
+                cur = s;
+            } else {
+                cf_surface_free(dec);
+                *dec = prev_dec, prev_dec = (cf_surface){0};
+                cur = dec;
+            }
+            n = t.m.n_tets;
+            break;
+        }
         n = t.m.n_tets;
         if (n <= (1 + TOL) * target || cur->n_tris <= 8)
             break;
@@ -549,6 +594,12 @@ static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_su
             break; /* decimation stalled: cannot get coarser */
         /* tets grow about linearly with surface triangles at fixed q */
         n_tris = (int)((double)cur->n_tris * 0.9 * target / n) & ~1;
+    }
+    cf_mesh_free(&prev.m);
+    cf_surface_free(&prev_dec);
+    if (st != CF_OK) {
+        cf_mesh_free(&t.m);
+        return st;
     }
     *used = cur;
     *best = t;
@@ -567,7 +618,14 @@ static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_su
         if ((st = cf_surface_write_off(&fine, off, err)) != CF_OK ||
             (st = tetgen_trial(p, BASE_OPTS "F", &f, err)) != CF_OK) {
             cf_surface_free(&fine);
-            return st;
+            cf_mesh_free(&f.m);
+            if (!survive_failed_trial(st, p, 1, err))
+                return st;
+            /* the closest so far is `best`, from `cur`: tetgen's surface
+             * file goes back to it for the fill below */
+            if ((st = cf_surface_write_off(cur, off, err)) != CF_OK)
+                return st;
+            break;
         }
         if (verbose)
             fprintf(stderr, "  subdivided the surface to %d triangles\n", fine.n_tris);
@@ -603,6 +661,9 @@ static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_su
         a = strtod(strchr(opts, 'a') + 1, NULL); /* exactly the value tetgen gets */
         trial u = {{0}, {0}};
         if ((st = tetgen_trial(p, opts, &u, err)) != CF_OK) {
+            cf_mesh_free(&u.m);
+            if (survive_failed_trial(st, p, 1, err))
+                break; /* `best` stays the closest */
             cf_mesh_free(&best->m);
             return st;
         }
@@ -735,20 +796,16 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
         goto out;
     }
     double off_by = o->target_tets > 0 ? (double)best.m.n_tets / o->target_tets - 1 : 0;
-    if (fabs(off_by) > MISS_ALLOWED) {
-        st = cf_error_set(err, CF_ERR_USAGE,
-                          "--target-tets %d cannot be met within %.0f%% for %s: the closest "
-                          "tetgen came is %d tets (%+.0f%%; %s).  Ask for about %d tets, or 0 "
-                          "for tetgen's own choice",
-                          o->target_tets, 100 * MISS_ALLOWED, o->input, best.m.n_tets,
-                          100 * off_by,
-                          off_by > 0 ? "thin parts need smaller tets than that at tetgen's "
-                                       "quality bound"
-                                     : "refining further needs more points than --target-tets "
-                                       "allows tetgen to add",
-                          best.m.n_tets);
-        goto out;
-    }
+    if (fabs(off_by) > MISS_ALLOWED) /* the closest valid mesh is kept, and said to be off */
+        fprintf(stderr,
+                "cohfrac mesh: warning: --target-tets %d missed by more than %.0f%% for %s: "
+                "kept the closest mesh tetgen made, %d tets (%+.0f%%; %s).  Ask for about %d "
+                "to make it again without this warning, or 0 for tetgen's own choice\n",
+                o->target_tets, 100 * MISS_ALLOWED, o->input, best.m.n_tets, 100 * off_by,
+                off_by > 0 ? "thin parts need smaller tets than that at tetgen's quality bound"
+                           : "refining further needs more points than --target-tets allows "
+                             "tetgen to add",
+                best.m.n_tets);
 
     /* Orientation: flip what tetgen wrote the other way round, then insist
      * on positive, non-degenerate tets. */
