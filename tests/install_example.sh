@@ -55,3 +55,12 @@ if command -v ffmpeg >/dev/null; then
     [ -s "$tmp/movie/box_break.mp4" ]
     echo "installed render from /: a $(du -k "$tmp/movie/box_break.mp4" | cut -f1) kB MP4"
 fi
+
+# The Python package, installed where Debian's python3 looks under the
+# prefix (lib/python3.X/dist-packages), loads the installed library.
+site=$(find "$prefix/lib" -path '*dist-packages/cohfrac/__init__.py' | head -1)
+[ -n "$site" ] || { echo "FAIL: the Python package is not installed"; exit 1; }
+lib=$(env -u COHFRAC_LIB PYTHONPATH="$(dirname "$(dirname "$site")")" /usr/bin/python3 -c \
+    'import cohfrac; print(cohfrac.library()._name)')
+case "$lib" in "$prefix"/*) ;; *) echo "FAIL: import cohfrac loaded $lib, not the install's"; exit 1 ;; esac
+echo "import cohfrac from the install: $lib"

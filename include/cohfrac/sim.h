@@ -42,6 +42,15 @@ typedef struct cf_run_options {
 cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
                         cf_error *err);
 
+/* The same from a scene script held in memory (cf_scene_load_text: `name`
+ * stands for the file in messages, `overrides` are "key.path=value"
+ * strings): what a binding that builds scenes from its own data calls
+ * (python/cohfrac).  Prepared meshes are looked up in opt->mesh_dir.
+ * Errors: those of cf_scene_load_text and cf_sim_create. */
+cf_status cf_sim_create_text(const char *name, const char *text, const char *const *overrides,
+                             int n_overrides, const cf_run_options *opt, cf_sim **out,
+                             cf_error *err);
+
 /* One rigid step of the world (cf_world_step), its events written and
  * shown, a frame when due.  Errors: those of cf_world_step (the output file
  * then holds every frame written so far), CF_ERR_OUTPUT, CF_ERR_NOMEM. */

@@ -4,6 +4,7 @@
 
 #include "clock.h"
 #include "cohfrac/h5_output.h"
+#include "cohfrac/scene.h"
 #include "cohfrac/surface.h"
 
 #include <dirent.h>
@@ -355,6 +356,21 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
     }
     *out = sim;
     return CF_OK;
+}
+
+cf_status cf_sim_create_text(const char *name, const char *text, const char *const *overrides,
+                             int n_overrides, const cf_run_options *opt, cf_sim **out,
+                             cf_error *err)
+{
+    *out = NULL;
+    const char *mesh_dir = opt && opt->mesh_dir ? opt->mesh_dir : cf_default_mesh_dir();
+    cf_world_def def;
+    cf_status st = cf_scene_load_text(name, text, overrides, n_overrides, mesh_dir, &def, err);
+    if (st != CF_OK)
+        return st;
+    st = cf_sim_create(&def, opt, out, err);
+    cf_scene_free(&def);
+    return st;
 }
 
 void cf_sim_destroy(cf_sim *sim)
