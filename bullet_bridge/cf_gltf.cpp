@@ -86,6 +86,8 @@ extern "C" int cfg_write_glb(const char *path, const cfg_node *nodes, int n_node
         tinygltf::Scene scene;
         tinygltf::Animation anim;
         anim.name = animation ? animation : "animation";
+        // The crack faces' material, shared: the inside of the solid.
+        int crack_material = -1;
         for (int i = 0; i < n_nodes; ++i) {
             const cfg_node &n = nodes[i];
             tinygltf::Material mat;
@@ -95,22 +97,47 @@ extern "C" int cfg_write_glb(const char *path, const cfg_node *nodes, int n_node
             mat.pbrMetallicRoughness.metallicFactor = 0.0;
             mat.pbrMetallicRoughness.roughnessFactor = 0.8;
             m.materials.push_back(mat);
-            tinygltf::Primitive prim;
-            prim.attributes["POSITION"] =
+            int outer_material = static_cast<int>(m.materials.size() - 1);
+            if (n.n_inner > 0 && crack_material < 0) {
+                tinygltf::Material crack;
+                crack.name = "crack";
+                crack.pbrMetallicRoughness.baseColorFactor = {0.85, 0.83, 0.78, 1.0};
+                crack.pbrMetallicRoughness.metallicFactor = 0.0;
+                crack.pbrMetallicRoughness.roughnessFactor = 1.0;
+                m.materials.push_back(crack);
+                crack_material = static_cast<int>(m.materials.size() - 1);
+            }
+            int position =
                 add_accessor(m, n.positions, n.n_vertices, TINYGLTF_TYPE_VEC3,
                              TINYGLTF_COMPONENT_TYPE_FLOAT, 3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
-            prim.indices = add_accessor(m, n.indices, 3 * (size_t)n.n_triangles,
-                                        TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                        1, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
-            prim.material = static_cast<int>(m.materials.size() - 1);
-            prim.mode = TINYGLTF_MODE_TRIANGLES;
             tinygltf::Mesh mesh;
             mesh.name = mat.name;
-            mesh.primitives.push_back(prim);
+            const int parts[2][2] = {{0, n.n_triangles - n.n_inner},
+                                     {n.n_triangles - n.n_inner, n.n_triangles}};
+            for (int k = 0; k < 2; ++k) {
+                int count = parts[k][1] - parts[k][0];
+                if (count <= 0)
+                    continue;
+                tinygltf::Primitive prim;
+                prim.attributes["POSITION"] = position;
+                prim.indices = add_accessor(m, n.indices + 3 * (size_t)parts[k][0],
+                                            3 * (size_t)count, TINYGLTF_TYPE_SCALAR,
+                                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, 1,
+                                            TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
+                prim.material = k == 0 ? outer_material : crack_material;
+                prim.mode = TINYGLTF_MODE_TRIANGLES;
+                mesh.primitives.push_back(prim);
+            }
             m.meshes.push_back(mesh);
             tinygltf::Node node;
             node.name = mat.name;
             node.mesh = static_cast<int>(m.meshes.size() - 1);
+            if (n.n_extras > 0) {
+                tinygltf::Value::Object extras;
+                for (int k = 0; k < n.n_extras; ++k)
+                    extras[n.extra_keys[k]] = tinygltf::Value(n.extra_values[k]);
+                node.extras = tinygltf::Value(extras);
+            }
             if (n.n_keys > 0) { // the rest pose is the first key
                 node.translation = {n.translation[0], n.translation[1], n.translation[2]};
                 node.rotation = {n.rotation[0], n.rotation[1], n.rotation[2], n.rotation[3]};

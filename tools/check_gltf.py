@@ -9,8 +9,10 @@ and checks: one node per fragment that has a surface, each with a mesh;
 one animation with translation, rotation and scale channels per node;
 the largest fragment's last key equals its HDF5 pose at the last frame
 (glTF +y up: cohfrac (x, y, z) is (x, z, -y)); its mesh has the surface's
-triangle count; and a fragment is hidden (scale 0) exactly where it is not
-alive.  Exit status 0 when all hold, 1 otherwise.
+triangle count; a fragment is hidden (scale 0) exactly where it is not
+alive; each node's crack faces are a primitive of the material "crack"
+(as many as the file's crack faces), and its extras hold the fragment's
+record (fragment, mass, parent, birth_time, n_tets; mode 0, 1 or -1).  Exit status 0 when all hold, 1 otherwise.
 """
 import json
 import os
@@ -93,14 +95,43 @@ def main(h5, glb):
         err = np.abs(tr - want).max()
         if err > 1e-5 * max(1.0, np.abs(want).max()):
             fails.append(f"fragment {big}: last key {tr} against the HDF5's {want}")
-        prim = doc["meshes"][nodes[k]["mesh"]]["primitives"][0]
-        ntri = doc["accessors"][prim["indices"]]["count"] // 3
+        prims = doc["meshes"][nodes[k]["mesh"]]["primitives"]
+        ntri = sum(doc["accessors"][p["indices"]]["count"] // 3 for p in prims)
         if ntri != len(run.fragment(big).triangles):
             fails.append(f"fragment {big}: {ntri} triangles in the mesh, "
                          f"{len(run.fragment(big).triangles)} in the file")
+    # Crack faces: a second primitive with the material "crack", holding as
+    # many triangles as the fragment's surface has crack faces.
+    materials = [m.get("name") for m in doc.get("materials", [])]
+    n_inner = 0
+    for i in with_surface:
+        node = byname.get(f"fragment_{i}")
+        if node is None:
+            continue
+        prims = doc["meshes"][nodes[node]["mesh"]]["primitives"]
+        inner = sum(doc["accessors"][p["indices"]]["count"] // 3 for p in prims
+                    if materials[p["material"]] == "crack")
+        want = int(np.count_nonzero(run.fragment(i).crack))
+        if inner != want:
+            fails.append(f"fragment {i}: {inner} triangles with the crack material, {want} "
+                         f"crack faces in the file")
+        n_inner += inner
+        # Extras: the fragment's record, as the HDF5 has it.
+        ex = nodes[node].get("extras", {})
+        rec = {"fragment": i, "mass": masses[i], "parent": run.fragments["parent"][i],
+               "birth_time": run.fragments["birth_time"][i],
+               "n_tets": run.fragments["n_tets"][i]}
+        for key, v in rec.items():
+            if key not in ex or abs(ex[key] - float(v)) > 1e-12 * max(1.0, abs(float(v))):
+                fails.append(f"fragment {i}: extras {key} = {ex.get(key)}, the file has {v}")
+                break
+        if ex.get("mode") not in (0, 1, -1):
+            fails.append(f"fragment {i}: extras mode = {ex.get('mode')}")
+    if k is not None:
         print(f"{glb}: {len(nodes)} nodes, {len(anims)} animation, {checked} fragments' "
               f"channels checked; largest fragment {big} ({masses[big]:.4g} kg) ends at "
-              f"({com[0]:.4f}, {com[1]:.4f}, {com[2]:.4f}) m, glTF key off by {err:.2g} m")
+              f"({com[0]:.4f}, {com[1]:.4f}, {com[2]:.4f}) m, glTF key off by {err:.2g} m; "
+              f"{n_inner} crack faces with the crack material; extras match the file")
     for m in fails:
         print("FAIL:", m)
     return 1 if fails else 0

@@ -107,7 +107,9 @@ static const struct {
      "                                      .vtu of the posed surfaces per frame, a .pvd)\n"
      "      -f, --format gltf|pvd           the format (default gltf: glTF 2.0 binary)\n"
      "      -o, --output PATH               gltf: the file (default OUT minus .h5, .glb);\n"
-     "                                      pvd: the directory (default OUT minus .h5, _pvd)\n"},
+     "                                      pvd: the directory (default OUT minus .h5, _pvd)\n"
+     "          --slow-motion F             gltf: play F times slower than the run (default 1;\n"
+     "                                      100 makes a 2 ms break last 0.2 s)\n"},
     {"bench",
      "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 4.43 m/s)\n"
      "                                      against the memory floor, 1 against N threads\n"
@@ -675,9 +677,11 @@ static int cmd_export(int argc, char **argv)
 {
     static const struct option lo[] = {{"format", required_argument, 0, 'f'},
                                        {"output", required_argument, 0, 'o'},
+                                       {"slow-motion", required_argument, 0, 'S'},
                                        {0, 0, 0, 0}};
     const char *out = NULL;
     int c, pvd = 0;
+    double slow = 1;
     while ((c = getopt_long(argc, argv, "f:o:", lo, NULL)) != -1) {
         switch (c) {
         case 'f':
@@ -686,6 +690,12 @@ static int cmd_export(int argc, char **argv)
                 return usage_error("--format is gltf (glTF 2.0 binary, .glb) or pvd (ParaView)");
             break;
         case 'o': out = optarg; break;
+        case 'S':
+            if (real_arg("--slow-motion", optarg, 0, &slow))
+                return cf_status_exit_code(CF_ERR_USAGE);
+            if (!(slow > 0))
+                return usage_error("--slow-motion needs a factor > 0 (1: real time)");
+            break;
         default: return usage_error("bad option for 'export'");
         }
     }
@@ -706,7 +716,7 @@ static int cmd_export(int argc, char **argv)
                    : cf_status_exit_code(CF_ERR_EXTERNAL);
     }
     cf_error err = {0};
-    if (cf_export_gltf(in, out, &err) != CF_OK)
+    if (cf_export_gltf(in, out, slow, &err) != CF_OK)
         return fail(&err);
     printf("wrote %s\n", out);
     return 0;

@@ -14,14 +14,16 @@
 typedef struct run_data {
     hsize_t T, N, nn, M;             /* frames, fragment columns, rest nodes, triangles */
     int nf;                          /* fragment records */
-    double *time, *pos, *quat, *X, *com_rest;
-    int *id, *tri, *first, *count;
+    double *time, *pos, *quat, *X, *com_rest, *mass, *birth;
+    int *id, *tri, *first, *count, *crack, *parent, *n_tets, *debris, *mode;
 } run_data;
 
 static void run_free(run_data *r)
 {
     free(r->time), free(r->pos), free(r->quat), free(r->X), free(r->com_rest);
     free(r->id), free(r->tri), free(r->first), free(r->count);
+    free(r->mass), free(r->birth), free(r->crack), free(r->parent), free(r->n_tets);
+    free(r->debris), free(r->mode);
 }
 
 static cf_status run_read(const char *path, run_data *r, cf_error *err)
@@ -43,6 +45,15 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
     r->first = cf_h5_read_all(f, "/fragments/surface_first", H5T_NATIVE_INT, 4, &rk, dfs);
     r->count = cf_h5_read_all(f, "/fragments/surface_count", H5T_NATIVE_INT, 4, &rk, dfs);
     r->com_rest = cf_h5_read_all(f, "/fragments/com_rest", H5T_NATIVE_DOUBLE, 8, &rk, dc);
+    /* What the nodes carry besides geometry (absent from older files: left out) */
+    hsize_t dn[3];
+    r->crack = cf_h5_read_all(f, "/surfaces/crack", H5T_NATIVE_INT, 4, &rk, dn);
+    r->mass = cf_h5_read_all(f, "/fragments/mass", H5T_NATIVE_DOUBLE, 8, &rk, dn);
+    r->birth = cf_h5_read_all(f, "/fragments/birth_time", H5T_NATIVE_DOUBLE, 8, &rk, dn);
+    r->parent = cf_h5_read_all(f, "/fragments/parent", H5T_NATIVE_INT, 4, &rk, dn);
+    r->n_tets = cf_h5_read_all(f, "/fragments/n_tets", H5T_NATIVE_INT, 4, &rk, dn);
+    r->debris = cf_h5_read_all(f, "/fragments/debris", H5T_NATIVE_INT, 4, &rk, dn);
+    r->mode = cf_h5_read_all(f, "/particles/fragments/mode/value", H5T_NATIVE_INT, 4, &rk, dn);
     H5Fclose(f);
     if (!r->X || !r->first || !r->count || !r->com_rest || !r->tri)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
@@ -64,8 +75,16 @@ static void to_gltf(const double v[3], float out[3])
     out[0] = (float)v[0], out[1] = (float)v[2], out[2] = (float)-v[1];
 }
 
-/* One fragment's node: its surface in its body frame, its keys. */
-static int make_node(const run_data *r, int i, cfg_node *n, char *name, size_t name_len)
+/* The numbers each node carries in its extras, SI units (docs/output.md). */
+static const char *const EXTRA_KEYS[] = {"fragment", "mass",  "parent", "birth_time",
+                                         "n_tets",   "debris", "mode"};
+enum { N_EXTRAS = sizeof EXTRA_KEYS / sizeof EXTRA_KEYS[0] };
+
+/* One fragment's node: its surface in its body frame (outer triangles,
+ * then crack faces), its extras, its keys at `slow_motion` times the run's
+ * time. */
+static int make_node(const run_data *r, int i, double slow_motion, cfg_node *n, char *name,
+                     size_t name_len)
 {
     memset(n, 0, sizeof *n);
     snprintf(name, name_len, "fragment_%d", i);
@@ -79,24 +98,33 @@ static int make_node(const run_data *r, int i, cfg_node *n, char *name, size_t n
     unsigned *idx = malloc((size_t)3 * m * sizeof(unsigned));
     float *times = malloc(r->T * sizeof(float)), *tr = malloc(r->T * 3 * sizeof(float));
     float *rot = malloc(r->T * 4 * sizeof(float)), *scale = malloc(r->T * sizeof(float));
-    if (!map || !pos || !idx || !times || !tr || !rot || !scale) {
+    double *extras = malloc(N_EXTRAS * sizeof *extras);
+    if (!map || !pos || !idx || !times || !tr || !rot || !scale || !extras) {
         free(map), free(pos), free(idx), free(times), free(tr), free(rot), free(scale);
+        free(extras);
         return -1;
     }
     for (hsize_t v = 0; v < r->nn; v++)
         map[v] = -1;
-    int nv = 0;
-    for (int k = 0; k < 3 * m; k++) {
-        int v = r->tri[3 * a + k];
-        if (map[v] < 0) {
-            double rel[3];
-            for (int c = 0; c < 3; c++)
-                rel[c] = r->X[3 * v + c] - r->com_rest[3 * i + c];
-            to_gltf(rel, &pos[3 * nv]);
-            map[v] = nv++;
+    int nv = 0, k = 0, inner = 0;
+    for (int pass = 0; pass < 2; pass++) /* the outer surface, then the crack faces */
+        for (int j = a; j < a + m; j++) {
+            int is_crack = r->crack && r->crack[j] != 0;
+            if (is_crack != pass)
+                continue;
+            inner += is_crack;
+            for (int c3 = 0; c3 < 3; c3++, k++) {
+                int v = r->tri[3 * j + c3];
+                if (map[v] < 0) {
+                    double rel[3];
+                    for (int c = 0; c < 3; c++)
+                        rel[c] = r->X[3 * v + c] - r->com_rest[3 * i + c];
+                    to_gltf(rel, &pos[3 * nv]);
+                    map[v] = nv++;
+                }
+                idx[k] = (unsigned)map[v];
+            }
         }
-        idx[k] = (unsigned)map[v];
-    }
     free(map);
     /* Keys at every frame; before the first and after the last alive frame
      * the nearest alive pose is held, hidden by scale 0. */
@@ -109,7 +137,7 @@ static int make_node(const run_data *r, int i, cfg_node *n, char *name, size_t n
         const double *p = &r->pos[((hsize_t)s * r->N + i) * 3];
         const double *q = &r->quat[((hsize_t)s * r->N + i) * 4]; /* w, x, y, z */
         int alive = first >= 0 && (long)t >= first && (long)t <= last;
-        times[t] = (float)r->time[t];
+        times[t] = (float)(slow_motion * r->time[t]);
         to_gltf(p, &tr[3 * t]);
         double qv[3] = {q[1], q[2], q[3]};
         float qg[3];
@@ -128,7 +156,20 @@ static int make_node(const run_data *r, int i, cfg_node *n, char *name, size_t n
         n->color[c] = (float)(0.45 + 0.4 * cos(6.283185307179586 * (h + c / 3.0)));
     n->color[3] = 1.0f;
     n->n_vertices = nv, n->positions = pos;
-    n->n_triangles = m, n->indices = idx;
+    n->n_triangles = m, n->indices = idx, n->n_inner = inner;
+    /* mode: at the last frame it is alive (0 rigid, 1 fracture; -1 never seen) */
+    int mode = -1;
+    if (r->mode && last >= 0)
+        mode = r->mode[(hsize_t)last * r->N + i];
+    const double values[N_EXTRAS] = {i,
+                                     r->mass ? r->mass[i] : NAN,
+                                     r->parent ? r->parent[i] : -1,
+                                     r->birth ? r->birth[i] : NAN,
+                                     r->n_tets ? r->n_tets[i] : -1,
+                                     r->debris ? r->debris[i] : 0,
+                                     mode};
+    memcpy(extras, values, sizeof values);
+    n->extra_keys = EXTRA_KEYS, n->extra_values = extras, n->n_extras = N_EXTRAS;
     n->n_keys = (int)r->T, n->times = times, n->translation = tr, n->rotation = rot;
     n->scale = scale;
     return 1;
@@ -138,10 +179,16 @@ static void node_free(cfg_node *n)
 {
     free((void *)n->positions), free((void *)n->indices), free((void *)n->times);
     free((void *)n->translation), free((void *)n->rotation), free((void *)n->scale);
+    free((void *)n->extra_values);
 }
 
-cf_status cf_export_gltf(const char *h5_path, const char *glb_path, cf_error *err)
+cf_status cf_export_gltf(const char *h5_path, const char *glb_path, double slow_motion,
+                         cf_error *err)
 {
+    if (!(slow_motion > 0) || !isfinite(slow_motion))
+        return cf_error_set(err, CF_ERR_USAGE,
+                            "the slow-motion factor must be a number > 0 (1: real time), got %g",
+                            slow_motion);
     quiet_state q;
     quiet_begin(&q);
     run_data r;
@@ -153,7 +200,7 @@ cf_status cf_export_gltf(const char *h5_path, const char *glb_path, cf_error *er
         st = cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     int n = 0;
     for (int i = 0; st == CF_OK && i < r.nf; i++) {
-        int k = make_node(&r, i, &nodes[n], names[i], sizeof names[i]);
+        int k = make_node(&r, i, slow_motion, &nodes[n], names[i], sizeof names[i]);
         if (k < 0)
             st = cf_error_set(err, CF_ERR_NOMEM, "out of memory for fragment %d", i);
         n += k > 0;
