@@ -31,7 +31,7 @@ run: meshes
 	/usr/bin/python3 tools/check_run.py out/plaster_bunny_drop.h5 --max-hull-error 0.35
 	/usr/bin/python3 tools/check_physics.py out/plaster_bunny_drop.h5
 	/usr/bin/python3 tools/check_geometry.py out/plaster_bunny_drop.h5
-	$(BUILD)/cohfrac render out/plaster_bunny_drop.h5
+	$(BUILD)/cohfrac render out/plaster_bunny_drop.h5 --to 0.06 --slow-motion 30
 
 # The fracture-mode step on the 203k-tet bunny against the memory floor, 1
 # against 2 threads and against btSoftBody (docs/performance.md).

@@ -71,5 +71,5 @@ return {
     obstacle_contact = "penalty",           -- the floor neither takes nor gives energy
     debris_size = 0.0125,                   -- l_ch: pieces narrower are debris (§9.2)
   },
-  output = { file = "out/plaster_bunny_drop.h5", frame_interval = 0.0025 },
+  output = { file = "out/plaster_bunny_drop.h5", frame_interval = 0.0005 },  -- the break in slow motion
 }

@@ -37,8 +37,17 @@ if ! command -v ffmpeg >/dev/null; then
     echo "ffmpeg is not installed (make test's set-up installs it): render not checked"
     exit 0
 fi
-"$exe" render "$tmp/box.h5" --fps 10 --size 320x240
-frames=$(ls "$tmp/box_frames" | grep -c '^frame_.*\.png$')
-test -s "$tmp/box.mp4"
-echo "render: $frames PNG frames and an MP4 of $(wc -c < "$tmp/box.mp4") bytes"
-test "$frames" -eq "$(/usr/bin/python3 -c "import h5py,sys; print(len(h5py.File(sys.argv[1])['particles/fragments/position/step']))" "$tmp/box.h5")"
+n_out=$(/usr/bin/python3 -c "import h5py,sys; print(len(h5py.File(sys.argv[1])['particles/fragments/position/step']))" "$tmp/box.h5")
+# Both engines, by default a movie frame per output frame.
+for engine in matplotlib auto; do
+    rm -rf "$tmp/box_frames" "$tmp/box.mp4"
+    "$exe" render "$tmp/box.h5" --fps 10 --size 320x240 --engine $engine
+    frames=$(ls "$tmp/box_frames" | grep -c '^frame_.*\.png$')
+    test -s "$tmp/box.mp4"
+    echo "render ($engine): $frames PNG frames and an MP4 of $(wc -c < "$tmp/box.mp4") bytes"
+    test "$frames" -eq "$n_out"
+done
+# A span in slow motion: 0.1 s of the run 5 times slower is 0.5 s, 6 frames at 10 fps.
+rm -rf "$tmp/box_frames"
+"$exe" render "$tmp/box.h5" --fps 10 --size 320x240 --from 0.4 --to 0.5 --slow-motion 5
+test "$(ls "$tmp/box_frames" | grep -c '^frame_.*\.png$')" -eq 6

@@ -1,18 +1,28 @@
 #!/usr/bin/python3
 """Render a cohfrac run: PNG frames and an MP4 of every fragment's surface.
 
-    tools/render.py OUT.h5 [-o DIR] [--fps N] [--size WxH] [--frames a:b]
+    tools/render.py OUT.h5 [-o DIR] [--fps N] [--size WxH] [--from T0] [--to T1]
+                    [--slow-motion F] [--glb RUN.glb] [--engine auto|blender|matplotlib]
 
-Writes DIR/frame_0000.png ... (one per output frame) and DIR/<name>.mp4
-(ffmpeg, H.264); without -o the frames go to OUT minus .h5 plus "_frames"
-and the movie beside the file, as OUT minus .h5 plus ".mp4".  The camera
-looks at the whole run (the rest mesh and every fragment's path) from above
-and to the side, +z up; the ground plane and the other obstacles are drawn
-(spheres and boxes where they are at each frame); fragments are coloured by
-id, crack faces darker, debris grey and at half its size.  Reads the file with tools/cohfrac_h5.py.
+Writes DIR/frame_0000.png ... and DIR/<name>.mp4 (ffmpeg, H.264); without
+-o the frames go to OUT minus .h5 plus "_frames" and the movie beside the
+file, as OUT minus .h5 plus ".mp4".  Movie frame k shows the run at
+t = T0 + k / (fps F): --from/--to choose the span (default the whole run),
+--slow-motion F plays it F times slower (default: one movie frame per
+output frame, and never faster than the run).
+
+Engines: `blender` renders the glTF export (--glb, which `cohfrac render`
+writes) in Blender headless (Workbench: depth, studio lighting, shadows;
+under xvfb-run) with a camera that follows the pieces
+(tools/render_blender.py); `matplotlib` draws the posed surfaces from a
+fixed camera that sees the whole run (no depth buffer).  `auto` (default)
+takes Blender when --glb is given and blender and xvfb-run are installed.
+Fragments are coloured by id, crack faces in their own colour, debris
+small.  Reads the file with tools/cohfrac_h5.py.
 
 Exit status: 0 done, 2 the file has no geometry (an older file), 3
-matplotlib is missing, 5 ffmpeg failed or is missing (the PNGs stay).
+matplotlib is missing, 5 ffmpeg or Blender failed or is missing (the PNGs
+stay).
 """
 import argparse
 import os
@@ -107,26 +117,71 @@ def main():
     ap.add_argument("-o", "--output", help="directory for the frames and the movie")
     ap.add_argument("--fps", type=int, default=24)
     ap.add_argument("--size", default="960x720", help="WxH in pixels")
-    ap.add_argument("--frames", default=":", help="a:b, a Python slice of the frames")
+    ap.add_argument("--from", dest="t0", type=float, help="first time shown, s")
+    ap.add_argument("--to", dest="t1", type=float, help="last time shown, s")
+    ap.add_argument("--slow-motion", type=float,
+                    help="play F times slower than the run (default: one movie frame per "
+                         "output frame, at least real time)")
+    ap.add_argument("--glb", help="the run's glTF export (cohfrac export), for Blender")
+    ap.add_argument("--engine", choices=("auto", "blender", "matplotlib"), default="auto")
     a = ap.parse_args()
     run = cohfrac_h5.load(a.h5)
     if run.rest_nodes is None:
         print(f"render.py: {a.h5} holds no geometry (/mesh/rest): written by an older "
               "cohfrac; run the scene again", file=sys.stderr)
         return 2
+    if a.slow_motion is None:
+        step = float(np.median(np.diff(run.times))) if len(run.times) > 1 else 1.0
+        a.slow_motion = max(1.0, 1.0 / (a.fps * step)) if step > 0 else 1.0
+    if not a.slow_motion > 0:
+        print("render.py: --slow-motion needs a factor > 0", file=sys.stderr)
+        return 1
     out = a.output or os.path.splitext(a.h5)[0] + "_frames"
     os.makedirs(out, exist_ok=True)
+    for old in os.listdir(out):  # frames of an earlier render would join the movie
+        if old.startswith("frame_") and old.endswith(".png"):
+            os.remove(os.path.join(out, old))
     w, h = (int(x) for x in a.size.lower().split("x"))
+    t0 = run.times[0] if a.t0 is None else max(a.t0, run.times[0])
+    t1 = run.times[-1] if a.t1 is None else min(a.t1, run.times[-1])
+    if t1 < t0:
+        print(f"render.py: nothing to show between {t0} and {t1} s (the run covers "
+              f"{run.times[0]}-{run.times[-1]} s)", file=sys.stderr)
+        return 1
+    floor = [o for o in run.obstacles if o["type"] == "plane" and abs(o["normal"][2]) > 0.9]
+    blender = shutil.which("blender") and shutil.which("xvfb-run")
+    engine = a.engine if a.engine != "auto" else ("blender" if a.glb and blender else "matplotlib")
+    if engine == "blender":
+        if not (a.glb and blender):
+            print("render.py: the Blender engine needs --glb and the Debian packages blender "
+                  "and xvfb", file=sys.stderr)
+            return 5
+        script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "render_blender.py")
+        cmd = ["xvfb-run", "-a", "blender", "-b", "-noaudio", "-P", script, "--", a.glb, out,
+               str(a.fps), str(w), str(h), repr(t0), repr(t1), repr(a.slow_motion),
+               repr(floor[0]["point"][2]) if floor else "nan"]
+        r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        n = len([f for f in os.listdir(out) if f.startswith("frame_")])
+        if r.returncode != 0 or n == 0:
+            print(f"render.py: Blender failed (status {r.returncode}); its output ends:\n"
+                  + r.stdout[-1500:], file=sys.stderr)
+            return 5
+        return movie(a, run, out, n)
+    return draw_matplotlib(a, run, out, w, h, t0, t1, floor)
+
+
+def draw_matplotlib(a, run, out, w, h, t0, t1, floor):
+    """The frames through matplotlib: a fixed camera on the whole run."""
     lo, hi = run.bounds()
     pad = 0.15 * (hi - lo).max()
     lo, hi = lo - pad, hi + pad
-    floor = [o for o in run.obstacles if o["type"] == "plane" and abs(o["normal"][2]) > 0.9]
     if floor:
         lo[2] = min(lo[2], floor[0]["point"][2])
     cmap = plt.get_cmap("tab20")
-    start, _, stop = a.frames.partition(":")
-    frames = range(len(run.times))[slice(int(start) if start else None,
-                                         int(stop) if stop else None)]
+    # Movie frame k shows the output frame nearest t0 + k / (fps F).
+    n = int(np.floor((t1 - t0) * a.fps * a.slow_motion + 1e-9)) + 1
+    want = t0 + np.arange(n) / (a.fps * a.slow_motion)
+    frames = [int(np.argmin(np.abs(run.times - t))) for t in want]
     dpi = 100
     for k, fr in enumerate(frames):
         fig = plt.figure(figsize=(w / dpi, h / dpi), dpi=dpi)
@@ -154,6 +209,11 @@ def main():
             print(f"render: frame {k + 1}/{len(frames)} (t = {t:.3f} s)", file=sys.stderr)
     if sys.stderr.isatty():
         print(file=sys.stderr)
+    return movie(a, run, out, len(frames))
+
+
+def movie(a, run, out, n_frames):
+    """frame_*.png in `out` to an MP4 with ffmpeg."""
     movie = (os.path.join(out, (run.name or "run") + ".mp4") if a.output
              else os.path.splitext(a.h5)[0] + ".mp4")
     ffmpeg = shutil.which("ffmpeg")
@@ -166,7 +226,7 @@ def main():
     if subprocess.run(cmd).returncode != 0:
         print(f"render.py: ffmpeg failed: PNG frames in {out}", file=sys.stderr)
         return 5
-    print(f"render: {len(frames)} frames, {movie} ({len(frames) / a.fps:.1f} s at {a.fps} fps)")
+    print(f"render: {n_frames} frames, {movie} ({n_frames / a.fps:.1f} s at {a.fps} fps)")
     return 0
 
 

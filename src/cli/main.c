@@ -98,7 +98,14 @@ static const struct {
      "      -o, --output DIR                frames and movie here (default: frames in\n"
      "                                      OUT_frames/, the movie beside OUT as OUT.mp4)\n"
      "          --fps N                     frames per second of the movie (default 24)\n"
-     "          --size WxH                  pixels (default 960x720)\n"},
+     "          --size WxH                  pixels (default 960x720)\n"
+     "          --from T0, --to T1          the span shown, s (default the whole run)\n"
+     "          --slow-motion F             play F times slower (default: a movie frame\n"
+     "                                      per output frame, at least real time)\n"
+     "          --engine auto|blender|matplotlib\n"
+     "                                      blender: depth, lighting and a camera that\n"
+     "                                      follows the pieces (default when blender and\n"
+     "                                      xvfb are installed); matplotlib: fixed camera\n"},
     {"export",
      "  cohfrac export OUT.h5 --format gltf|pvd [-o PATH]\n"
      "                                      the fragments for other tools: gltf (Blender,\n"
@@ -633,9 +640,15 @@ static int cmd_render(int argc, char **argv)
     static const struct option lo[] = {{"output", required_argument, 0, 'o'},
                                        {"fps", required_argument, 0, 'f'},
                                        {"size", required_argument, 0, 'S'},
+                                       {"from", required_argument, 0, 'a'},
+                                       {"to", required_argument, 0, 'b'},
+                                       {"slow-motion", required_argument, 0, 'm'},
+                                       {"engine", required_argument, 0, 'e'},
                                        {0, 0, 0, 0}};
-    const char *out = NULL, *fps = NULL, *size = NULL;
+    const char *out = NULL, *fps = NULL, *size = NULL, *from = NULL, *to = NULL;
+    const char *slow = NULL, *engine = NULL;
     int c, w, h;
+    double v;
     while ((c = getopt_long(argc, argv, "o:", lo, NULL)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
@@ -649,6 +662,24 @@ static int cmd_render(int argc, char **argv)
                 return usage_error("--size is WxH in pixels, 16 to 8192 each (e.g. 960x720)");
             size = optarg;
             break;
+        case 'a':
+        case 'b':
+            if (real_arg(c == 'a' ? "--from" : "--to", optarg, 0, &v))
+                return cf_status_exit_code(CF_ERR_USAGE);
+            *(c == 'a' ? &from : &to) = optarg;
+            break;
+        case 'm':
+            if (real_arg("--slow-motion", optarg, 0, &v))
+                return cf_status_exit_code(CF_ERR_USAGE);
+            if (!(v > 0))
+                return usage_error("--slow-motion needs a factor > 0 (1: real time)");
+            slow = optarg;
+            break;
+        case 'e':
+            if (strcmp(optarg, "auto") && strcmp(optarg, "blender") && strcmp(optarg, "matplotlib"))
+                return usage_error("--engine is auto, blender or matplotlib");
+            engine = optarg;
+            break;
         default: return usage_error("bad option for 'render'");
         }
     }
@@ -659,17 +690,35 @@ static int cmd_render(int argc, char **argv)
                 strerror(errno));
         return cf_status_exit_code(CF_ERR_FILE_OPEN);
     }
-    const char *args[10] = {argv[optind]};
+    /* Blender renders the glTF export: written to a temporary file first
+     * (an older file without geometry falls back to matplotlib). */
+    char dir[600] = "", glb[620] = "";
+    if (!engine || strcmp(engine, "matplotlib")) {
+        const char *tmpdir = getenv("TMPDIR");
+        snprintf(dir, sizeof dir, "%s/cohfrac-render-XXXXXX",
+                 tmpdir && *tmpdir && strlen(tmpdir) < 500 ? tmpdir : "/tmp");
+        cf_error err = {0};
+        if (!mkdtemp(dir))
+            dir[0] = '\0';
+        else if (snprintf(glb, sizeof glb, "%s/run.glb", dir),
+                 cf_export_gltf(argv[optind], glb, 1.0, &err) != CF_OK)
+            unlink(glb), glb[0] = '\0';
+    }
+    const char *args[20] = {argv[optind]};
     int n = 1;
-    if (out)
-        args[n++] = "-o", args[n++] = out;
-    if (fps)
-        args[n++] = "--fps", args[n++] = fps;
-    if (size)
-        args[n++] = "--size", args[n++] = size;
+    const char *opt[][2] = {{"-o", out},           {"--fps", fps},   {"--size", size},
+                            {"--from", from},      {"--to", to},     {"--slow-motion", slow},
+                            {"--engine", engine},  {"--glb", glb[0] ? glb : NULL}};
+    for (size_t i = 0; i < sizeof opt / sizeof opt[0]; i++)
+        if (opt[i][1])
+            args[n++] = opt[i][0], args[n++] = opt[i][1];
     args[n] = NULL;
-    return cf_report_plot("render.py", NULL, args, "no frames or movie") ? 0
-                                                                          : cf_status_exit_code(CF_ERR_EXTERNAL);
+    int ok = cf_report_plot("render.py", NULL, args, "no frames or movie");
+    if (glb[0])
+        unlink(glb);
+    if (dir[0])
+        rmdir(dir);
+    return ok ? 0 : cf_status_exit_code(CF_ERR_EXTERNAL);
 }
 
 /* The fragments of an output file as glTF (cf_export_gltf). */

@@ -85,11 +85,11 @@ int cf_report_plot(const char *script, const char *script_path, const char *cons
         return 0;
     }
     const char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-    char *argv[16];
+    char *argv[24];
     int n = 0;
     argv[n++] = (char *)py;
     argv[n++] = path;
-    for (int i = 0; args[i] && n < 15; i++)
+    for (int i = 0; args[i] && n < 23; i++)
         argv[n++] = (char *)args[i];
     argv[n] = NULL;
     pid_t pid;
