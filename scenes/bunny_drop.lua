@@ -37,6 +37,7 @@ return {
       orientation = {0.7071067811865476, 0.7071067811865476, 0, 0},  -- y-up -> z-up
       position = {0, 0, 1.0 + 0.991233},      -- bottom 1 m above the ground
       velocity = {0, 0, 0},
+      visual = "/usr/share/glmark2/models/bunny.obj",  -- the 70k-triangle surface, drawn
     },
   },
   obstacles = {

@@ -57,6 +57,7 @@ return {
       orientation = {0, 1, 0, 0},             -- on its side
       position = {0, 0, 0.001 + 0.1147},      -- lowest point 1 mm above the floor
       velocity = {0, 0, -10},                 -- landing speed of a 5.1 m fall
+      visual = "/usr/share/glmark2/models/bunny.obj",  -- the 70k-triangle surface, drawn
     },
   },
   obstacles = {

@@ -142,6 +142,13 @@ cf_status cf_h5_add_cracks(cf_h5 *h, const cf_crack_row *rows, int n, cf_error *
 cf_status cf_h5_write_rest_mesh(cf_h5 *h, const double *X, int n, const int *tets, int nt,
                                 cf_error *err);
 
+/* /visual: a finer surface that rides on the rest tets, for drawing
+ * (src/io/visual.h): vertices [nv][3] (m, placed as /mesh/rest/nodes),
+ * triangles [nt][3] and tet [nt] (the rest tet each triangle moves with).
+ * Errors: CF_ERR_OUTPUT. */
+cf_status cf_h5_write_visual(cf_h5 *h, const double *V, int nv, const int *tri, const int *tet,
+                             int nt, cf_error *err);
+
 /* Append m boundary triangles ([m][3] indices into /mesh/rest/nodes) and
  * their crack flags to /surfaces; *first gets the row of the first (a
  * fragment's surface_first).  Reaches the disk with the next flush. */

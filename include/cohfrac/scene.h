@@ -75,6 +75,12 @@
  *       face or a node on the boundary; layer k+1: tets sharing a node with
  *       layer k) and drops the rest, a hollow shell (cf_mesh_hollow); 0 keeps
  *       the solid.  The boundary, hence the bounding box, is unchanged.
+ *     visual [none]: path of a finer triangle surface of the same object, in
+ *       the mesh's file units (any format assimp reads; relative to the scene
+ *       file), placed as the mesh is; the output carries it (/visual), each
+ *       triangle riding on the rest tet that holds it, so exports and
+ *       renders draw the object's own surface cut along the crack faces
+ *       (docs/output.md).  The physics does not read it.
  *   }, ... }
  *   boundary = { {                        prescribed nodes (fracture mode)
  *     region = {type="box", min={..}, max={..}}            nodes inside, m

@@ -79,6 +79,10 @@ typedef struct cf_body_def {
     double expansion_center[3];/* m */
     int hollow_layers;         /* > 0: keep only the tets within this many tet
                                   layers of the surface (a hollow shell); 0 solid */
+    char visual[1024];         /* resolved path of a finer triangle surface of the same
+                                  object, in the mesh's file units, that the output
+                                  carries for drawing (docs/output.md); "" none.  The
+                                  engine does not read it */
 } cf_body_def;
 
 typedef enum { CF_REGION_BOX, CF_REGION_PLANE, CF_REGION_GROUP } cf_region_type;

@@ -16,6 +16,10 @@ typedef struct run_data {
     int nf;                          /* fragment records */
     double *time, *pos, *quat, *X, *com_rest, *mass, *birth;
     int *id, *tri, *first, *count, *crack, *parent, *n_tets, *debris, *mode;
+    /* The visual surface (/visual, optional) and, per fragment, the visual
+     * triangles that ride on its tets: vis_item[vis_start[i] ..). */
+    double *vis_v;
+    int *vis_tri, *vis_tet, n_vis, *vis_start, *vis_item;
 } run_data;
 
 static void run_free(run_data *r)
@@ -24,6 +28,66 @@ static void run_free(run_data *r)
     free(r->id), free(r->tri), free(r->first), free(r->count);
     free(r->mass), free(r->birth), free(r->crack), free(r->parent), free(r->n_tets);
     free(r->debris), free(r->mode);
+    free(r->vis_v), free(r->vis_tri), free(r->vis_tet), free(r->vis_start), free(r->vis_item);
+}
+
+/* vis_start/vis_item: the visual triangles of each fragment, those whose
+ * tet is the fragment's in tf (rows [rows][nt] of tet -> fragment, each
+ * written at tf_time when the map changed) at the first frame it is
+ * alive; a fragment keeps its tets for its life.  -1 out of memory. */
+static int own_visual(run_data *r, const int *tf, const double *tf_time, hsize_t rows,
+                      hsize_t nt)
+{
+    hsize_t T = r->T;
+    int nf = r->nf;
+    long *born = malloc(((size_t)nf + 1) * sizeof *born);
+    r->vis_start = calloc((size_t)nf + 2, sizeof *r->vis_start);
+    if (!born || !r->vis_start) {
+        free(born);
+        return -1;
+    }
+    for (int i = 0; i < nf; i++) {
+        born[i] = -1;
+        for (hsize_t t = 0; t < T && born[i] < 0; t++)
+            if ((hsize_t)i < r->N && r->id[t * r->N + i] >= 0)
+                born[i] = (long)t;
+    }
+    /* The fragment a triangle rides with, at the frame that fragment is born. */
+    for (int pass = 0; pass < 2; pass++) { /* count, then fill */
+        for (hsize_t t = 0; t < T; t++) {
+            int any = 0;
+            for (int i = 0; i < nf && !any; i++)
+                any = born[i] == (long)t;
+            if (!any)
+                continue;
+            /* the map in force at frame t: the last row written by then (a
+             * row is written when the map changes) */
+            hsize_t row = 0;
+            while (row + 1 < rows && tf_time[row + 1] <= r->time[t] * (1 + 1e-12) + 1e-15)
+                row++;
+            for (int j = 0; j < r->n_vis; j++) {
+                int tet = r->vis_tet[j];
+                int f = tet >= 0 && (hsize_t)tet < nt ? tf[row * nt + (hsize_t)tet] : -1;
+                if (f < 0 || f >= nf || born[f] != (long)t)
+                    continue;
+                if (pass == 0)
+                    r->vis_start[f + 2]++;
+                else
+                    r->vis_item[r->vis_start[f + 1]++] = j;
+            }
+        }
+        if (pass == 0) {
+            for (int i = 0; i < nf; i++)
+                r->vis_start[i + 2] += r->vis_start[i + 1];
+            r->vis_item = malloc(((size_t)r->vis_start[nf + 1] + 1) * sizeof *r->vis_item);
+            if (!r->vis_item) {
+                free(born);
+                return -1;
+            }
+        }
+    }
+    free(born);
+    return 0;
 }
 
 static cf_status run_read(const char *path, run_data *r, cf_error *err)
@@ -54,6 +118,18 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
     r->n_tets = cf_h5_read_all(f, "/fragments/n_tets", H5T_NATIVE_INT, 4, &rk, dn);
     r->debris = cf_h5_read_all(f, "/fragments/debris", H5T_NATIVE_INT, 4, &rk, dn);
     r->mode = cf_h5_read_all(f, "/particles/fragments/mode/value", H5T_NATIVE_INT, 4, &rk, dn);
+    hsize_t dv[3], dvt[3], dmap[3];
+    int *tf = NULL; /* /mesh/tet_fragment rows, read only with a visual surface */
+    double *tf_time = NULL;
+    hsize_t dmt[3];
+    r->vis_v = cf_h5_read_all(f, "/visual/vertices", H5T_NATIVE_DOUBLE, 8, &rk, dv);
+    r->vis_tri = cf_h5_read_all(f, "/visual/triangles", H5T_NATIVE_INT, 4, &rk, dvt);
+    r->vis_tet = cf_h5_read_all(f, "/visual/tet", H5T_NATIVE_INT, 4, &rk, dn);
+    if (r->vis_v && r->vis_tri && r->vis_tet) {
+        r->n_vis = (int)dvt[0];
+        tf = cf_h5_read_all(f, "/mesh/tet_fragment/value", H5T_NATIVE_INT, 4, &rk, dmap);
+        tf_time = cf_h5_read_all(f, "/mesh/tet_fragment/time", H5T_NATIVE_DOUBLE, 8, &rk, dmt);
+    }
     H5Fclose(f);
     if (!r->X || !r->first || !r->count || !r->com_rest || !r->tri)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
@@ -66,7 +142,12 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
     /* Complete frames only (a killed run may leave one partial row). */
     r->T = dt[0] < d[0] ? dt[0] : d[0];
     r->N = d[1], r->nn = dx[0], r->M = dtr[0], r->nf = (int)dfs[0];
-    return CF_OK;
+    cf_status st = CF_OK;
+    if (tf && tf_time &&
+        own_visual(r, tf, tf_time, dmap[0] < dmt[0] ? dmap[0] : dmt[0], dmap[1]) != 0)
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory for the visual surface");
+    free(tf), free(tf_time);
+    return st;
 }
 
 /* cohfrac (x, y, z), +z up -> glTF (x, z, -y), +y up. */
@@ -80,52 +161,77 @@ static const char *const EXTRA_KEYS[] = {"fragment", "mass",  "parent", "birth_t
                                          "n_tets",   "debris", "mode"};
 enum { N_EXTRAS = sizeof EXTRA_KEYS / sizeof EXTRA_KEYS[0] };
 
-/* One fragment's node: its surface in its body frame (outer triangles,
- * then crack faces), its extras, its keys at `slow_motion` times the run's
- * time. */
+/* Corner c of rest-mesh or visual vertex v (`vis`), in fragment i's body
+ * frame, glTF axes, into pos[3 * at]. */
+static void corner(const run_data *r, int i, int vis, int v, float *pos)
+{
+    const double *x = vis ? &r->vis_v[3 * v] : &r->X[3 * v];
+    double rel[3];
+    for (int c = 0; c < 3; c++)
+        rel[c] = x[c] - r->com_rest[3 * i + c];
+    to_gltf(rel, pos);
+}
+
+/* Fragment i's triangles into n: its outer surface, then its crack faces
+ * (n_inner).  The outer surface is the visual surface's triangles that
+ * ride on its tets where the file has one (vis_start/vis_item), its rest
+ * surface's outer faces otherwise.  Each corner is a vertex of its own
+ * (flat shading).  0 done, 1 nothing to draw, -1 out of memory. */
+static int node_geometry(const run_data *r, int i, cfg_node *n)
+{
+    int a = r->first[i], m = r->count[i];
+    if (m <= 0 || a < 0 || (hsize_t)(a + m) > r->M)
+        return 1;
+    int n_vis = r->vis_start ? r->vis_start[i + 1] - r->vis_start[i] : 0;
+    size_t cap = (size_t)m + (size_t)n_vis;
+    float *pos = malloc(3 * 3 * cap * sizeof(float) + 1);
+    unsigned *idx = malloc(3 * cap * sizeof(unsigned) + 1);
+    if (!pos || !idx) {
+        free(pos), free(idx);
+        return -1;
+    }
+    int k = 0, inner = 0;
+    for (int j = 0; j < n_vis; j++) /* the visual surface on its tets */
+        for (int c3 = 0; c3 < 3; c3++, k++)
+            corner(r, i, 1, r->vis_tri[3 * r->vis_item[r->vis_start[i] + j] + c3], &pos[3 * k]);
+    for (int pass = 0; pass < 2; pass++) /* its rest surface: outer faces, then cracks */
+        for (int j = a; j < a + m; j++) {
+            int is_crack = r->crack && r->crack[j] != 0;
+            if (is_crack != pass || (!is_crack && r->vis_start))
+                continue;
+            inner += is_crack;
+            for (int c3 = 0; c3 < 3; c3++, k++)
+                corner(r, i, 0, r->tri[3 * j + c3], &pos[3 * k]);
+        }
+    for (int v = 0; v < k; v++)
+        idx[v] = (unsigned)v;
+    n->n_vertices = k, n->positions = pos;
+    n->n_triangles = k / 3, n->indices = idx, n->n_inner = inner;
+    return k > 0 ? 0 : 1;
+}
+
+/* One fragment's node: its surface in its body frame (node_geometry), its
+ * extras, its keys at `slow_motion` times the run's time. */
 static int make_node(const run_data *r, int i, double slow_motion, cfg_node *n, char *name,
                      size_t name_len)
 {
     memset(n, 0, sizeof *n);
     snprintf(name, name_len, "fragment_%d", i);
     n->name = name;
-    int a = r->first[i], m = r->count[i];
-    if (m <= 0 || a < 0 || (hsize_t)(a + m) > r->M)
-        return 0;
-    /* Compact the vertices the surface uses. */
-    int *map = malloc(r->nn * sizeof(int));
-    float *pos = malloc((size_t)3 * 3 * m * sizeof(float));
-    unsigned *idx = malloc((size_t)3 * m * sizeof(unsigned));
+    int geo = node_geometry(r, i, n);
+    if (geo != 0) {
+        free((void *)n->positions), free((void *)n->indices);
+        n->positions = NULL, n->indices = NULL;
+        return geo < 0 ? -1 : 0;
+    }
     float *times = malloc(r->T * sizeof(float)), *tr = malloc(r->T * 3 * sizeof(float));
     float *rot = malloc(r->T * 4 * sizeof(float)), *scale = malloc(r->T * sizeof(float));
     double *extras = malloc(N_EXTRAS * sizeof *extras);
-    if (!map || !pos || !idx || !times || !tr || !rot || !scale || !extras) {
-        free(map), free(pos), free(idx), free(times), free(tr), free(rot), free(scale);
-        free(extras);
+    if (!times || !tr || !rot || !scale || !extras) {
+        free(times), free(tr), free(rot), free(scale), free(extras);
+        free((void *)n->positions), free((void *)n->indices);
         return -1;
     }
-    for (hsize_t v = 0; v < r->nn; v++)
-        map[v] = -1;
-    int nv = 0, k = 0, inner = 0;
-    for (int pass = 0; pass < 2; pass++) /* the outer surface, then the crack faces */
-        for (int j = a; j < a + m; j++) {
-            int is_crack = r->crack && r->crack[j] != 0;
-            if (is_crack != pass)
-                continue;
-            inner += is_crack;
-            for (int c3 = 0; c3 < 3; c3++, k++) {
-                int v = r->tri[3 * j + c3];
-                if (map[v] < 0) {
-                    double rel[3];
-                    for (int c = 0; c < 3; c++)
-                        rel[c] = r->X[3 * v + c] - r->com_rest[3 * i + c];
-                    to_gltf(rel, &pos[3 * nv]);
-                    map[v] = nv++;
-                }
-                idx[k] = (unsigned)map[v];
-            }
-        }
-    free(map);
     /* Keys at every frame; before the first and after the last alive frame
      * the nearest alive pose is held, hidden by scale 0. */
     long first = -1, last = -1;
@@ -155,8 +261,6 @@ static int make_node(const run_data *r, int i, double slow_motion, cfg_node *n, 
     for (int c = 0; c < 3; c++)
         n->color[c] = (float)(0.45 + 0.4 * cos(6.283185307179586 * (h + c / 3.0)));
     n->color[3] = 1.0f;
-    n->n_vertices = nv, n->positions = pos;
-    n->n_triangles = m, n->indices = idx, n->n_inner = inner;
     /* mode: at the last frame it is alive (0 rigid, 1 fracture; -1 never seen) */
     int mode = -1;
     if (r->mode && last >= 0)

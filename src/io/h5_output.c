@@ -1398,6 +1398,40 @@ cf_status cf_h5_write_rest_mesh(cf_h5 *h, const double *X, int n, const int *tet
     return st;
 }
 
+static cf_status write_visual_impl(cf_h5 *h, const double *V, int nv, const int *tri,
+                                   const int *tet, int nt, cf_error *err)
+{
+    hid_t g = make_group(h->file, "visual");
+    hid_t dv = g >= 0 ? create_rows(g, "vertices", H5T_IEEE_F64LE, 3) : H5I_INVALID_HID;
+    hid_t dt = g >= 0 ? create_rows(g, "triangles", H5T_STD_I32LE, 3) : H5I_INVALID_HID;
+    hid_t de = g >= 0 ? create_rows(g, "tet", H5T_STD_I32LE, 1) : H5I_INVALID_HID;
+    int ok = dv >= 0 && dt >= 0 && de >= 0 && write_unit(dv, "m") == 0 &&
+             append_rows(dv, 0, (hsize_t)nv, H5T_NATIVE_DOUBLE, V) == 0 &&
+             append_rows(dt, 0, (hsize_t)nt, H5T_NATIVE_INT, tri) == 0 &&
+             append_rows(de, 0, (hsize_t)nt, H5T_NATIVE_INT, tet) == 0;
+    int ignored = 0;
+    close_dataset(&dv, &ignored);
+    close_dataset(&dt, &ignored);
+    close_dataset(&de, &ignored);
+    if (g >= 0)
+        H5Gclose(g);
+    if (!ok)
+        return h5_fail(err, h->path, "writing /visual");
+    return flush_file(h, err, "flushing /visual");
+}
+
+cf_status cf_h5_write_visual(cf_h5 *h, const double *V, int nv, const int *tri, const int *tet,
+                             int nt, cf_error *err)
+{
+    if (!h || nv < 0 || nt < 0)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_visual: bad arguments");
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = write_visual_impl(h, V, nv, tri, tet, nt, err);
+    quiet_end(&q);
+    return st;
+}
+
 static cf_status write_tet_fragments_impl(cf_h5 *h, long step, double time, const int *map,
                                           int nt, cf_error *err)
 {

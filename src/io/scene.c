@@ -57,7 +57,7 @@ static const char *const strength_keys[] = {"distribution", "modulus", "seed", "
 static const char *const distribution_names[] = {"uniform", "weibull"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
                                         "velocity", "angular_velocity", "expansion_rate",
-                                        "expansion_center", "hollow_layers"};
+                                        "expansion_center", "hollow_layers", "visual"};
 /* Primitive meshes (bodies[i].mesh = {type = ...}), one key list per type. */
 static const char *const prim_box_keys[] = {"type", "size", "cells", "tets_per_cell"};
 static const char *const prim_sphere_keys[] = {"type", "radius", "mesh_size"};
@@ -986,6 +986,15 @@ static cf_status read_body(loader *ld, int t, cf_body_def *b)
     }
     lua_pop(L, 1);
     TRY(get_int(ld, t, "hollow_layers", 0, &NON_NEGATIVE, &b->hollow_layers));
+    b->visual[0] = '\0';
+    if (raw_get(L, t, "visual") != LUA_TNIL) {
+        lua_pop(L, 1);
+        char visual[1024];
+        TRY(get_str(ld, t, "visual", NULL, visual, sizeof visual));
+        TRY(resolve_surface(ld, "visual", visual, b->visual, sizeof b->visual));
+    } else {
+        lua_pop(L, 1);
+    }
     return CF_OK;
 }
 
@@ -1782,6 +1791,8 @@ static char *resolved_text(const cf_world_def *s)
         else
             put(&b, "      -- expansion_center: the body's centre of mass\n");
         put(&b, "      hollow_layers = %d,\n", d->hollow_layers);
+        if (d->visual[0])
+            put_str(&b, 6, "visual", d->visual);
         put(&b, "    },\n");
     }
     put(&b, "  },\n  boundary = {\n");

@@ -6,6 +6,7 @@
 #include "cohfrac/h5_output.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/surface.h"
+#include "visual.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -146,7 +147,7 @@ static cf_status write_surfaces(cf_sim *sim, cf_frag_info *info, int first, int 
 }
 
 /* The rest mesh into the file, and what the surfaces need of it. */
-static cf_status write_rest_mesh(cf_sim *sim, cf_error *err)
+static cf_status write_rest_mesh(cf_sim *sim, const cf_world_def *def, cf_error *err)
 {
     cf_world *w = sim->world;
     int nn = cf_world_rest_node_count(w), nt = cf_world_tet_count(w);
@@ -173,6 +174,13 @@ static cf_status write_rest_mesh(cf_sim *sim, cf_error *err)
     }
     if (st == CF_OK)
         st = cf_h5_write_rest_mesh(sim->h5, X, nn, sim->rest_tets, nt, err);
+    cf_visual vis = {0}; /* the bodies' finer surfaces, riding on the rest tets */
+    if (st == CF_OK)
+        st = cf_visual_embed(def, &sim->meshes, X, nn, sim->rest_tets, nt, &vis, err);
+    if (st == CF_OK && vis.n_triangles > 0)
+        st = cf_h5_write_visual(sim->h5, vis.vertices, vis.n_vertices, vis.triangles, vis.tet,
+                                vis.n_triangles, err);
+    cf_visual_free(&vis);
     free(X), free(faces);
     return st;
 }
@@ -344,7 +352,7 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
         st = write_initial_bounds(sim, err);
         double t0 = cf_wall_time();
         if (st == CF_OK)
-            st = write_rest_mesh(sim, err);
+            st = write_rest_mesh(sim, def, err);
         sim->output_time += cf_wall_time() - t0;
     }
     if (st == CF_OK)

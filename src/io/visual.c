@@ -1,0 +1,210 @@
+/* A body's visual surface embedded in the rest tets (see visual.h). */
+#include "visual.h"
+
+#include "linalg.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cf_visual_free(cf_visual *v)
+{
+    if (!v)
+        return;
+    free(v->vertices), free(v->triangles), free(v->tet);
+    memset(v, 0, sizeof *v);
+}
+
+/* A uniform grid over the rest tets' bounding boxes: cell -> tets. */
+typedef struct grid {
+    double lo[3], h;
+    int n[3];
+    int *start, *item; /* CSR: the tets of cell c are item[start[c] .. start[c + 1]) */
+} grid;
+
+static long cell_of(const grid *g, const double x[3], int c[3])
+{
+    for (int k = 0; k < 3; k++) {
+        int i = (int)floor((x[k] - g->lo[k]) / g->h);
+        c[k] = i < 0 ? 0 : i >= g->n[k] ? g->n[k] - 1 : i;
+    }
+    return ((long)c[2] * g->n[1] + c[1]) * g->n[0] + c[0];
+}
+
+/* The cells a tet's bounding box covers, a[] to b[] per axis. */
+static void tet_cells(const grid *g, const double *X, const int *T, int a[3], int b[3])
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int j = 0; j < 4; j++)
+        for (int k = 0; k < 3; k++)
+            lo[k] = fmin(lo[k], X[3 * T[j] + k]), hi[k] = fmax(hi[k], X[3 * T[j] + k]);
+    cell_of(g, lo, a), cell_of(g, hi, b);
+}
+
+static int grid_build(grid *g, const double *X, int nn, const int *tets, int nt)
+{
+    double hi[3], vol = 1;
+    points_bbox(X, nn, g->lo, hi);
+    for (int k = 0; k < 3; k++)
+        vol *= fmax(hi[k] - g->lo[k], 1e-12);
+    g->h = 1.5 * cbrt(vol / (nt > 0 ? nt : 1)); /* a few tets a cell */
+    long cells = 1;
+    for (int k = 0; k < 3; k++)
+        cells *= g->n[k] = (int)fmin(512, floor((hi[k] - g->lo[k]) / g->h) + 1);
+    g->start = calloc((size_t)cells + 1, sizeof *g->start);
+    int *fill = calloc((size_t)cells + 1, sizeof *fill);
+    if (!g->start || !fill) {
+        free(fill);
+        return -1;
+    }
+    for (int pass = 0; pass < 2; pass++) { /* count, then fill */
+        for (int t = 0; t < nt; t++) {
+            int a[3], b[3];
+            tet_cells(g, X, &tets[4 * t], a, b);
+            for (int z = a[2]; z <= b[2]; z++)
+                for (int y = a[1]; y <= b[1]; y++)
+                    for (int x = a[0]; x <= b[0]; x++) {
+                        long c = ((long)z * g->n[1] + y) * g->n[0] + x;
+                        if (pass == 0)
+                            g->start[c + 1]++;
+                        else
+                            g->item[fill[c]++] = t;
+                    }
+        }
+        if (pass == 0) {
+            for (long c = 0; c < cells; c++)
+                g->start[c + 1] += g->start[c], fill[c] = g->start[c];
+            g->item = malloc(((size_t)g->start[cells] + 1) * sizeof *g->item);
+            if (!g->item) {
+                free(fill);
+                return -1;
+            }
+        }
+    }
+    free(fill);
+    return 0;
+}
+
+/* The smallest barycentric coordinate of p in tet t: >= 0 inside. */
+static double inside(const double *X, const int *T, const double p[3])
+{
+    const double *a = &X[3 * T[0]];
+    double M[9], r[3], l[3];
+    for (int k = 0; k < 3; k++) {
+        M[3 * k + 0] = X[3 * T[1] + k] - a[k];
+        M[3 * k + 1] = X[3 * T[2] + k] - a[k];
+        M[3 * k + 2] = X[3 * T[3] + k] - a[k];
+        r[k] = p[k] - a[k];
+    }
+    double d = m3_det(M);
+    if (d == 0)
+        return -INFINITY;
+    /* Cramer's rule, column by column */
+    for (int j = 0; j < 3; j++) {
+        double Mj[9];
+        memcpy(Mj, M, sizeof Mj);
+        for (int k = 0; k < 3; k++)
+            Mj[3 * k + j] = r[k];
+        l[j] = m3_det(Mj) / d;
+    }
+    return fmin(fmin(l[0], l[1]), fmin(l[2], 1 - l[0] - l[1] - l[2]));
+}
+
+/* The tet holding p, else the one whose coordinates miss by the least,
+ * searched in rings of cells around p until one is found a ring ago. */
+static int locate(const grid *g, const double *X, const int *tets, const double p[3])
+{
+    int c[3], best = -1;
+    double best_in = -INFINITY;
+    cell_of(g, p, c);
+    int rmax = g->n[0] + g->n[1] + g->n[2];
+    for (int r = 0; r <= rmax; r++) {
+        for (int z = c[2] - r; z <= c[2] + r; z++)
+            for (int y = c[1] - r; y <= c[1] + r; y++)
+                for (int x = c[0] - r; x <= c[0] + r; x++) {
+                    if (x < 0 || y < 0 || z < 0 || x >= g->n[0] || y >= g->n[1] ||
+                        z >= g->n[2])
+                        continue;
+                    if (abs(x - c[0]) != r && abs(y - c[1]) != r && abs(z - c[2]) != r)
+                        continue; /* the ring's shell only */
+                    long cell = ((long)z * g->n[1] + y) * g->n[0] + x;
+                    for (int i = g->start[cell]; i < g->start[cell + 1]; i++) {
+                        int t = g->item[i];
+                        double in = inside(X, &tets[4 * t], p);
+                        if (in > best_in || (in == best_in && t < best))
+                            best_in = in, best = t;
+                    }
+                }
+        if (best_in >= 0 || (best >= 0 && r >= 1))
+            break;
+    }
+    return best;
+}
+
+cf_status cf_visual_embed(const cf_world_def *def, const cf_world_meshes *meshes,
+                          const double *X, int nn, const int *tets, int nt, cf_visual *out,
+                          cf_error *err)
+{
+    memset(out, 0, sizeof *out);
+    cf_status st = CF_OK;
+    grid g = {0};
+    for (int b = 0; b < def->n_bodies && st == CF_OK; b++) {
+        const cf_body_def *bd = &def->bodies[b];
+        if (!bd->visual[0])
+            continue;
+        if (!g.start && grid_build(&g, X, nn, tets, nt) != 0) {
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory embedding the visual surface");
+            break;
+        }
+        cf_surface s = {0};
+        if ((st = cf_surface_load(bd->visual, &s, err)) != CF_OK) {
+            char why[sizeof err->msg];
+            memcpy(why, err->msg, sizeof why);
+            cf_error_set(err, st, "bodies[%d].visual: %s", b + 1, why);
+            break;
+        }
+        const cf_mesh *m = &meshes->bodies[b];
+        double lo[3], hi[3], R[9];
+        points_bbox(m->x, m->n_nodes, lo, hi);
+        quat_to_mat(bd->orientation, R);
+        int v0 = out->n_vertices, t0 = out->n_triangles;
+        double *V = realloc(out->vertices, 3 * sizeof(double) * ((size_t)v0 + s.n_verts + 1));
+        if (V)
+            out->vertices = V;
+        int *T = realloc(out->triangles, 3 * sizeof(int) * ((size_t)t0 + s.n_tris + 1));
+        if (T)
+            out->triangles = T;
+        int *E = realloc(out->tet, sizeof(int) * ((size_t)t0 + s.n_tris + 1));
+        if (E)
+            out->tet = E;
+        if (!V || !T || !E) {
+            cf_surface_free(&s);
+            st = cf_error_set(err, CF_ERR_NOMEM, "out of memory for the visual surface");
+            break;
+        }
+        for (int i = 0; i < s.n_verts; i++) {
+            double r[3], y[3];
+            for (int k = 0; k < 3; k++)
+                r[k] = s.v[3 * i + k] - 0.5 * (lo[k] + hi[k]);
+            m3_mulv(R, r, y);
+            for (int k = 0; k < 3; k++)
+                V[3 * (v0 + i) + k] = bd->position[k] + bd->scale * y[k];
+        }
+        for (int i = 0; i < s.n_tris; i++) {
+            double c[3] = {0, 0, 0};
+            for (int j = 0; j < 3; j++) {
+                int v = s.tri[3 * i + j];
+                T[3 * (t0 + i) + j] = v0 + v;
+                for (int k = 0; k < 3; k++)
+                    c[k] += V[3 * (v0 + v) + k] / 3;
+            }
+            E[t0 + i] = locate(&g, X, tets, c);
+        }
+        out->n_vertices += s.n_verts, out->n_triangles += s.n_tris;
+        cf_surface_free(&s);
+    }
+    free(g.start), free(g.item);
+    if (st != CF_OK)
+        cf_visual_free(out);
+    return st;
+}
