@@ -41,10 +41,11 @@ shading = scene.display.shading
 shading.light = "STUDIO"
 shading.color_type = "MATERIAL"
 shading.show_shadows = True
-shading.show_cavity = True
+shading.show_cavity = False  # screen-space, slow in software GL
 scene.world = bpy.data.worlds.new("sky")  # the background where the floor ends
 scene.world.color = (0.80, 0.84, 0.90)
 scene.display.shadow_focus = 0.9
+scene.display.render_aa = "FXAA"  # one sample: multisampling is slow in software GL
 
 if math.isfinite(floor_z):
     bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0, 0, floor_z))
@@ -66,10 +67,12 @@ view = mathutils.Vector((math.cos(math.radians(-60)) * math.cos(math.radians(20)
 
 
 def shown():
-    """(centre, size, mass) of the pieces visible at the current frame."""
+    """(centre, size, mass) of the pieces visible at the current frame; the
+    others (scale 0: not yet born, or split) are left out of the render."""
     out = []
     for o in pieces:
-        if o.matrix_world.to_scale()[0] < 0.5:
+        o.hide_render = o.matrix_world.to_scale()[0] < 0.5
+        if o.hide_render:
             continue
         corners = [o.matrix_world @ mathutils.Vector(c) for c in o.bound_box]
         lo = mathutils.Vector([min(c[k] for c in corners) for k in range(3)])
