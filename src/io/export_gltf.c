@@ -6,6 +6,7 @@
 #include "h5_quiet.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -98,35 +99,47 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (f < 0)
         return cf_error_set(err, CF_ERR_FILE_OPEN, "%s: cannot open it", path);
+    /* Every dataset the export reads, whole; the ones after com_rest are
+     * optional (older files lack them; the nodes then go without). */
+    enum { TIME, ID, POS, QUAT, X, TRI, FIRST, COUNT, COM, CRACK, MASS, BIRTH, PARENT, NTETS,
+           DEBRIS, MODE, VIS_V, VIS_TRI, VIS_TET, N_READS };
+    static const struct {
+        const char *path;
+        int is_double;
+        size_t field; /* offset of the pointer in run_data */
+    } reads[N_READS] = {
+        {"/particles/fragments/position/time", 1, offsetof(run_data, time)},
+        {"/particles/fragments/id/value", 0, offsetof(run_data, id)},
+        {"/particles/fragments/position/value", 1, offsetof(run_data, pos)},
+        {"/particles/fragments/orientation/value", 1, offsetof(run_data, quat)},
+        {"/mesh/rest/nodes", 1, offsetof(run_data, X)},
+        {"/surfaces/triangles", 0, offsetof(run_data, tri)},
+        {"/fragments/surface_first", 0, offsetof(run_data, first)},
+        {"/fragments/surface_count", 0, offsetof(run_data, count)},
+        {"/fragments/com_rest", 1, offsetof(run_data, com_rest)},
+        {"/surfaces/crack", 0, offsetof(run_data, crack)},
+        {"/fragments/mass", 1, offsetof(run_data, mass)},
+        {"/fragments/birth_time", 1, offsetof(run_data, birth)},
+        {"/fragments/parent", 0, offsetof(run_data, parent)},
+        {"/fragments/n_tets", 0, offsetof(run_data, n_tets)},
+        {"/fragments/debris", 0, offsetof(run_data, debris)},
+        {"/particles/fragments/mode/value", 0, offsetof(run_data, mode)},
+        {"/visual/vertices", 1, offsetof(run_data, vis_v)},
+        {"/visual/triangles", 0, offsetof(run_data, vis_tri)},
+        {"/visual/tet", 0, offsetof(run_data, vis_tet)},
+    };
     int rk;
-    hsize_t d[3], dt[3], dp[3], dq[3], dx[3], dtr[3], dfs[3], dc[3];
-    r->time = cf_h5_read_all(f, "/particles/fragments/position/time", H5T_NATIVE_DOUBLE, 8, &rk, dt);
-    r->id = cf_h5_read_all(f, "/particles/fragments/id/value", H5T_NATIVE_INT, 4, &rk, d);
-    r->pos = cf_h5_read_all(f, "/particles/fragments/position/value", H5T_NATIVE_DOUBLE, 8, &rk, dp);
-    r->quat = cf_h5_read_all(f, "/particles/fragments/orientation/value", H5T_NATIVE_DOUBLE, 8, &rk, dq);
-    r->X = cf_h5_read_all(f, "/mesh/rest/nodes", H5T_NATIVE_DOUBLE, 8, &rk, dx);
-    r->tri = cf_h5_read_all(f, "/surfaces/triangles", H5T_NATIVE_INT, 4, &rk, dtr);
-    r->first = cf_h5_read_all(f, "/fragments/surface_first", H5T_NATIVE_INT, 4, &rk, dfs);
-    r->count = cf_h5_read_all(f, "/fragments/surface_count", H5T_NATIVE_INT, 4, &rk, dfs);
-    r->com_rest = cf_h5_read_all(f, "/fragments/com_rest", H5T_NATIVE_DOUBLE, 8, &rk, dc);
-    /* What the nodes carry besides geometry (absent from older files: left out) */
-    hsize_t dn[3];
-    r->crack = cf_h5_read_all(f, "/surfaces/crack", H5T_NATIVE_INT, 4, &rk, dn);
-    r->mass = cf_h5_read_all(f, "/fragments/mass", H5T_NATIVE_DOUBLE, 8, &rk, dn);
-    r->birth = cf_h5_read_all(f, "/fragments/birth_time", H5T_NATIVE_DOUBLE, 8, &rk, dn);
-    r->parent = cf_h5_read_all(f, "/fragments/parent", H5T_NATIVE_INT, 4, &rk, dn);
-    r->n_tets = cf_h5_read_all(f, "/fragments/n_tets", H5T_NATIVE_INT, 4, &rk, dn);
-    r->debris = cf_h5_read_all(f, "/fragments/debris", H5T_NATIVE_INT, 4, &rk, dn);
-    r->mode = cf_h5_read_all(f, "/particles/fragments/mode/value", H5T_NATIVE_INT, 4, &rk, dn);
-    hsize_t dv[3], dvt[3], dmap[3];
+    hsize_t dims[N_READS][3], dmap[3], dmt[3];
+    for (int k = 0; k < N_READS; k++) {
+        void *data = cf_h5_read_all(f, reads[k].path,
+                                    reads[k].is_double ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT,
+                                    reads[k].is_double ? 8 : 4, &rk, dims[k]);
+        memcpy((char *)r + reads[k].field, &data, sizeof data); /* the pointer field */
+    }
     int *tf = NULL; /* /mesh/tet_fragment rows, read only with a visual surface */
     double *tf_time = NULL;
-    hsize_t dmt[3];
-    r->vis_v = cf_h5_read_all(f, "/visual/vertices", H5T_NATIVE_DOUBLE, 8, &rk, dv);
-    r->vis_tri = cf_h5_read_all(f, "/visual/triangles", H5T_NATIVE_INT, 4, &rk, dvt);
-    r->vis_tet = cf_h5_read_all(f, "/visual/tet", H5T_NATIVE_INT, 4, &rk, dn);
     if (r->vis_v && r->vis_tri && r->vis_tet) {
-        r->n_vis = (int)dvt[0];
+        r->n_vis = (int)dims[VIS_TRI][0];
         tf = cf_h5_read_all(f, "/mesh/tet_fragment/value", H5T_NATIVE_INT, 4, &rk, dmap);
         tf_time = cf_h5_read_all(f, "/mesh/tet_fragment/time", H5T_NATIVE_DOUBLE, 8, &rk, dmt);
     }
@@ -140,8 +153,8 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
         return cf_error_set(err, CF_ERR_MESH_PARSE, "%s holds no frames (/particles/fragments)",
                             path);
     /* Complete frames only (a killed run may leave one partial row). */
-    r->T = dt[0] < d[0] ? dt[0] : d[0];
-    r->N = d[1], r->nn = dx[0], r->M = dtr[0], r->nf = (int)dfs[0];
+    r->T = dims[TIME][0] < dims[ID][0] ? dims[TIME][0] : dims[ID][0];
+    r->N = dims[ID][1], r->nn = dims[X][0], r->M = dims[TRI][0], r->nf = (int)dims[FIRST][0];
     cf_status st = CF_OK;
     if (tf && tf_time &&
         own_visual(r, tf, tf_time, dmap[0] < dmt[0] ? dmap[0] : dmt[0], dmap[1]) != 0)
