@@ -20,7 +20,8 @@ grep '^fragments' "$tmp/run.txt"
 "$exe" export "$tmp/box.h5" --format pvd -o "$tmp/pvd"
 /usr/bin/python3 - "$tmp/box.h5" "$tmp/pvd" "$src/tools" <<'PY'
 # The ParaView series: a .vtu per frame whose cells carry every alive
-# fragment (read back with meshio), and a .pvd that lists them.
+# fragment (read back with meshio), their velocity field, and a .pvd that
+# lists them.
 import os, sys
 sys.path.insert(0, sys.argv[3])
 import meshio, numpy as np, cohfrac_h5
@@ -29,6 +30,17 @@ for k in (0, len(run.times) - 1):
     m = meshio.read(os.path.join(sys.argv[2], f"frame_{k:04d}.vtu"))
     got = sorted(set(np.concatenate(m.cell_data["fragment"]).tolist()))
     assert got == sorted(run.alive(k)), (k, got, run.alive(k))
+    # velocity: each fragment's rigid motion at its vertices, from the file
+    import h5py
+    w = h5py.File(sys.argv[1])["particles/fragments/angular_velocity/value"][k]
+    fid = np.concatenate(m.cell_data["fragment"])
+    tri = m.cells_dict["triangle"]
+    for i in got:
+        vs = np.unique(tri[fid == i])
+        want = run.velocity[k, i] + np.cross(w[i], m.points[vs] - run.position[k, i])
+        err = np.abs(m.point_data["velocity"][vs] - want).max()
+        assert err <= 1e-9 * (1 + np.abs(want).max()), (k, i, err)
+    assert set(m.cell_data) >= {"fragment", "crack", "mode", "mass"}, m.cell_data.keys()
 print(f"pvd: frames 0 and {len(run.times) - 1} hold the alive fragments "
       f"({len(run.alive(0))} and {len(run.alive(-1))})")
 PY

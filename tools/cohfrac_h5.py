@@ -150,31 +150,44 @@ def read_obstacles(params):
                  **{k: v[j] for k, v in vec.items()}) for j, t in enumerate(types)]
 
 
+CELL_FIELDS = {"fragment": np.int32, "crack": np.int32, "mode": np.int32, "mass": np.float64}
+
+
 def export_pvd(run, out_dir):
     """Write a ParaView time series: out_dir/frame_NNNN.vtu (every alive
-    fragment's posed surface as triangles, cell data `fragment` and `crack`,
-    through meshio) and out_dir/<name>.pvd listing them with their times.
+    fragment's posed surface as triangles, through meshio) and
+    out_dir/<name>.pvd listing them with their times.  Point data
+    `velocity` (m s-1: the fragment's rigid motion v + w x (x - com) at
+    each vertex); cell data `fragment` (id), `crack` (1 on crack faces),
+    `mode` (0 rigid, 1 fracture) and `mass` (kg, the fragment's).
     Returns the .pvd path."""
+    import h5py
     import meshio
     import os
     from xml.sax.saxutils import quoteattr
+    with h5py.File(run.path, "r") as f:
+        omega = f["particles/fragments/angular_velocity/value"][:len(run.times)]
     os.makedirs(out_dir, exist_ok=True)
     entries = []
     for k, t in enumerate(run.times):
-        pts, tris, fid, crack, base = [], [], [], [], 0
+        pts, tris, vel, cells, base = [], [], [], {n: [] for n in CELL_FIELDS}, 0
         for i, verts, tri, cr in run.surfaces_at(k):
             pts.append(verts)
             tris.append(tri + base)
-            fid.append(np.full(len(tri), i, np.int32))
-            crack.append(cr.astype(np.int32))
+            com = run.position[k, i]
+            vel.append(run.velocity[k, i] + np.cross(omega[k, i], verts - com))
+            for n, v in (("fragment", i), ("mode", run.mode[k, i]),
+                         ("mass", run.fragments["mass"][i])):
+                cells[n].append(np.full(len(tri), v, CELL_FIELDS[n]))
+            cells["crack"].append(cr.astype(np.int32))
             base += len(verts)
         if not pts:
             continue
         name = f"frame_{k:04d}.vtu"
         meshio.write(os.path.join(out_dir, name),
                      meshio.Mesh(np.concatenate(pts), [("triangle", np.concatenate(tris))],
-                                 cell_data={"fragment": [np.concatenate(fid)],
-                                            "crack": [np.concatenate(crack)]}),
+                                 point_data={"velocity": np.concatenate(vel)},
+                                 cell_data={n: [np.concatenate(v)] for n, v in cells.items()}),
                      binary=True)
         entries.append(f'    <DataSet timestep="{t:.9g}" file={quoteattr(name)}/>')
     pvd = os.path.join(out_dir, (run.name or "run") + ".pvd")
