@@ -162,6 +162,13 @@ double cf_world_dt_cfl(const cf_world *sim);
  * INFINITY for a mesh without tets, NaN when a tet is degenerate. */
 double cf_mesh_dt_cfl(const cf_mesh *m, double scale, const cf_material *mat);
 
+/* Where body b puts points x [n][3] given in its mesh's file units, as
+ * cf_world_create places the mesh's nodes: out = position + scale R (x - c),
+ * R the body's orientation and c the bounding-box centre of `mesh`'s nodes
+ * (m).  out may be x. */
+void cf_body_place(const cf_body_def *b, const cf_mesh *mesh, const double *x, int n,
+                   double *out);
+
 /* The energy ledger and momenta now. */
 void cf_world_ledger(const cf_world *sim, cf_ledger *out);
 

@@ -28,19 +28,19 @@ static cf_status bullet_error(cf_error *err, const char *what)
                         "Bullet, %s: %s", what, why);
 }
 
-/* Place a body's mesh: x' = position + scale R (x - bbox centre). */
-static void place_mesh(cf_mesh *m, const cf_body_def *b)
+void cf_body_place(const cf_body_def *b, const cf_mesh *mesh, const double *x, int n,
+                   double *out)
 {
     double lo[3], hi[3];
-    points_bbox(m->x, m->n_nodes, lo, hi);
+    points_bbox(mesh->x, mesh->n_nodes, lo, hi);
     double c[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])}, R[9];
     quat_to_mat(b->orientation, R);
-    for (int i = 0; i < m->n_nodes; i++) {
+    for (int i = 0; i < n; i++) {
         double r[3], y[3];
-        v3_sub(&m->x[3 * i], c, r);
+        v3_sub(&x[3 * i], c, r);
         m3_mulv(R, r, y);
         for (int k = 0; k < 3; k++)
-            m->x[3 * i + k] = b->position[k] + b->scale * y[k];
+            out[3 * i + k] = b->position[k] + b->scale * y[k];
     }
 }
 
@@ -133,7 +133,7 @@ static cf_status load_bodies(const cf_world_def *sc, cf_mesh *all, int **body, i
         st = copy_mesh(&sc->bodies[b], b, &m, err);
         if (st != CF_OK)
             break;
-        place_mesh(&m, &sc->bodies[b]);
+        cf_body_place(&sc->bodies[b], &m, m.x, m.n_nodes, m.x);
         size_t nn = (size_t)(all->n_nodes + m.n_nodes), nt = (size_t)(all->n_tets + m.n_tets);
         double *x = realloc(all->x, nn * 3 * sizeof(double));
         if (x)

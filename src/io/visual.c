@@ -1,6 +1,7 @@
 /* A body's visual surface embedded in the rest tets (see visual.h). */
 #include "visual.h"
 
+#include "cohfrac/world.h"
 #include "linalg.h"
 
 #include <math.h>
@@ -163,10 +164,6 @@ cf_status cf_visual_embed(const cf_world_def *def, const cf_world_meshes *meshes
             cf_error_set(err, st, "bodies[%d].visual: %s", b + 1, why);
             break;
         }
-        const cf_mesh *m = &meshes->bodies[b];
-        double lo[3], hi[3], R[9];
-        points_bbox(m->x, m->n_nodes, lo, hi);
-        quat_to_mat(bd->orientation, R);
         int v0 = out->n_vertices, t0 = out->n_triangles;
         double *V = realloc(out->vertices, 3 * sizeof(double) * ((size_t)v0 + s.n_verts + 1));
         if (V)
@@ -182,14 +179,7 @@ cf_status cf_visual_embed(const cf_world_def *def, const cf_world_meshes *meshes
             st = cf_error_set(err, CF_ERR_NOMEM, "out of memory for the visual surface");
             break;
         }
-        for (int i = 0; i < s.n_verts; i++) {
-            double r[3], y[3];
-            for (int k = 0; k < 3; k++)
-                r[k] = s.v[3 * i + k] - 0.5 * (lo[k] + hi[k]);
-            m3_mulv(R, r, y);
-            for (int k = 0; k < 3; k++)
-                V[3 * (v0 + i) + k] = bd->position[k] + bd->scale * y[k];
-        }
+        cf_body_place(bd, &meshes->bodies[b], s.v, s.n_verts, &V[3 * v0]); /* as the mesh */
         for (int i = 0; i < s.n_tris; i++) {
             double c[3] = {0, 0, 0};
             for (int j = 0; j < 3; j++) {
