@@ -30,7 +30,9 @@
 
 #include "clock.h"
 #include "file_text.h"
+#include "linalg.h"
 #include "process.h"
+#include "sort.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/surface.h"
 
@@ -301,12 +303,6 @@ static cf_status check_intersections(const cf_surface *s, const char *what, int 
                         what, list);
 }
 
-static int by_double(const void *x, const void *y)
-{
-    double a = *(const double *)x, b = *(const double *)y;
-    return (a > b) - (a < b);
-}
-
 /* The widest span of a surface that tetgen meshes in double precision,
  * against its short edges: beyond it a stray vertex (one at 1e10 in a file
  * of metres) has stretched the box, and tetgen's predicates lose the small
@@ -328,14 +324,11 @@ static cf_status check_span(const cf_surface *s, const char *what, cf_error *err
             len[3 * t + k] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
                                   (a[2] - b[2]) * (a[2] - b[2]));
         }
-    qsort(len, (size_t)ne, sizeof *len, by_double);
+    cf_doubles_sort(len, ne);
     double edge = ne > 0 ? len[ne / 10] : 0;
     free(len);
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i < s->n_verts; i++)
-        for (int k = 0; k < 3; k++)
-            lo[k] = fmin(lo[k], s->v[3 * i + k]), hi[k] = fmax(hi[k], s->v[3 * i + k]);
-    double span = 0;
+    double lo[3], hi[3], span = 0;
+    points_bbox(s->v, s->n_verts, lo, hi);
     for (int k = 0; k < 3; k++)
         span = fmax(span, hi[k] - lo[k]);
     if (!(span <= CF_SURFACE_SPAN_RATIO * edge) || !isfinite(span)) {
@@ -347,7 +340,7 @@ static cf_status check_span(const cf_surface *s, const char *what, cf_error *err
         for (int k = 0; k < 3; k++) {
             for (int i = 0; i < s->n_verts; i++)
                 x[i] = s->v[3 * i + k];
-            qsort(x, (size_t)s->n_verts, sizeof *x, by_double);
+            cf_doubles_sort(x, s->n_verts);
             c[k] = x[s->n_verts / 2];
         }
         free(x);
