@@ -204,6 +204,20 @@ static int real_arg(const char *opt, const char *text, double lo, double *out)
     return 0;
 }
 
+/* A slow-motion factor (render, export): a number > 0, or -1 with a
+ * message. */
+static int slow_motion_arg(const char *text, double *out)
+{
+    if (real_arg("--slow-motion", text, 0, out))
+        return -1;
+    if (!(*out > 0)) {
+        fprintf(stderr, "cohfrac: --slow-motion needs a factor > 0 (1: real time), got '%s'\n",
+                text);
+        return -1;
+    }
+    return 0;
+}
+
 /* The signal that asked a run or a mesh preparation to stop (0: none). */
 static volatile sig_atomic_t stop_signal = 0;
 
@@ -669,10 +683,8 @@ static int cmd_render(int argc, char **argv)
             *(c == 'a' ? &from : &to) = optarg;
             break;
         case 'm':
-            if (real_arg("--slow-motion", optarg, 0, &v))
+            if (slow_motion_arg(optarg, &v))
                 return cf_status_exit_code(CF_ERR_USAGE);
-            if (!(v > 0))
-                return usage_error("--slow-motion needs a factor > 0 (1: real time)");
             slow = optarg;
             break;
         case 'e':
@@ -740,10 +752,8 @@ static int cmd_export(int argc, char **argv)
             break;
         case 'o': out = optarg; break;
         case 'S':
-            if (real_arg("--slow-motion", optarg, 0, &slow))
+            if (slow_motion_arg(optarg, &slow))
                 return cf_status_exit_code(CF_ERR_USAGE);
-            if (!(slow > 0))
-                return usage_error("--slow-motion needs a factor > 0 (1: real time)");
             break;
         default: return usage_error("bad option for 'export'");
         }
