@@ -158,7 +158,8 @@ def main():
             return 5
         script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "render_blender.py")
         cmd = ["xvfb-run", "-a", "blender", "-b", "-noaudio", "-P", script, "--", a.glb, out,
-               str(a.fps), str(w), str(h), repr(t0), repr(t1), repr(a.slow_motion),
+               str(a.fps), str(w), str(h), repr(t0), str(len(movie_times(a, t0, t1))),
+               repr(a.slow_motion),
                repr(floor[0]["point"][2]) if floor else "nan"]
         r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         n = len([f for f in os.listdir(out) if f.startswith("frame_")])
@@ -170,6 +171,12 @@ def main():
     return draw_matplotlib(a, run, out, w, h, t0, t1, floor)
 
 
+def movie_times(a, t0, t1):
+    """The run's time at each movie frame: t0 + k / (fps F), up to t1."""
+    n = int(np.floor((t1 - t0) * a.fps * a.slow_motion + 1e-9)) + 1
+    return t0 + np.arange(n) / (a.fps * a.slow_motion)
+
+
 def draw_matplotlib(a, run, out, w, h, t0, t1, floor):
     """The frames through matplotlib: a fixed camera on the whole run."""
     lo, hi = run.bounds()
@@ -179,8 +186,7 @@ def draw_matplotlib(a, run, out, w, h, t0, t1, floor):
         lo[2] = min(lo[2], floor[0]["point"][2])
     cmap = plt.get_cmap("tab20")
     # Movie frame k shows the output frame nearest t0 + k / (fps F).
-    n = int(np.floor((t1 - t0) * a.fps * a.slow_motion + 1e-9)) + 1
-    want = t0 + np.arange(n) / (a.fps * a.slow_motion)
+    want = movie_times(a, t0, t1)
     frames = [int(np.argmin(np.abs(run.times - t))) for t in want]
     dpi = 100
     for k, fr in enumerate(frames):

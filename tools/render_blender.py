@@ -3,10 +3,10 @@ with depth, lighting and shadows (Workbench), from a camera that follows
 the pieces.  Run by tools/render.py:
 
     xvfb-run -a blender -b -P tools/render_blender.py -- \
-        RUN.glb OUT_DIR FPS W H T0 T1 SLOW FLOOR_Z
+        RUN.glb OUT_DIR FPS W H T0 N SLOW FLOOR_Z
 
 Writes OUT_DIR/frame_0000.png ...: movie frame k shows the run at
-t = T0 + k / (FPS * SLOW) s, for t up to T1.  The camera looks from the
+t = T0 + k / (FPS * SLOW) s, for k < N.  The camera looks from the
 side and above (+z up) at the mass-weighted centre of the pieces shown,
 from as far as keeps the pieces that carry 95 % of the mass in view (it
 backs off at once and closes in slowly, so it does not jitter); before
@@ -24,7 +24,7 @@ import mathutils
 args = sys.argv[sys.argv.index("--") + 1:]
 glb, out_dir = args[0], args[1]
 fps, width, height = float(args[2]), int(args[3]), int(args[4])
-t0, t1, slow, floor_z = (float(x) for x in args[5:9])
+t0, n_frames, slow, floor_z = float(args[5]), int(args[6]), float(args[7]), float(args[8])
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
 # Flat shading: the default of Debian's Blender 3.4 fails with numpy 1.24
@@ -83,7 +83,6 @@ def shown():
 
 
 os.makedirs(out_dir, exist_ok=True)
-n_frames = max(1, int(math.floor((t1 - t0) * fps * slow + 1e-9)) + 1)
 radius, target = None, None
 for k in range(n_frames):
     t = t0 + k / (fps * slow)
