@@ -1364,42 +1364,21 @@ cf_status cf_h5_add_surfaces(cf_h5 *h, const int *tris, const int *crack, int m,
     return st;
 }
 
-/* A dataset written whole, once: rows x cols of doubles or ints. */
-typedef struct whole_dataset {
-    const char *name;
-    int is_double;
-    int cols;
-    hsize_t rows;
-    const void *data;
-    const char *unit; /* NULL: none */
-} whole_dataset;
-
-/* Creates and fills each of d[0..n) in group g; 0, or -1 on an HDF5
- * failure (every dataset opened is closed either way). */
-static int write_whole(hid_t g, const whole_dataset *d, int n)
-{
-    int ok = g >= 0, ignored = 0;
-    for (int i = 0; i < n && ok; i++) {
-        hid_t ds = create_rows(g, d[i].name, d[i].is_double ? H5T_IEEE_F64LE : H5T_STD_I32LE,
-                               d[i].cols);
-        ok = ds >= 0 && (!d[i].unit || write_unit(ds, d[i].unit) == 0) &&
-             append_rows(ds, 0, d[i].rows, d[i].is_double ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT,
-                         d[i].data) == 0;
-        close_dataset(&ds, &ignored);
-    }
-    return ok ? 0 : -1;
-}
-
 static cf_status write_rest_mesh_impl(cf_h5 *h, const double *X, int n, const int *tets, int nt,
                                       cf_error *err)
 {
     if (!h || n < 0 || nt < 0)
         return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_write_rest_mesh: bad arguments");
-    const whole_dataset d[] = {{"nodes", 1, 3, (hsize_t)n, X, "m"},
-                               {"tets", 0, 4, (hsize_t)nt, tets, NULL}};
     hid_t mesh = make_group(h->file, "mesh");
     hid_t rest = mesh >= 0 ? make_group(mesh, "rest") : H5I_INVALID_HID;
-    int ok = write_whole(rest, d, 2) == 0;
+    hid_t dn = rest >= 0 ? create_rows(rest, "nodes", H5T_IEEE_F64LE, 3) : H5I_INVALID_HID;
+    hid_t dt = rest >= 0 ? create_rows(rest, "tets", H5T_STD_I32LE, 4) : H5I_INVALID_HID;
+    int ok = dn >= 0 && dt >= 0 && write_unit(dn, "m") == 0 &&
+             append_rows(dn, 0, (hsize_t)n, H5T_NATIVE_DOUBLE, X) == 0 &&
+             append_rows(dt, 0, (hsize_t)nt, H5T_NATIVE_INT, tets) == 0;
+    int ignored = 0;
+    close_dataset(&dn, &ignored);
+    close_dataset(&dt, &ignored);
     if (rest >= 0)
         H5Gclose(rest);
     if (mesh >= 0)
@@ -1422,11 +1401,18 @@ cf_status cf_h5_write_rest_mesh(cf_h5 *h, const double *X, int n, const int *tet
 static cf_status write_visual_impl(cf_h5 *h, const double *V, int nv, const int *tri,
                                    const int *tet, int nt, cf_error *err)
 {
-    const whole_dataset d[] = {{"vertices", 1, 3, (hsize_t)nv, V, "m"},
-                               {"triangles", 0, 3, (hsize_t)nt, tri, NULL},
-                               {"tet", 0, 1, (hsize_t)nt, tet, NULL}};
     hid_t g = make_group(h->file, "visual");
-    int ok = write_whole(g, d, 3) == 0;
+    hid_t dv = g >= 0 ? create_rows(g, "vertices", H5T_IEEE_F64LE, 3) : H5I_INVALID_HID;
+    hid_t dt = g >= 0 ? create_rows(g, "triangles", H5T_STD_I32LE, 3) : H5I_INVALID_HID;
+    hid_t de = g >= 0 ? create_rows(g, "tet", H5T_STD_I32LE, 1) : H5I_INVALID_HID;
+    int ok = dv >= 0 && dt >= 0 && de >= 0 && write_unit(dv, "m") == 0 &&
+             append_rows(dv, 0, (hsize_t)nv, H5T_NATIVE_DOUBLE, V) == 0 &&
+             append_rows(dt, 0, (hsize_t)nt, H5T_NATIVE_INT, tri) == 0 &&
+             append_rows(de, 0, (hsize_t)nt, H5T_NATIVE_INT, tet) == 0;
+    int ignored = 0;
+    close_dataset(&dv, &ignored);
+    close_dataset(&dt, &ignored);
+    close_dataset(&de, &ignored);
     if (g >= 0)
         H5Gclose(g);
     if (!ok)
