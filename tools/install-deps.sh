@@ -6,7 +6,7 @@ PKGS="gcc g++ make cmake pkg-config libbullet-dev libbullet-extras-dev libccd-de
       libhdf5-dev libcmocka-dev liblua5.4-dev tetgen gmsh glmark2-data python3 python3-h5py
       python3-numpy python3-matplotlib ffmpeg libtinygltf-dev nlohmann-json3-dev
       blender python3-meshio paraview python3-paraview xvfb
-      clang libomp-dev libassimp-dev libmeshoptimizer-dev
+      clang libomp-dev libassimp-dev libmeshoptimizer-dev libcgal-dev
       libopenmpi-dev openmpi-bin metis"
 missing=""
 for p in $PKGS; do

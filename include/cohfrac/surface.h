@@ -82,6 +82,23 @@ int cf_surface_remove_unused(cf_surface *s);
  * indices, in `why` if non-NULL), -1 out of memory. */
 int cf_surface_check_closed(const cf_surface *s, char *why, size_t why_len);
 
+/* Repair a surface that is not a closed manifold or intersects itself, with
+ * CGAL's Polygon Mesh Processing (bullet_bridge/cf_cgal.h, Debian
+ * libcgal-dev): equal points joined, degenerate and repeated triangles
+ * removed, one orientation, non-manifold vertices split, holes closed, and
+ * intersecting triangles cut along their intersections with the parts
+ * inside the enclosed volume removed (overlapping closed parts become the
+ * surface of their union).  `s` is replaced; `report` (len bytes) says what
+ * changed, one line.  CF_ERR_MESH_PARSE when CGAL cannot repair it,
+ * CF_ERR_NOMEM.  The result is rounded to double: check it again. */
+cf_status cf_surface_repair(cf_surface *s, char *report, size_t len, cf_error *err);
+
+/* Replace `s` by its alpha wrap (CGAL alpha_wrap_3, bullet_bridge/cf_cgal.h):
+ * a closed 2-manifold without self-intersections standing `offset` outside
+ * `s`, closed over features thinner than about `alpha` (file units, > 0).
+ * CF_ERR_MESH_PARSE when CGAL fails, CF_ERR_NOMEM. */
+cf_status cf_surface_wrap(cf_surface *s, double alpha, double offset, cf_error *err);
+
 /* Reduce to about `target_tris` triangles with meshoptimizer's
  * topology-preserving edge collapse (meshopt_simplify, Debian
  * libmeshoptimizer-dev: quadric error, no flipped triangles, the kept
@@ -111,6 +128,8 @@ typedef struct cf_mesh_prep_opts {
     const char *output;   /* output base: writes <output>.node/.ele */
     int target_tets;      /* approximate number of tets wanted (0: tetgen -pq default) */
     int verbose;          /* print what is done to stderr */
+    int no_repair;        /* 1: refuse an open or self-intersecting surface (after the
+                             valence-3 repair) instead of repairing it with CGAL */
     double time_limit;    /* s for the whole preparation; 0: CF_MESH_TIME_LIMIT */
     const volatile sig_atomic_t *stop; /* NULL, or a flag a signal handler raises: tetgen
                                           is stopped, the temporary files removed, and

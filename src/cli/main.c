@@ -61,13 +61,17 @@ static const struct {
      "      -q, --quiet                     no progress display\n"},
     {"mesh",
      "  cohfrac mesh SURFACE -o OUT [options]\n"
-     "                                      repair a closed surface (OBJ, OFF, STL, PLY,\n"
-     "                                      glTF, 3DS, FBX... read with assimp), run tetgen,\n"
-     "                                      write OUT.node/OUT.ele (cached)\n"
+     "                                      repair a surface (OBJ, OFF, STL, PLY, glTF, 3DS,\n"
+     "                                      FBX... read with assimp; CGAL closes holes and\n"
+     "                                      removes self-intersections, saying what it\n"
+     "                                      changed), run tetgen, write OUT.node/OUT.ele\n"
+     "                                      (cached)\n"
      "      -o, --output OUT                the TetGen base to write (OUT.node, OUT.ele)\n"
      "          --target-tets N             about this many tets (default: tetgen's own);\n"
      "                                      tetgen then adds at most N points (-S N)\n"
      "          --time-limit S              give up after S seconds (default 300)\n"
+     "          --no-repair                 refuse a surface that is open or intersects\n"
+     "                                      itself instead of repairing it with CGAL\n"
      "      -q, --quiet                     no progress lines\n"},
     {"study",
      "  cohfrac study SCENE.lua --vary KEY.PATH=V1,V2,... [options]\n"
@@ -249,6 +253,7 @@ static int cmd_mesh(int argc, char **argv)
     static const struct option lo[] = {{"output", required_argument, 0, 'o'},
                                        {"target-tets", required_argument, 0, 't'},
                                        {"time-limit", required_argument, 0, 'L'},
+                                       {"no-repair", no_argument, 0, 'R'},
                                        {"quiet", no_argument, 0, 'q'},
                                        {0, 0, 0, 0}};
     cf_mesh_prep_opts o = {0};
@@ -270,6 +275,7 @@ static int cmd_mesh(int argc, char **argv)
             if (!(o.time_limit > 0))
                 return usage_error("--time-limit needs a number of seconds > 0");
             break;
+        case 'R': o.no_repair = 1; break;
         case 'q': o.verbose = 0; break;
         default: return usage_error("bad option for 'mesh'");
         }

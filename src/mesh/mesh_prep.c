@@ -36,6 +36,8 @@
 #include "cohfrac/mesh.h"
 #include "cohfrac/surface.h"
 
+#include "cf_cgal.h"
+
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
@@ -53,7 +55,8 @@
 /* Bump when the pipeline changes in a way that changes its output, so old
  * cached meshes are rebuilt. */
 #define PREP_VERSION                                                                          \
-    "cohfrac-mesh 3 (assimp; repair valence3; meshoptimizer; tetgen -pYq2.0 [-a]; peel 0.25)"
+    "cohfrac-mesh 4 (assimp; repair valence3, CGAL; meshoptimizer, alpha wrap past 2x; "       \
+    "tetgen -pYq2.0 [-a]; peel 0.25)"
 #define TETS_PER_TRI 2.4 /* tetgen -pYq2.0 tets per surface triangle (bunny: 2.3-2.5) */
 #define BASE_OPTS "pYq2.0"
 #define TOL 0.05
@@ -118,9 +121,10 @@ static cf_status stamp_key(const cf_mesh_prep_opts *o, char *key, size_t n, cf_e
                             strerror(errno));
     char *real = realpath(o->input, NULL);
     snprintf(key, n,
-             "version %s\ninput %s\ninput_size %lld\ninput_mtime %lld.%09ld\ntarget_tets %d\n",
+             "version %s\ninput %s\ninput_size %lld\ninput_mtime %lld.%09ld\ntarget_tets %d\n%s",
              PREP_VERSION, real ? real : o->input, (long long)st.st_size,
-             (long long)st.st_mtim.tv_sec, (long)st.st_mtim.tv_nsec, o->target_tets);
+             (long long)st.st_mtim.tv_sec, (long)st.st_mtim.tv_nsec, o->target_tets,
+             o->no_repair ? "no_repair\n" : "");
     free(real);
     return CF_OK;
 }
@@ -363,9 +367,50 @@ static cf_status check_span(const cf_surface *s, const char *what, cf_error *err
     return CF_OK;
 }
 
-/* Load, repair, close-check and orient the input surface. */
-static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, cf_error *err)
+/* Replaces `s` by its alpha wrap at the size CGAL's repair uses
+ * (bullet_bridge/cf_cgal.h), saying why on stderr. */
+static cf_status wrap_whole(const cf_mesh_prep_opts *o, cf_surface *s, const char *why,
+                            cf_error *err)
 {
+    double lo[3], hi[3];
+    points_bbox(s->v, s->n_verts, lo, hi);
+    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double alpha = diag / CFC_WRAP_ALPHA_DIVISOR, offset = diag / CFC_WRAP_OFFSET_DIVISOR;
+    int n0 = s->n_tris;
+    cf_status st = cf_surface_wrap(s, alpha, offset, err);
+    if (st == CF_OK)
+        fprintf(stderr,
+                "cohfrac mesh: %s %s; wrapped it instead (CGAL alpha wrapping, alpha %.4g, "
+                "offset %.4g file units: the solid is that much larger all round); %d -> %d "
+                "triangles\n",
+                o->input, why, alpha, offset, n0, s->n_tris);
+    return st;
+}
+
+/* Repairs the surface with CGAL (cf_surface_repair) and says what changed,
+ * on stderr: a user must know that the mesh is not of the file as it was. */
+static cf_status repair_surface(const cf_mesh_prep_opts *o, cf_surface *s, const char *defect,
+                                cf_error *err)
+{
+    char report[512];
+    cf_error why;
+    cf_status st = cf_surface_repair(s, report, sizeof report, &why);
+    if (st != CF_OK)
+        return cf_error_set(err, st, "%s %s, and CGAL's repair failed: %s. Repair the surface "
+                            "in a modeller (close it, remove overlapping parts), then retry",
+                            o->input, defect, why.msg);
+    fprintf(stderr, "cohfrac mesh: %s %s; repaired with CGAL: %s\n", o->input, defect, report);
+    return CF_OK;
+}
+
+/* Load, repair, close-check and orient the input surface.  The cheap
+ * valence-3 repair goes first, so that surfaces it fixes mesh as before;
+ * what is still open or intersecting goes through CGAL's repair, once. */
+static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, int *repaired,
+                                    cf_error *err)
+{
+    *repaired = 0;
     cf_status st = cf_surface_load(o->input, s, err);
     if (st != CF_OK)
         return st;
@@ -395,10 +440,9 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, c
             fprintf(stderr, "  repair: removed %d valence-3 vertex(es); now %d vertices, %d "
                             "triangles\n",
                     r, s->n_verts, s->n_tris);
-        if ((st = check_intersections(s, o->input, v, err)) != CF_OK)
-            return st;
-        if (v)
-            fprintf(stderr, "  no intersections left\n");
+        n = cf_surface_self_intersections(s, pairs, 64);
+        if (n < 0)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     }
     if (cf_surface_remove_unused(s) < 0)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
@@ -406,11 +450,37 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, c
     int closed = cf_surface_check_closed(s, why, sizeof why);
     if (closed < 0)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    if ((n > 0 || !closed) && !o->no_repair) {
+        char defect[400];
+        if (n > 0)
+            snprintf(defect, sizeof defect, "intersects itself (%d%s pair(s) of faces)", n,
+                     n >= 64 ? " or more" : "");
+        else
+            snprintf(defect, sizeof defect, "is not a closed manifold surface (%s)", why);
+        if ((st = repair_surface(o, s, defect, err)) != CF_OK)
+            return st;
+        *repaired = 1;
+        /* Exact intersection points rounded to double can cross again. */
+        cf_error left;
+        if ((st = check_intersections(s, o->input, v, &left)) == CF_ERR_SURFACE_INTERSECT &&
+            (st = wrap_whole(o, s, "intersects itself again once the repair is rounded to "
+                                   "double", err)) == CF_OK)
+            st = check_intersections(s, o->input, v, &left);
+        if (st != CF_OK)
+            return cf_error_set(err, st, "after CGAL's repair, %s", left.msg);
+        if ((closed = cf_surface_check_closed(s, why, sizeof why)) < 0)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    }
+    if (n > 0 && o->no_repair)
+        return check_intersections(s, o->input, v, err);
     if (!closed)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
-                            "%s is not a closed manifold surface: %s (0-based indices). Close "
-                            "the holes and fix the orientation, then retry",
-                            o->input, why);
+                            "%s is not a closed manifold surface%s: %s (0-based indices). Close "
+                            "the holes and fix the orientation%s, then retry",
+                            o->input, o->no_repair ? "" : ", even after CGAL's repair", why,
+                            o->no_repair ? " (or drop --no-repair)" : "");
+    if (v)
+        fprintf(stderr, "  no intersections left\n");
     double vol = cf_surface_volume(s);
     if (vol < 0) {
         cf_surface_flip(s); /* inside-out: tetgen does not care, our volume check does */
@@ -436,20 +506,21 @@ static int more_tris(int tris)
 
 /* Decimate a copy of `full` to about `tris` triangles, without
  * self-intersections or folds: retried with 15 % more triangles each time
- * (meshoptimizer does not promise either), up to the full surface, which
- * is clean (load_clean_surface) and is then what `out` gets. */
-static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int verbose,
-                         cf_error *err)
+ * (meshoptimizer does not promise either) while the count stays below
+ * `limit`.  1 with `out` set when one was clean, 0 when none was, or -1
+ * with `err` set. */
+static int decimate_clean(const cf_surface *full, int tris, int limit, cf_surface *out,
+                          int verbose, cf_error *err)
 {
-    for (; tris < full->n_tris; tris = more_tris(tris)) {
-        cf_status st = copy_surface(full, out, err);
-        if (st != CF_OK)
-            return st;
+    for (; tris < limit; tris = more_tris(tris)) {
+        if (copy_surface(full, out, err) != CF_OK)
+            return -1;
         double t0 = cf_wall_time();
         int got = cf_surface_decimate(out, tris);
         if (got < 0) {
             cf_surface_free(out);
-            return cf_error_set(err, CF_ERR_NOMEM, "out of memory in decimation");
+            cf_error_set(err, CF_ERR_NOMEM, "out of memory in decimation");
+            return -1;
         }
         int n = cf_surface_self_intersections(out, NULL, 0);
         char why[300];
@@ -461,11 +532,77 @@ static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int 
                     got, out->n_verts, tris, cf_wall_time() - t0, cf_surface_volume(out), n,
                     closed == 0 ? "; folded (not a closed manifold)" : "");
         if (n == 0 && closed == 1)
-            return CF_OK;
+            return 1;
         cf_surface_free(out);
-        if (n < 0 || closed < 0)
-            return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+        if (n < 0 || closed < 0) {
+            cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+            return -1;
+        }
     }
+    return 0;
+}
+
+static double surface_area(const cf_surface *s)
+{
+    double a = 0;
+    for (int t = 0; t < s->n_tris; t++) {
+        const double *p = &s->v[3 * s->tri[3 * t]], *q = &s->v[3 * s->tri[3 * t + 1]],
+                     *r = &s->v[3 * s->tri[3 * t + 2]];
+        double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+        double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                       u[0] * w[1] - u[1] * w[0]};
+        a += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    }
+    return a;
+}
+
+/* A clean decimation that needs more than WRAP_AFTER times the triangles
+ * asked for means features (thin parts, close sheets) finer than the
+ * triangles asked for: tetgen would resolve them with tets far smaller than
+ * the rest, which set the explicit step.  The surface is then wrapped at
+ * that triangle size first (cf_surface_wrap), closing over them, and the
+ * wrap is decimated instead. */
+#define WRAP_AFTER 2.0
+
+/* Decimate `full` to about `tris` triangles without self-intersections or
+ * folds (decimate_clean); failing that within WRAP_AFTER times as many,
+ * its alpha wrap at the edge length of `tris` equilateral triangles over
+ * its area (offset a thirtieth of that, CGAL's advice); failing that, with
+ * more triangles up to the full surface, which is clean
+ * (load_clean_surface) and is then what `out` gets.  No wrap unless
+ * `may_wrap` (--no-repair keeps the surface's shape). */
+static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int may_wrap,
+                         int verbose, cf_error *err)
+{
+    int got = decimate_clean(full, tris, (int)fmin(full->n_tris, WRAP_AFTER * tris), out,
+                             verbose, err);
+    if (got != 0)
+        return got > 0 ? CF_OK : err->code;
+    if (may_wrap && WRAP_AFTER * tris < full->n_tris) {
+        double edge = sqrt(4.0 * surface_area(full) / (sqrt(3.0) * tris));
+        cf_surface w = {0};
+        cf_status st = copy_surface(full, &w, err);
+        if (st == CF_OK)
+            st = cf_surface_wrap(&w, edge, edge / 30.0, err);
+        if (st == CF_OK) {
+            got = decimate_clean(&w, tris, w.n_tris, out, verbose, err);
+            if (got > 0)
+                fprintf(stderr,
+                        "cohfrac mesh: the surface cannot be decimated to %d triangles without "
+                        "intersecting itself (parts thinner than its triangles): wrapped it "
+                        "first (CGAL alpha wrapping, alpha %.4g, offset %.4g file units)\n",
+                        tris, edge, edge / 30.0);
+        }
+        cf_surface_free(&w);
+        if (st == CF_ERR_NOMEM || got < 0)
+            return err->code;
+        if (got > 0)
+            return CF_OK;
+        tris = (int)(WRAP_AFTER * tris);
+    }
+    if ((got = decimate_clean(full, tris, full->n_tris, out, verbose, err)) != 0)
+        return got > 0 ? CF_OK : err->code;
     if (verbose)
         fprintf(stderr, "  no decimation without intersections or folds: the full surface (%d "
                         "triangles) is used\n",
@@ -556,7 +693,7 @@ static cf_status fit_size(const cf_surface *s, const prep *p, trial *best, cf_su
         }
         if (n_tris < s->n_tris) {
             cf_surface_free(dec);
-            if ((st = coarsen(s, n_tris < 8 ? 8 : n_tris, dec, verbose, err)) != CF_OK)
+            if ((st = coarsen(s, n_tris < 8 ? 8 : n_tris, dec, !p->o->no_repair, verbose, err)) != CF_OK)
                 break;
             cur = dec;
         } else {
@@ -735,6 +872,68 @@ static cf_status write_stamp(const cf_mesh_prep_opts *o, const char *key, const 
     return st;
 }
 
+/* Tetgen on the clean surface `s` (to the target, fit_size), the tets
+ * oriented and checked (non-degenerate, filling the surface's volume):
+ * *best, on *used (s or its decimation, kept in *dec). */
+static cf_status tetrahedralise(const prep *p, const cf_surface *s, trial *best, cf_surface *dec,
+                                const cf_surface **used, cf_error *err)
+{
+    const cf_mesh_prep_opts *o = p->o;
+    cf_status st;
+    if (o->target_tets == 0) {
+        char off[PATH_MAX];
+        snprintf(off, sizeof off, "%s/surf.off", p->dir);
+        if ((st = cf_surface_write_off(s, off, err)) != CF_OK ||
+            (st = tetgen_trial(p, "pqF", best, err)) != CF_OK)
+            return st;
+    } else if ((st = fit_size(s, p, best, dec, used, err)) != CF_OK) {
+        return st;
+    }
+    double off_by = o->target_tets > 0 ? (double)best->m.n_tets / o->target_tets - 1 : 0;
+    if (fabs(off_by) > MISS_ALLOWED) /* the closest valid mesh is kept, and said to be off */
+        fprintf(stderr,
+                "cohfrac mesh: warning: --target-tets %d missed by more than %.0f%% for %s: "
+                "kept the closest mesh tetgen made, %d tets (%+.0f%%; %s).  Ask for about %d "
+                "to make it again without this warning, or 0 for tetgen's own choice\n",
+                o->target_tets, 100 * MISS_ALLOWED, o->input, best->m.n_tets, 100 * off_by,
+                off_by > 0 ? "thin parts need smaller tets than that at tetgen's quality bound"
+                           : "refining further needs more points than --target-tets allows "
+                             "tetgen to add",
+                best->m.n_tets);
+
+    /* Orientation: flip what tetgen wrote the other way round, then insist
+     * on positive, non-degenerate tets. */
+    int flipped = cf_mesh_orient_positive(&best->m);
+    if (o->verbose)
+        fprintf(stderr, "  orientation: %d of %d tets flipped to det[x1-x0,x2-x0,x3-x0] > 0\n",
+                flipped, best->m.n_tets);
+    double vs = cf_surface_volume(*used), vm = cf_mesh_volume(&best->m);
+    double rel = fabs(vm - vs) / vs;
+    if (o->verbose)
+        fprintf(stderr, "  volume: tets %.12g, surface %.12g (relative difference %.2g)\n", vm,
+                vs, rel);
+    if (!(rel <= 1e-5)) /* round-off is 1e-16 with -Y, ~1e-6 where tetgen splits facets */
+        return cf_error_set(err, CF_ERR_EXTERNAL,
+                            "tetgen -%s: tet volume %.12g differs from the surface's enclosed "
+                            "volume %.12g by %.2g (relative): tetgen did not fill the surface; "
+                            "check the surface is closed and does not intersect itself",
+                            best->opts, vm, vs, rel);
+    /* Boundary caps set the explicit step where -Y keeps the surface
+     * (src/mesh/mesh_quality.c); peeling them changes the volume by theirs.
+     * Flat caps on nearly coplanar facets go with them, before the check. */
+    int peeled;
+    double peeled_volume;
+    if ((st = cf_mesh_peel_slivers(&best->m, PEEL_FRACTION, &peeled, &peeled_volume, err)) !=
+        CF_OK)
+        return st;
+    if (o->verbose)
+        fprintf(stderr,
+                "  slivers: %d boundary cap(s) thinner than %.2g x the median tet peeled "
+                "(%.2g of the volume)\n",
+                peeled, PEEL_FRACTION, peeled_volume / vm);
+    return cf_mesh_check(&best->m, "tetgen output", err);
+}
+
 cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
 {
     if (!o || !o->input || !o->output || !*o->output)
@@ -765,7 +964,8 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
     const cf_surface *used = &s;
     trial best = {{0}, {0}};
     char dir[512] = ""; /* short, so every path built from it fits PATH_MAX */
-    if ((st = load_clean_surface(o, &s, err)) != CF_OK)
+    int repaired;
+    if ((st = load_clean_surface(o, &s, &repaired, err)) != CF_OK)
         goto out;
     const char *tmpdir = getenv("TMPDIR");
     if (!tmpdir || !*tmpdir || strlen(tmpdir) > 400)
@@ -779,62 +979,25 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
     }
     double limit = o->time_limit > 0 ? o->time_limit : CF_MESH_TIME_LIMIT;
     prep pr = {o, dir, limit, t_start + limit};
-    if (o->target_tets == 0) {
-        char off[PATH_MAX];
-        snprintf(off, sizeof off, "%s/surf.off", dir);
-        if ((st = cf_surface_write_off(&s, off, err)) != CF_OK ||
-            (st = tetgen_trial(&pr, "pqF", &best, err)) != CF_OK)
-            goto out;
-    } else if ((st = fit_size(&s, &pr, &best, &dec, &used, err)) != CF_OK) {
-        goto out;
+    st = tetrahedralise(&pr, &s, &best, &dec, &used, err);
+    if ((st == CF_ERR_MESH_PARSE || st == CF_ERR_MESH_INVERTED || st == CF_ERR_EXTERNAL) &&
+        repaired && !o->no_repair &&
+        cf_wall_time() < pr.deadline) {
+        /* The union or autorefinement leaves slivers of triangles along the
+         * cuts, which tetgen can turn into flat tets or crash on. */
+        char why[1200];
+        snprintf(why, sizeof why, "as repaired, gives tetgen trouble (%s)", err->msg);
+        cf_mesh_free(&best.m);
+        best = (trial){{0}, {0}};
+        cf_surface_free(&dec);
+        used = &s;
+        if ((st = wrap_whole(o, &s, why, err)) == CF_OK)
+            st = tetrahedralise(&pr, &s, &best, &dec, &used, err);
     }
-    double off_by = o->target_tets > 0 ? (double)best.m.n_tets / o->target_tets - 1 : 0;
-    if (fabs(off_by) > MISS_ALLOWED) /* the closest valid mesh is kept, and said to be off */
-        fprintf(stderr,
-                "cohfrac mesh: warning: --target-tets %d missed by more than %.0f%% for %s: "
-                "kept the closest mesh tetgen made, %d tets (%+.0f%%; %s).  Ask for about %d "
-                "to make it again without this warning, or 0 for tetgen's own choice\n",
-                o->target_tets, 100 * MISS_ALLOWED, o->input, best.m.n_tets, 100 * off_by,
-                off_by > 0 ? "thin parts need smaller tets than that at tetgen's quality bound"
-                           : "refining further needs more points than --target-tets allows "
-                             "tetgen to add",
-                best.m.n_tets);
-
-    /* Orientation: flip what tetgen wrote the other way round, then insist
-     * on positive, non-degenerate tets. */
-    int flipped = cf_mesh_orient_positive(&best.m);
+    if (st != CF_OK)
+        goto out;
     if (o->verbose)
-        fprintf(stderr, "  orientation: %d of %d tets flipped to det[x1-x0,x2-x0,x3-x0] > 0\n",
-                flipped, best.m.n_tets);
-    if ((st = cf_mesh_check(&best.m, "tetgen output", err)) != CF_OK)
-        goto out;
-    double vs = cf_surface_volume(used), vm = cf_mesh_volume(&best.m);
-    double rel = fabs(vm - vs) / vs;
-    if (o->verbose)
-        fprintf(stderr, "  volume: tets %.12g, surface %.12g (relative difference %.2g)\n", vm,
-                vs, rel);
-    if (!(rel <= 1e-5)) { /* round-off is 1e-16 with -Y, ~1e-6 where tetgen splits facets */
-        st = cf_error_set(err, CF_ERR_EXTERNAL,
-                          "tetgen -%s: tet volume %.12g differs from the surface's enclosed "
-                          "volume %.12g by %.2g (relative): tetgen did not fill the surface; "
-                          "check the surface is closed and does not intersect itself",
-                          best.opts, vm, vs, rel);
-        goto out;
-    }
-    /* Boundary caps set the explicit step where -Y keeps the surface
-     * (src/mesh/mesh_quality.c); peeling them changes the volume by theirs. */
-    int peeled;
-    double peeled_volume;
-    if ((st = cf_mesh_peel_slivers(&best.m, PEEL_FRACTION, &peeled, &peeled_volume, err)) !=
-        CF_OK)
-        goto out;
-    if (o->verbose) {
-        fprintf(stderr,
-                "  slivers: %d boundary cap(s) thinner than %.2g x the median tet peeled "
-                "(%.2g of the volume)\n",
-                peeled, PEEL_FRACTION, peeled_volume / vm);
         report_quality(&best.m);
-    }
     if ((st = cf_mesh_write_tetgen(&best.m, o->output, err)) != CF_OK ||
         (st = write_stamp(o, key, best.opts, used->n_tris, &best.m, err)) != CF_OK)
         goto out;

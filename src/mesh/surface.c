@@ -1,6 +1,7 @@
 /* cohfrac — closed triangle surfaces: input through assimp, OFF output,
  * enclosed volume, closedness, self-intersection search, the valence-3
- * repair of docs/scenes.md and decimation through meshoptimizer. */
+ * repair of docs/scenes.md, the general repair through CGAL and
+ * decimation through meshoptimizer. */
 #include "cohfrac/surface.h"
 
 #include <errno.h>
@@ -11,12 +12,18 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <meshoptimizer.h>
+
+#include "cf_cgal.h" /* the report's codes and sizes only: CGAL runs in cohfrac-repair */
+#include "file_text.h"
+#include "process.h"
+#include "surface_raw.h"
 
 /* ====================================================================== */
 /* Input through assimp                                                   */
@@ -982,6 +989,130 @@ int cf_surface_repair_valence3(cf_surface *s)
             break;
     }
     return removed;
+}
+
+/* ====================================================================== */
+/* General repair (CGAL, through cohfrac-repair)                          */
+/* ====================================================================== */
+
+/* The program: $COHFRAC_REPAIR, else the build tree's cohfrac-repair while
+ * it exists, else the installed one (libexec/cohfrac). */
+static const char *repair_program(void)
+{
+    const char *env = getenv("COHFRAC_REPAIR");
+    if (env && *env)
+        return env;
+    if (access(COHFRAC_REPAIR_BUILT, X_OK) == 0)
+        return COHFRAC_REPAIR_BUILT;
+    return COHFRAC_REPAIR_INSTALLED;
+}
+
+/* Runs cohfrac-repair with `args` (NULL-terminated, at most 4) on `s`,
+ * replacing it by the result; the program's report line into report. */
+static cf_status run_repair(cf_surface *s, const char *const *args, char *report, size_t len,
+                            cf_error *err)
+{
+    const char *tmpdir = getenv("TMPDIR");
+    char dir[512];
+    snprintf(dir, sizeof dir, "%s/cohfrac-repair-XXXXXX",
+             tmpdir && *tmpdir && strlen(tmpdir) < 400 ? tmpdir : "/tmp");
+    if (!mkdtemp(dir))
+        return cf_error_set(err, CF_ERR_OUTPUT, "cannot create a temporary directory %s (%s)",
+                            dir, strerror(errno));
+    char in[600], out[600], log[600];
+    snprintf(in, sizeof in, "%s/in.surf", dir);
+    snprintf(out, sizeof out, "%s/out.surf", dir);
+    snprintf(log, sizeof log, "%s/log", dir);
+    const char *prog = repair_program();
+    char *argv[8] = {(char *)prog};
+    int a = 1;
+    for (; args[a - 1]; a++)
+        argv[a] = (char *)args[a - 1];
+    argv[a++] = in, argv[a++] = out, argv[a] = NULL;
+    cf_status st = cf_surface_write_raw(s, in, err);
+    pid_t pid;
+    int rc = st == CF_OK ? cf_spawn(argv, log, &pid) : 0, status = 0;
+    if (st == CF_OK && rc != 0)
+        st = cf_error_set(err, CF_ERR_EXTERNAL, "cannot run '%s' (%s): build or install "
+                          "cohfrac-repair, or point COHFRAC_REPAIR at it", prog, strerror(rc));
+    if (st == CF_OK && cf_wait(pid, &status, NULL) < 0)
+        st = cf_error_set(err, CF_ERR_EXTERNAL, "waiting for '%s': %s", prog, strerror(errno));
+    char tail[700] = "";
+    if (st == CF_OK && (!WIFEXITED(status) || WEXITSTATUS(status) != 0)) {
+        cf_file_log_tail(log, tail, sizeof tail);
+        char *e = strstr(tail, "error: ");
+        st = cf_error_set(err, strstr(tail, "out of memory") ? CF_ERR_NOMEM : CF_ERR_MESH_PARSE,
+                          "%s", WIFSIGNALED(status) ? "cohfrac-repair crashed"
+                                : WEXITSTATUS(status) == 127 ? "cohfrac-repair not found"
+                                : e ? e + 7 : tail);
+    }
+    cf_surface r = {0};
+    if (st == CF_OK && (st = cf_surface_read_raw(out, &r, err)) == CF_OK) {
+        cf_surface_free(s);
+        *s = r;
+        cf_file_log_tail(log, tail, sizeof tail);
+        char *line = strstr(tail, "report ");
+        snprintf(report, len, "%s", line ? line + 7 : "");
+    }
+    unlink(in), unlink(out), unlink(log), rmdir(dir);
+    return st;
+}
+
+/* The value of key K in a "K=V K=V" report, 0 when absent. */
+static double report_value(const char *report, const char *key)
+{
+    size_t n = strlen(key);
+    for (const char *p = strstr(report, key); p; p = strstr(p + 1, key))
+        if ((p == report || p[-1] == ' ') && p[n] == '=')
+            return strtod(p + n + 1, NULL);
+    return 0;
+}
+
+cf_status cf_surface_repair(cf_surface *s, char *report, size_t len, cf_error *err)
+{
+    static const char *const args[] = {"repair", NULL};
+    char kv[700];
+    cf_status st = run_repair(s, args, kv, sizeof kv, err);
+    if (st != CF_OK)
+        return st;
+#define R(k) ((int)report_value(kv, k))
+    static const char *const how[] = {
+        [CFC_NONE_FOUND] = "",
+        [CFC_FIXED_BY_UNION] = " (the overlapping parts joined into their union)",
+        [CFC_FIXED_BY_AUTOREFINE] = " (cut along the intersections, the enclosed patches removed)",
+        [CFC_WRAPPED] = "",
+        [CFC_NOT_FIXED] = "",
+    };
+    int fixed = R("intersections_fixed");
+    if (fixed < 0 || fixed > CFC_NOT_FIXED)
+        fixed = CFC_NOT_FIXED;
+    if (fixed == CFC_WRAPPED)
+        snprintf(report, len,
+                 "%d point(s) merged, %d degenerate or repeated triangle(s) removed; no exact "
+                 "repair held (non-manifold edges, holes or intersections), so the surface was "
+                 "wrapped (CGAL alpha wrapping, alpha %.4g, offset %.4g file units: the solid is "
+                 "that much larger all round); %d -> %d triangles",
+                 R("points_merged"), R("faces_removed"), report_value(kv, "wrap_alpha"),
+                 report_value(kv, "wrap_offset"), R("faces_in"), R("faces_out"));
+    else
+        snprintf(report, len,
+                 "%d point(s) merged, %d degenerate or repeated triangle(s) removed, %d "
+                 "triangle(s) reoriented, %d hole(s) filled, %d intersecting triangle pair(s)%s; "
+                 "%d -> %d triangles",
+                 R("points_merged"), R("faces_removed"), R("faces_reoriented"),
+                 R("holes_filled"), R("intersecting_pairs"), how[fixed], R("faces_in"),
+                 R("faces_out"));
+#undef R
+    return CF_OK;
+}
+
+cf_status cf_surface_wrap(cf_surface *s, double alpha, double offset, cf_error *err)
+{
+    char a[32], o[32], ignored[8];
+    snprintf(a, sizeof a, "%.17g", alpha);
+    snprintf(o, sizeof o, "%.17g", offset);
+    const char *const args[] = {"wrap", a, o, NULL};
+    return run_repair(s, args, ignored, sizeof ignored, err);
 }
 
 /* ====================================================================== */
