@@ -6,7 +6,12 @@
 #             fragment at the end where the HDF5 file has it (within 1 mm);
 #   paraview  ParaView 5.11 (`paraview`, `python3-paraview`, through xvfb-run)
 #             plays `cohfrac export --format pvd`: at the last frame the
-#             connected surface pieces are the fragments alive.
+#             connected surface pieces are the fragments alive; at the first
+#             frame with fracture-mode tets, ParaView's volume of those
+#             deformed tets is the volume of the corners the HDF5 file has
+#             for them (/fracture_mode), damage lies in [0, 1] and the
+#             stress is not zero; the XDMF sidecar's fracture_mode grid at
+#             that time holds the same tets and volume.
 # Skipped, with a line saying so, where the program is not installed.
 #   tests/output_viewers.sh blender|paraview COHFRAC SOURCE_DIR MESH_DIR
 set -eu
@@ -33,10 +38,17 @@ import cohfrac_h5
 r = cohfrac_h5.load(sys.argv[1])
 n = sum(1 for i in range(r.n_fragments) if len(r.fragment(i).triangles))
 big = max(r.alive(-1), key=lambda i: r.fragments["mass"][i])
-print(n, len(r.alive(-1)), big, r.times[-1], *r.position[-1, big])
+import numpy as np
+deformed = 0.0
+for k in range(len(r.times)):
+    fm = r.fracture_tets_at(k)
+    if fm is not None:
+        deformed = sum(abs(np.linalg.det(t[1:] - t[0])) for t in fm["corners"]) / 6
+        break
+print(n, len(r.alive(-1)), big, r.times[-1], *r.position[-1, big], deformed)
 PY
 )
-n=$1 alive=$2 big=$3 t_end=$4 hx=$5 hy=$6 hz=$7
+n=$1 alive=$2 big=$3 t_end=$4 hx=$5 hy=$6 hz=$7 h5_volume=$8
 if [ "$tool" = blender ]; then
     "$exe" export "$tmp/box.h5" --format gltf -o "$tmp/box.glb" > /dev/null
     HOME=$tmp blender -b --factory-startup --python "$src/tools/blender_check.py" -- \
@@ -49,8 +61,16 @@ if [ "$tool" = blender ]; then
 else
     "$exe" export "$tmp/box.h5" --format pvd -o "$tmp/pvd" > /dev/null
     HOME=$tmp xvfb-run -a pvpython "$src/tools/paraview_check.py" "$tmp/pvd/box_break.pvd" \
-        > "$tmp/out.txt" 2>&1 || { cat "$tmp/out.txt"; exit 1; }
+        "$tmp/box.xdmf" > "$tmp/out.txt" 2>&1 || { cat "$tmp/out.txt"; exit 1; }
     pieces=$(awk '$1 == "pieces" {print $2}' "$tmp/out.txt")
     echo "ParaView: $(awk '$1 == "times" {print $2}' "$tmp/out.txt") time steps; at the last, $pieces connected surface pieces; the HDF5 file has $alive fragments alive"
     [ "$pieces" = "$alive" ]
+    set -- $(awk '$1 == "fracture" {print $2, $3, $4, $5, $6}' "$tmp/out.txt")
+    echo "ParaView: first fracture-mode frame t = $1 s, $2 deformed tets of volume $3 m3 (HDF5 corners: $h5_volume m3), damage up to $4, von Mises stress up to $5 Pa"
+    /usr/bin/python3 -c "import sys; v, v0, d, s = map(float, sys.argv[1:]); sys.exit(not (abs(v / v0 - 1) < 1e-9 and 0 <= d <= 1 and s > 0))" "$3" "$h5_volume" "$4" "$5"
+    tets=$2
+    set -- $(awk '$1 == "xdmf" {print $2, $3}' "$tmp/out.txt")
+    echo "ParaView: the XDMF sidecar's fracture_mode grid at that time: ${1:-no} tets of volume ${2:-no} m3"
+    [ "${1:-0}" = "$tets" ]
+    /usr/bin/python3 -c "import sys; v, v0 = map(float, sys.argv[1:]); sys.exit(not abs(v / v0 - 1) < 1e-9)" "$2" "$h5_volume"
 fi

@@ -68,6 +68,13 @@ class Run:
             else:
                 self.surface_triangles = np.zeros((0, 3), int)
                 self.surface_crack = np.zeros(0, int)
+            self.tet_map_times = (f["mesh/tet_fragment/time"][:] if "mesh/tet_fragment" in f
+                                  else np.zeros(0))
+            self.tet_maps = (f["mesh/tet_fragment/value"][:] if "mesh/tet_fragment" in f
+                             else np.zeros((0, 0), np.int32))
+            fm = f.get("fracture_mode")
+            self.fracture_rows = ({k: fm[k][:len(fm["time"])] for k in fm.keys()}
+                                  if fm is not None else None)
             self.observables = {}
             for name, g in f["observables"].items():
                 unit = g["value"].attrs.get("unit", "")
@@ -123,6 +130,28 @@ class Run:
             verts = (self.rest_nodes[used] - frag.com_rest) @ R.T + com
             yield i, verts, tris.reshape(-1, 3), frag.crack
 
+    def tet_fragments_at(self, frame):
+        """The fragment of every rest tet at a frame ([nt] ids; 0 before the
+        first map: the first body)."""
+        k = int(np.searchsorted(self.tet_map_times, self.times[frame], side="right")) - 1
+        if k < 0:
+            return np.zeros(len(self.rest_tets), np.int32)
+        return self.tet_maps[k]
+
+    def fracture_tets_at(self, frame):
+        """The tets of fracture-mode fragments at a frame, deformed
+        (/fracture_mode): dict of tet [n], corners [n][4][3] m, stress
+        [n][6] Pa (xx yy zz yz xz xy), damage [n]; None when the file has
+        none at that frame (rigid only, or output.fields = false)."""
+        r = self.fracture_rows
+        if r is None:
+            return None
+        sel = r["time"] == self.times[frame]
+        if not sel.any():
+            return None
+        return dict(tet=r["tet"][sel], corners=r["corners"][sel].reshape(-1, 4, 3),
+                    stress=r["stress"][sel], damage=r["damage"][sel])
+
     def bounds(self):
         """Box (lo [3], hi [3]) around the rest mesh and every fragment's centre."""
         pts = [self.rest_nodes] if self.rest_nodes is not None else []
@@ -150,17 +179,27 @@ def read_obstacles(params):
                  **{k: v[j] for k, v in vec.items()}) for j, t in enumerate(types)]
 
 
-CELL_FIELDS = {"fragment": np.int32, "crack": np.int32, "mode": np.int32, "mass": np.float64}
+
+def von_mises(s):
+    """Von Mises stress of Voigt rows [n][6] (xx yy zz yz xz xy), Pa."""
+    xx, yy, zz, yz, xz, xy = s.T
+    return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2)
+                   + 3.0 * (yz ** 2 + xz ** 2 + xy ** 2))
 
 
 def export_pvd(run, out_dir):
-    """Write a ParaView time series: out_dir/frame_NNNN.vtu (every alive
-    fragment's posed surface as triangles, through meshio) and
-    out_dir/<name>.pvd listing them with their times.  Point data
-    `velocity` (m s-1: the fragment's rigid motion v + w x (x - com) at
-    each vertex); cell data `fragment` (id), `crack` (1 on crack faces),
-    `mode` (0 rigid, 1 fracture) and `mass` (kg, the fragment's).
-    Returns the .pvd path."""
+    """Write a ParaView time series: out_dir/frame_NNNN.vtu (through meshio)
+    and out_dir/<name>.pvd listing them with their times.  Each frame holds
+    every rigid fragment's posed surface as triangles and, where the file
+    has them (/fracture_mode), the tets of fracture-mode fragments as they
+    deform, each tet on its own four corners so that cracks open between
+    them.  Point data `velocity` (m s-1: the fragment's rigid motion
+    v + w x (x - com) at each point); cell data `fragment` (id), `crack`
+    (1 on crack faces), `mode` (0 rigid, 1 fracture), `mass` (kg, the
+    fragment's), `stress` (Pa, the Cauchy stress as 6 components xx yy zz
+    yz xz xy; 0 on rigid surfaces), `von_mises` (Pa) and `damage` (0-1, the
+    largest of the cohesive elements on the tet's faces).  Returns the .pvd
+    path."""
     import h5py
     import meshio
     import os
@@ -170,24 +209,44 @@ def export_pvd(run, out_dir):
     os.makedirs(out_dir, exist_ok=True)
     entries = []
     for k, t in enumerate(run.times):
-        pts, tris, vel, cells, base = [], [], [], {n: [] for n in CELL_FIELDS}, 0
+        fm = run.fracture_tets_at(k)
+        deformed = set()
+        if fm is not None:
+            frag_of = run.tet_fragments_at(k)[fm["tet"]]
+            deformed = set(int(i) for i in np.unique(frag_of))
+        blocks, base = [], 0  # (cell type, cells, points, velocities, cell fields)
+
+        def rigid_velocity(i, x):
+            return run.velocity[k, i] + np.cross(omega[k, i], x - run.position[k, i])
+
         for i, verts, tri, cr in run.surfaces_at(k):
-            pts.append(verts)
-            tris.append(tri + base)
-            com = run.position[k, i]
-            vel.append(run.velocity[k, i] + np.cross(omega[k, i], verts - com))
-            for n, v in (("fragment", i), ("mode", run.mode[k, i]),
-                         ("mass", run.fragments["mass"][i])):
-                cells[n].append(np.full(len(tri), v, CELL_FIELDS[n]))
-            cells["crack"].append(cr.astype(np.int32))
+            if i in deformed:
+                continue
+            n = len(tri)
+            blocks.append(("triangle", tri + base, verts, rigid_velocity(i, verts), dict(
+                fragment=np.full(n, i, np.int32), crack=cr.astype(np.int32),
+                mode=np.full(n, run.mode[k, i], np.int32),
+                mass=np.full(n, run.fragments["mass"][i]), stress=np.zeros((n, 6)),
+                von_mises=np.zeros(n), damage=np.zeros(n))))
             base += len(verts)
-        if not pts:
+        if fm is not None:
+            n = len(fm["tet"])
+            pts = fm["corners"].reshape(-1, 3)
+            vel = np.concatenate([rigid_velocity(int(i), c)
+                                  for i, c in zip(frag_of, fm["corners"])])
+            blocks.append(("tetra", np.arange(4 * n).reshape(n, 4) + base, pts, vel, dict(
+                fragment=frag_of.astype(np.int32), crack=np.zeros(n, np.int32),
+                mode=np.ones(n, np.int32), mass=run.fragments["mass"][frag_of],
+                stress=fm["stress"], von_mises=von_mises(fm["stress"]), damage=fm["damage"])))
+        if not blocks:
             continue
         name = f"frame_{k:04d}.vtu"
+        fields = blocks[0][4].keys()
         meshio.write(os.path.join(out_dir, name),
-                     meshio.Mesh(np.concatenate(pts), [("triangle", np.concatenate(tris))],
-                                 point_data={"velocity": np.concatenate(vel)},
-                                 cell_data={n: [np.concatenate(v)] for n, v in cells.items()}),
+                     meshio.Mesh(np.concatenate([b[2] for b in blocks]),
+                                 [(b[0], b[1]) for b in blocks],
+                                 point_data={"velocity": np.concatenate([b[3] for b in blocks])},
+                                 cell_data={n: [b[4][n] for b in blocks] for n in fields}),
                      binary=True)
         entries.append(f'    <DataSet timestep="{t:.9g}" file={quoteattr(name)}/>')
     pvd = os.path.join(out_dir, (run.name or "run") + ".pvd")

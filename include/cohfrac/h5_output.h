@@ -35,6 +35,10 @@
  *   /cracks/{element, centroid[3] m, normal[3], area m^2, opening m,
  *            sliding m, failed, time s}  with output.cracks: one row per
  *            cohesive element per frame (rows of a frame share its time)
+ *   /fracture_mode/{tet int32 (input order), corners[4 * 3] m, stress[6] Pa
+ *            (Cauchy, xx yy zz yz xz xy), damage (0 intact .. 1 a free
+ *            crack face), time s}  with output.fields: one row per tet of a
+ *            fragment in fracture mode, at each frame that has one
  *   /mesh/rest/nodes[n][3] m, /mesh/rest/tets[nt][4] int32: the rest mesh as
  *                          placed at t = 0 (before node duplication), input tet order
  *   /mesh/tet_fragment/{step[K], time[K] s, value[K][nt] int32}: the fragment of
@@ -132,6 +136,16 @@ cf_status cf_h5_write_observable(cf_h5 *h, const char *name, const char *unit, l
  * is empty, holds '/' or exists already gives CF_ERR_OUTPUT. */
 cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int n,
                                 const char *unit, cf_error *err);
+
+/* Append the `n` tets of fracture-mode fragments at one frame to
+ * /fracture_mode (created on the first call, even with n = 0): tet [n]
+ * (input numbering, as /mesh/rest/tets), corners [n][4][3] m (deformed,
+ * cf_world_tet_positions), stress [n][6] Pa (Cauchy, xx yy zz yz xz xy),
+ * damage [n] (0-1, cf_world_tet_fields) and the frame's time, s, on every
+ * row.  Reaches the disk with the next flush (the frame's). */
+cf_status cf_h5_add_fracture_tets(cf_h5 *h, int n, const int *tet, const double *corners,
+                                  const double *stress, const double *damage, double time,
+                                  cf_error *err);
 
 /* Append `n` rows to /cracks (created on the first call, even with n = 0).
  * Reaches the disk with the next flush (the frame's). */

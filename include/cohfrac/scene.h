@@ -197,7 +197,11 @@
  *              the scene file's directory, as mesh paths do), frame_interval [0.01] s,
  *              cracks [true with solver.mode = "fracture", else false]: write
  *              every cohesive element's centroid, normal, area, opening and
- *              state at each frame to /cracks }
+ *              state at each frame to /cracks, fields [true]: write the
+ *              tets of fracture-mode fragments at each frame to
+ *              /fracture_mode (deformed corners, stress, damage; 21
+ *              doubles and an int per tet, only while a fragment is in
+ *              fracture mode) }
  */
 #ifndef COHFRAC_SCENE_H
 #define COHFRAC_SCENE_H

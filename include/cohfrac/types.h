@@ -182,6 +182,8 @@ typedef struct cf_output_settings {
     char file[1024];
     double frame_interval;
     int cracks;                  /* write /cracks at frames */
+    int fields;                  /* write /fracture_mode (deformed tets, stress, damage of
+                                    fracture-mode fragments) at frames */
 } cf_output_settings;
 
 /* A world definition: everything cf_world_create needs.  Start from

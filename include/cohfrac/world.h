@@ -218,6 +218,15 @@ int cf_world_rest_tet(const cf_world *sim, int t, int nodes[4]);
  * for t out of range. */
 int cf_world_tet_positions(const cf_world *sim, int t, double x[12]);
 
+/* The tets of fracture-mode fragments now, for the viewers, in input order:
+ * tets[k] (input numbering), stress[k][6] the Cauchy stress at the last
+ * insertion check (Pa; xx yy zz yz xz xy), damage[k] the largest damage
+ * of the cohesive elements on its faces (0 intact, 1 a free crack face:
+ * the energy they dissipated over G_I times their area, docs/physics.md
+ * §6).  Each array holds cf_world_tet_count() entries (times 6 for
+ * stress).  Returns how many were written, -1 when out of memory. */
+int cf_world_fracture_tets(const cf_world *sim, int *tets, double *stress, double *damage);
+
 /* Support distance of fragment `id` along unit direction d now: the largest
  * (R (X - X_cm)).d over its nodes, m, with X the rest positions and R the
  * fragment's rigid pose (deformation is not seen); 0 for a dead or unknown

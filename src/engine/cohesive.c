@@ -203,6 +203,18 @@ void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
     }
 }
 
+double cf_cohesive_damage(const cf_solid *s, int e)
+{
+    const cf_cohesive *ce = &s->coh[e];
+    if (ce->failed[0] && ce->failed[1] && ce->failed[2])
+        return 1.0;
+    int a[3], b[3];
+    double n[3], area = mid_normal(s, ce, s->x, 3, a, b, n);
+    double d = ce->dissipated[0] + ce->dissipated[1] + ce->dissipated[2];
+    double full = s->mat.G_I * area;
+    return full > 0 ? fmin(1.0, d / full) : 0.0;
+}
+
 void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double normal[3],
                        double *area, double *opening, double *sliding, int *failed)
 {

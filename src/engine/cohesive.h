@@ -63,6 +63,12 @@ void cf_cohesive_fail(cf_solid *s, int e);
 void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double normal[3],
                        double *area, double *opening, double *sliding, int *failed);
 
+/* Damage of cohesive element e, 0 (intact) to 1 (a free crack face): the
+ * energy its node pairs have dissipated over what opening its facet in
+ * pure mode I takes, G_I times its area now, at most 1; 1 once every pair
+ * has failed.  Law-independent (every law books its dissipation). */
+double cf_cohesive_damage(const cf_solid *s, int e);
+
 /* Compression across a crack: a PBD non-penetration constraint on the
  * predicted positions s->p, Delta_n >= 0 for every open node pair, the
  * correction split by inverse masses, for pairs closer than half the facet's

@@ -770,6 +770,34 @@ int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
     return 0;
 }
 
+int cf_world_fracture_tets(const cf_world *sim, int *tets, double *stress, double *damage)
+{
+    const cf_solid *s = &sim->solid;
+    int nt = s->n_tets, n = 0;
+    /* damage by the solid's tets: each element's to both its sides */
+    double *d = calloc((size_t)(nt > 0 ? nt : 1), sizeof *d);
+    if (!d)
+        return -1;
+    for (int e = 0; e < s->n_coh; e++) {
+        double de = cf_cohesive_damage(s, e);
+        for (int side = 0; side < 2; side++)
+            d[s->coh[e].tet[side]] = fmax(d[s->coh[e].tet[side]], de);
+    }
+    static const int voigt[6] = {0, 4, 8, 5, 2, 1}; /* xx yy zz yz xz xy of [3][3] */
+    for (int t = 0; t < nt; t++) {
+        int st = sim->tet_of_user[t];
+        if (sim->frag[s->tet_frag[st]].mode != CF_MODE_FRACTURE)
+            continue;
+        tets[n] = t;
+        damage[n] = d[st];
+        for (int k = 0; k < 6; k++)
+            stress[6 * n + k] = s->sigma ? s->sigma[9 * st + voigt[k]] : 0.0;
+        n++;
+    }
+    free(d);
+    return n;
+}
+
 int cf_world_tet_fragment(const cf_world *sim, int t)
 {
     return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[sim->tet_of_user[t]] : -1;

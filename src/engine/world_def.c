@@ -61,6 +61,7 @@ cf_output_settings cf_default_output(void)
     cf_output_settings o;
     memset(&o, 0, sizeof o);
     o.frame_interval = 0.01;
+    o.fields = 1;
     return o;
 }
 

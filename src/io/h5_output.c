@@ -124,6 +124,16 @@ static const column_def CRACK_COLUMNS[CR_COUNT] = {
     {"time", 1, 0, "s"},
 };
 
+/* The tets of fracture-mode fragments at each frame, "time" last again. */
+enum { FT_TET, FT_CORNERS, FT_STRESS, FT_DAMAGE, FT_TIME, FT_COUNT };
+static const column_def FRACTURE_COLUMNS[FT_COUNT] = {
+    {"tet", 1, 1, NULL},
+    {"corners", 12, 0, "m"},
+    {"stress", 6, 0, "Pa"},
+    {"damage", 1, 0, NULL},
+    {"time", 1, 0, "s"},
+};
+
 /* An observable series kept open so that appending a sample costs three
  * small writes and no lookup in the file. */
 typedef struct observable {
@@ -139,6 +149,7 @@ typedef struct frame_record {
     hsize_t ncols;  /* width N of the value datasets when it was written */
     hsize_t first;  /* offset of its alive columns in the connectivity list */
     hsize_t count;  /* number of alive fragments */
+    hsize_t ft_first, ft_count; /* its rows of /fracture_mode */
 } frame_record;
 
 struct cf_h5 {
@@ -150,6 +161,9 @@ struct cf_h5 {
     hid_t handoff[HO_COUNT];
     hid_t crack[CR_COUNT];   /* /cracks, created by the first cf_h5_add_cracks */
     hsize_t ncracks;
+    hid_t ftet[FT_COUNT];    /* /fracture_mode, created by the first cf_h5_add_fracture_tets */
+    hsize_t nftets;
+    hsize_t ft_first, ft_count; /* the rows added for the frame being written */
     hid_t surface[SF_COUNT]; /* /surfaces */
     hsize_t nsurface;
     hid_t map_step, map_time, map_value; /* /mesh/tet_fragment, created on first use */
@@ -157,7 +171,7 @@ struct cf_h5 {
     /* Rows on disk at the last flush (frames, fragments and hand-offs are
      * counted only once flushed); `failed`: a write failed since then, and
      * the close puts every table back to these (see rollback). */
-    hsize_t ncracks_flushed, nsurface_flushed, nmaps_flushed;
+    hsize_t ncracks_flushed, nsurface_flushed, nmaps_flushed, nftets_flushed;
     int failed;
     hid_t obs_group;
 
@@ -246,6 +260,7 @@ static cf_status flush_file(cf_h5 *h, cf_error *err, const char *what)
         for (size_t i = 0; i < h->nobs; ++i)
             h->obs[i].flushed = h->obs[i].n;
         h->ncracks_flushed = h->ncracks;
+        h->nftets_flushed = h->nftets;
         h->nsurface_flushed = h->nsurface;
         h->nmaps_flushed = h->nmaps;
         h->failed = 0;
@@ -534,6 +549,8 @@ static void init_handles(cf_h5 *h)
         h->handoff[i] = H5I_INVALID_HID;
     for (int i = 0; i < CR_COUNT; ++i)
         h->crack[i] = H5I_INVALID_HID;
+    for (int i = 0; i < FT_COUNT; ++i)
+        h->ftet[i] = H5I_INVALID_HID;
     for (int i = 0; i < SF_COUNT; ++i)
         h->surface[i] = H5I_INVALID_HID;
     h->map_step = h->map_time = h->map_value = H5I_INVALID_HID;
@@ -556,6 +573,8 @@ static int close_handles(cf_h5 *h)
         close_dataset(&h->handoff[i], &failed);
     for (int i = 0; i < CR_COUNT; ++i)
         close_dataset(&h->crack[i], &failed);
+    for (int i = 0; i < FT_COUNT; ++i)
+        close_dataset(&h->ftet[i], &failed);
     for (int i = 0; i < SF_COUNT; ++i)
         close_dataset(&h->surface[i], &failed);
     close_dataset(&h->map_step, &failed);
@@ -953,6 +972,8 @@ static cf_status write_frame_impl(cf_h5 *h, long step, double time, const cf_fra
     r->ncols = ncols;
     r->first = h->nalive;
     r->count = (hsize_t)n;
+    r->ft_first = h->ft_first, r->ft_count = h->ft_count;
+    h->ft_count = 0;
     for (size_t c = 0; c < width; ++c)
         if (col_src[c] >= 0)
             h->alive[h->nalive++] = lo + (int)c;
@@ -1258,6 +1279,54 @@ static cf_status add_cracks_impl(cf_h5 *h, const cf_crack_row *r, int n, cf_erro
     return st;
 }
 
+static cf_status add_fracture_tets_impl(cf_h5 *h, int n, const int *tet, const double *corners,
+                                        const double *stress, const double *damage, double time,
+                                        cf_error *err)
+{
+    if (!h)
+        return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_add_fracture_tets: no output file is open");
+    if (n < 0 || (n > 0 && (!tet || !corners || !stress || !damage)))
+        return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': bad fracture-mode rows",
+                            h->path);
+    if (h->ftet[0] < 0) {
+        cf_status st = write_row_group(h, "fracture_mode", FRACTURE_COLUMNS, FT_COUNT, h->ftet, err);
+        if (st != CF_OK)
+            return st;
+    }
+    if (n == 0)
+        return CF_OK;
+    double *times = malloc((size_t)n * sizeof *times);
+    if (!times)
+        return no_memory(err, h->path);
+    for (int i = 0; i < n; i++)
+        times[i] = time;
+    const void *bufs[FT_COUNT] = {tet, corners, stress, damage, times};
+    cf_status st = CF_OK;
+    for (int c = 0; c < FT_COUNT && st == CF_OK; ++c)
+        if (append_rows(h->ftet[c], h->nftets, (hsize_t)n, mem_type(&FRACTURE_COLUMNS[c]),
+                        bufs[c]) < 0)
+            st = h5_fail(err, h->path, "appending to /fracture_mode/%s", FRACTURE_COLUMNS[c].name);
+    free(times);
+    if (st == CF_OK) {
+        h->ft_first = h->nftets, h->ft_count = (hsize_t)n;
+        h->nftets += (hsize_t)n;
+    }
+    return st;
+}
+
+cf_status cf_h5_add_fracture_tets(cf_h5 *h, int n, const int *tet, const double *corners,
+                                  const double *stress, const double *damage, double time,
+                                  cf_error *err)
+{
+    quiet_state q;
+    quiet_begin(&q);
+    cf_status st = add_fracture_tets_impl(h, n, tet, corners, stress, damage, time, err);
+    if (st != CF_OK && h)
+        h->failed = 1;
+    quiet_end(&q);
+    return st;
+}
+
 cf_status cf_h5_add_cracks(cf_h5 *h, const cf_crack_row *rows, int n, cf_error *err)
 {
     quiet_state q;
@@ -1533,6 +1602,48 @@ static char *xml_escape(const char *s)
     return out;
 }
 
+/* The largest number of /fracture_mode rows of one frame. */
+static hsize_t max_fracture_rows(const cf_h5 *h)
+{
+    hsize_t m = 0;
+    for (hsize_t t = 0; t < h->nframes; ++t)
+        m = h->frames[t].ft_count > m ? h->frames[t].ft_count : m;
+    return m;
+}
+
+/* /xdmf/tet_corners = 0, 1, ..., 4 M - 1 for the M rows of the largest
+ * fracture-mode frame: each tet of /fracture_mode sits on its own four
+ * corners, so a frame's tetrahedra are the first 4 n of these. */
+static cf_status write_corner_index(cf_h5 *h, cf_error *err)
+{
+    hsize_t n = 4 * max_fracture_rows(h);
+    if (n == 0)
+        return CF_OK;
+    int *idx = malloc((size_t)n * sizeof *idx);
+    if (!idx)
+        return no_memory(err, h->path);
+    for (hsize_t i = 0; i < n; ++i)
+        idx[i] = (int)i;
+    hid_t g = H5Gopen2(h->file, "xdmf", H5P_DEFAULT);
+    hid_t s = H5Screate_simple(1, &n, NULL);
+    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
+    hid_t d = H5I_INVALID_HID;
+    int ok = g >= 0 && s >= 0 && dcpl >= 0 &&
+             (d = H5Dcreate2(g, "tet_corners", H5T_STD_I32LE, s, H5P_DEFAULT, dcpl,
+                             H5P_DEFAULT)) >= 0 &&
+             H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, idx) >= 0;
+    if (d >= 0)
+        H5Dclose(d);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (s >= 0)
+        H5Sclose(s);
+    if (g >= 0)
+        H5Gclose(g);
+    free(idx);
+    return ok ? CF_OK : h5_fail(err, h->path, "writing /xdmf/tet_corners");
+}
+
 /* The XDMF topology cells of frame t are its alive columns; they are kept in
  * /xdmf/polyvertex so dead or unborn columns (NaN) are not drawn. */
 static cf_status write_connectivity(cf_h5 *h, cf_error *err)
@@ -1556,7 +1667,9 @@ static cf_status write_connectivity(cf_h5 *h, cf_error *err)
         H5Sclose(s);
     if (g >= 0)
         H5Gclose(g);
-    return ok ? CF_OK : h5_fail(err, h->path, "writing /xdmf/polyvertex");
+    if (!ok)
+        return h5_fail(err, h->path, "writing /xdmf/polyvertex");
+    return write_corner_index(h, err);
 }
 
 /* Shortest "%g" text that reads back as exactly `v` (0.03, not
@@ -1610,6 +1723,73 @@ static void put_attribute(const xdmf_ctx *x, hsize_t t, hsize_t cols, int field)
     fputs("        </Attribute>\n", x->fp);
 }
 
+/* A DataItem reading rows [first, first + n) of /fracture_mode/<name>, a
+ * [R][k] dataset (k = 1: [R]). */
+static void put_fracture_slab(const xdmf_ctx *x, const char *name, int k, int integer,
+                              hsize_t first, hsize_t n, hsize_t R)
+{
+    unsigned long long f = first, c = n, r = R;
+    const char *type = integer ? "NumberType=\"Int\" Precision=\"4\""
+                               : "NumberType=\"Float\" Precision=\"8\"";
+    if (k > 1)
+        fprintf(x->fp,
+                "          <DataItem Dimensions=\"%llu %d\" %s Format=\"HDF\">%s:/fracture_mode/"
+                "%s|%llu 0:1 1:%llu %d:%llu %d</DataItem>\n",
+                c, k, type, x->href, name, f, c, k, r, k);
+    else
+        fprintf(x->fp,
+                "          <DataItem Dimensions=\"%llu\" %s Format=\"HDF\">%s:/fracture_mode/"
+                "%s|%llu:1:%llu:%llu</DataItem>\n",
+                c, type, x->href, name, f, c, r);
+}
+
+/* A second temporal collection: the deformed tets of fracture-mode
+ * fragments at the frames that have them, with stress and damage. */
+static void put_fracture_grids(const xdmf_ctx *x, const cf_h5 *h)
+{
+    hsize_t M = max_fracture_rows(h);
+    if (M == 0)
+        return;
+    FILE *fp = x->fp;
+    fputs("    <Grid Name=\"fracture_mode\" GridType=\"Collection\" "
+          "CollectionType=\"Temporal\">\n",
+          fp);
+    for (hsize_t t = 0; t < h->nframes; ++t) {
+        const frame_record *r = &h->frames[t];
+        if (r->ft_count == 0)
+            continue;
+        unsigned long long n = r->ft_count;
+        char time_text[32];
+        format_double(time_text, sizeof time_text, r->time);
+        fprintf(fp,
+                "      <Grid Name=\"fracture_%06llu\" GridType=\"Uniform\">\n"
+                "        <Time Value=\"%s\"/>\n"
+                "        <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%llu\">\n"
+                "          <DataItem Dimensions=\"%llu 4\" NumberType=\"Int\" Precision=\"4\" "
+                "Format=\"HDF\">%s:/xdmf/tet_corners|0:1:%llu:%llu</DataItem>\n"
+                "        </Topology>\n"
+                "        <Geometry GeometryType=\"XYZ\">\n",
+                (unsigned long long)t, time_text, n, n, x->href, 4 * n,
+                (unsigned long long)(4 * M));
+        put_fracture_slab(x, "corners", 12, 0, r->ft_first, r->ft_count, h->nftets);
+        fputs("        </Geometry>\n", fp);
+        static const struct {
+            const char *name, *type;
+            int k, integer;
+        } attrs[] = {{"tet", "Scalar", 1, 1}, {"stress", "Tensor6", 6, 0},
+                     {"damage", "Scalar", 1, 0}};
+        for (size_t a = 0; a < sizeof attrs / sizeof attrs[0]; ++a) {
+            fprintf(fp, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Cell\">\n",
+                    attrs[a].name, attrs[a].type);
+            put_fracture_slab(x, attrs[a].name, attrs[a].k, attrs[a].integer, r->ft_first,
+                              r->ft_count, h->nftets);
+            fputs("        </Attribute>\n", fp);
+        }
+        fputs("      </Grid>\n", fp);
+    }
+    fputs("    </Grid>\n", fp);
+}
+
 static void put_xdmf(const xdmf_ctx *x, const cf_h5 *h)
 {
     FILE *fp = x->fp;
@@ -1645,7 +1825,9 @@ static void put_xdmf(const xdmf_ctx *x, const cf_h5 *h)
         put_attribute(x, t, r->ncols, FLD_ANGVEL);
         fputs("      </Grid>\n", fp);
     }
-    fputs("    </Grid>\n  </Domain>\n</Xdmf>\n", fp);
+    fputs("    </Grid>\n", fp);
+    put_fracture_grids(x, h);
+    fputs("  </Domain>\n</Xdmf>\n", fp);
 }
 
 /* The sidecar is written under a temporary name and renamed, so a reader
@@ -1752,6 +1934,10 @@ static void rollback(cf_h5 *h)
     for (int c = 0; c < CR_COUNT; ++c)
         trim_rows(h->crack[c], h->ncracks_flushed);
     h->ncracks = h->ncracks_flushed;
+    for (int c = 0; c < FT_COUNT; ++c)
+        trim_rows(h->ftet[c], h->nftets_flushed);
+    h->nftets = h->nftets_flushed;
+    h->ft_count = 0;
     for (int c = 0; c < SF_COUNT; ++c)
         trim_rows(h->surface[c], h->nsurface_flushed);
     h->nsurface = h->nsurface_flushed;

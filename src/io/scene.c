@@ -92,7 +92,7 @@ static const char *const pbd_keys[] = {"k_stiffness", "iterations", "k_damping",
                                        "iteration_independent"};
 static const char *const xpbd_keys[] = {"compliance_scale"};
 static const char *const guard_keys[] = {"max_inverted_fraction", "max_energy_growth"};
-static const char *const output_keys[] = {"file", "frame_interval", "cracks"};
+static const char *const output_keys[] = {"file", "frame_interval", "cracks", "fields"};
 
 /* Enum spellings, indexed by the enum values of scene.h (primitive_names by
  * cf_primitive_type - 1: CF_PRIM_NONE has no spelling). */
@@ -1296,6 +1296,7 @@ static cf_status read_output(loader *ld, int t, const char *name, int fracture_o
     }
     TRY(get_num(ld, t, "frame_interval", &frame_interval, &POSITIVE, &o->frame_interval));
     TRY(get_bool(ld, t, "cracks", fracture_only, &o->cracks));
+    TRY(get_bool(ld, t, "fields", 1, &o->fields));
     return CF_OK;
 }
 
@@ -1881,6 +1882,7 @@ static char *resolved_text(const cf_world_def *s)
     put_str(&b, 4, "file", s->output.file);
     put_num(&b, 4, "frame_interval", s->output.frame_interval);
     put(&b, "    cracks = %s,\n", s->output.cracks ? "true" : "false");
+    put(&b, "    fields = %s,\n", s->output.fields ? "true" : "false");
     put(&b, "  },\n}\n");
     if (b.oom) {
         free(b.p);

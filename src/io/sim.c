@@ -406,6 +406,29 @@ static cf_status write_cracks(cf_sim *sim, cf_error *err)
     return st;
 }
 
+/* The tets of fracture-mode fragments as they are now: deformed corners,
+ * stress and damage (/fracture_mode), for the viewers. */
+static cf_status write_fracture_tets(cf_sim *sim, double time, cf_error *err)
+{
+    cf_world *w = sim->world;
+    int nt = cf_world_tet_count(w), n;
+    cf_status st;
+    double *stress = malloc((size_t)nt * 6 * sizeof(double));
+    double *damage = malloc((size_t)nt * sizeof(double));
+    double *corners = malloc((size_t)nt * 12 * sizeof(double));
+    int *tet = malloc((size_t)nt * sizeof(int));
+    n = stress && damage && corners && tet ? cf_world_fracture_tets(w, tet, stress, damage) : -1;
+    if (n < 0) {
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory writing the fracture-mode tets");
+    } else {
+        for (int k = 0; k < n; k++)
+            cf_world_tet_positions(w, tet[k], &corners[12 * k]);
+        st = cf_h5_add_fracture_tets(sim->h5, n, tet, corners, stress, damage, time, err);
+    }
+    free(stress), free(damage), free(corners), free(tet);
+    return st;
+}
+
 static cf_status write_frame(cf_sim *sim, cf_error *err)
 {
     if (!sim->h5)
@@ -478,6 +501,8 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
                                     err);
     if (st == CF_OK && sim->output.cracks)
         st = write_cracks(sim, err);
+    if (st == CF_OK && sim->output.fields && n_fracture > 0)
+        st = write_fracture_tets(sim, t, err);
     /* The frame last: its write flushes everything above with it, so a
      * frame on disk has its observables, cracks and map. */
     if (st == CF_OK)
