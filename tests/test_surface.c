@@ -76,6 +76,23 @@ static void cube_surface(cf_surface *s, const double scale[3], const double shif
     }
 }
 
+/* Two unit cubes, the second shifted by `shift`, as one surface. */
+static void two_cubes(cf_surface *u, const double shift[3])
+{
+    double one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
+    cf_surface a, b;
+    cube_surface(&a, one, zero);
+    cube_surface(&b, one, shift);
+    *u = (cf_surface){16, 24, malloc(48 * sizeof(double)), malloc(72 * sizeof(int))};
+    memcpy(u->v, a.v, 24 * sizeof(double));
+    memcpy(u->v + 24, b.v, 24 * sizeof(double));
+    memcpy(u->tri, a.tri, 36 * sizeof(int));
+    for (int i = 0; i < 36; i++)
+        u->tri[36 + i] = b.tri[i] + 8;
+    cf_surface_free(&a);
+    cf_surface_free(&b);
+}
+
 static void check_unit_cube(const cf_surface *s)
 {
     assert_int_equal(s->n_verts, 8);
@@ -769,23 +786,14 @@ static void test_prepare_repairs_and_rejects(void **state)
     assert_null(fopen(tpath("open.node"), "r"));
 
     /* two interpenetrating cubes: no valence-3 vertex to remove */
-    cf_surface a, b;
-    cube_surface(&a, one, zero);
-    cube_surface(&b, one, half);
-    cf_surface u = {16, 24, malloc(48 * sizeof(double)), malloc(72 * sizeof(int))};
-    memcpy(u.v, a.v, 24 * sizeof(double));
-    memcpy(u.v + 24, b.v, 24 * sizeof(double));
-    memcpy(u.tri, a.tri, 36 * sizeof(int));
-    for (int i = 0; i < 36; i++)
-        u.tri[36 + i] = b.tri[i] + 8;
+    cf_surface u;
+    two_cubes(&u, half);
     assert_int_equal(cf_surface_write_off(&u, tpath("two.off"), &err), CF_OK);
     cf_mesh_prep_opts o3 = {.input = tpath("two.off"), .output = tpath("two"), .target_tets = 0,
                             .no_repair = 1};
     assert_int_equal(cf_mesh_prepare(&o3, &err), CF_ERR_SURFACE_INTERSECT);
     assert_non_null(strstr(err.msg, "faces "));
     assert_null(fopen(tpath("two.node"), "r")); /* nothing written */
-    cf_surface_free(&a);
-    cf_surface_free(&b);
     cf_surface_free(&u);
 
     /* tetgen missing */
@@ -841,15 +849,8 @@ static void test_prepare_repairs_with_cgal(void **state)
     assert_true(fabs(meshed_volume("hole", &err) - 1.0) < 1e-12);
     assert_true(fabs(meshed_volume("flip", &err) - 1.0) < 1e-12);
 
-    cf_surface a, b;
-    cube_surface(&a, one, zero);
-    cube_surface(&b, one, half);
-    cf_surface u = {16, 24, malloc(48 * sizeof(double)), malloc(72 * sizeof(int))};
-    memcpy(u.v, a.v, 24 * sizeof(double));
-    memcpy(u.v + 24, b.v, 24 * sizeof(double));
-    memcpy(u.tri, a.tri, 36 * sizeof(int));
-    for (int i = 0; i < 36; i++)
-        u.tri[36 + i] = b.tri[i] + 8;
+    cf_surface u;
+    two_cubes(&u, half);
     char report[512];
     assert_int_equal(cf_surface_repair(&u, report, sizeof report, &err), CF_OK);
     assert_non_null(strstr(report, "their union"));
@@ -861,15 +862,8 @@ static void test_prepare_repairs_with_cgal(void **state)
     /* Two boxes sharing one edge (non-manifold): no exact repair holds, the
      * alpha wrap does; it stands off the boxes, so it encloses more than
      * their 2 m^3, by about the offset over their area (12 m^2). */
-    cf_surface_free(&b);
-    cube_surface(&b, one, (double[3]){1, 1, 0});
     cf_surface_free(&u);
-    u = (cf_surface){16, 24, malloc(48 * sizeof(double)), malloc(72 * sizeof(int))};
-    memcpy(u.v, a.v, 24 * sizeof(double));
-    memcpy(u.v + 24, b.v, 24 * sizeof(double));
-    memcpy(u.tri, a.tri, 36 * sizeof(int));
-    for (int i = 0; i < 36; i++)
-        u.tri[36 + i] = b.tri[i] + 8;
+    two_cubes(&u, (double[3]){1, 1, 0});
     assert_int_equal(cf_surface_write_off(&u, tpath("edge.off"), &err), CF_OK);
     assert_int_equal(cf_surface_repair(&u, report, sizeof report, &err), CF_OK);
     assert_non_null(strstr(report, "wrapped"));
@@ -879,8 +873,6 @@ static void test_prepare_repairs_with_cgal(void **state)
     double diag = sqrt(4 + 4 + 1), off = diag / 2000;
     double vol = cf_surface_volume(&u);
     assert_true(vol > 2.0 && vol < 2.0 + 2 * 12 * off);
-    cf_surface_free(&a);
-    cf_surface_free(&b);
     cf_surface_free(&u);
 }
 

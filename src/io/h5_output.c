@@ -1611,6 +1611,29 @@ static hsize_t max_fracture_rows(const cf_h5 *h)
     return m;
 }
 
+/* Writes /xdmf/<name>, n int32 values; 0, or -1 when HDF5 failed (every
+ * object it opened closed again). */
+static int write_xdmf_ints(cf_h5 *h, const char *name, const int *v, hsize_t n)
+{
+    hid_t g = H5Lexists(h->file, "xdmf", H5P_DEFAULT) > 0 ? H5Gopen2(h->file, "xdmf", H5P_DEFAULT)
+                                                          : make_group(h->file, "xdmf");
+    hid_t s = H5Screate_simple(1, &n, NULL);
+    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
+    hid_t d = H5I_INVALID_HID;
+    int ok = g >= 0 && s >= 0 && dcpl >= 0 &&
+             (d = H5Dcreate2(g, name, H5T_STD_I32LE, s, H5P_DEFAULT, dcpl, H5P_DEFAULT)) >= 0 &&
+             H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0;
+    if (d >= 0)
+        H5Dclose(d);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (s >= 0)
+        H5Sclose(s);
+    if (g >= 0)
+        H5Gclose(g);
+    return ok ? 0 : -1;
+}
+
 /* /xdmf/tet_corners = 0, 1, ..., 4 M - 1 for the M rows of the largest
  * fracture-mode frame: each tet of /fracture_mode sits on its own four
  * corners, so a frame's tetrahedra are the first 4 n of these. */
@@ -1624,24 +1647,9 @@ static cf_status write_corner_index(cf_h5 *h, cf_error *err)
         return no_memory(err, h->path);
     for (hsize_t i = 0; i < n; ++i)
         idx[i] = (int)i;
-    hid_t g = H5Gopen2(h->file, "xdmf", H5P_DEFAULT);
-    hid_t s = H5Screate_simple(1, &n, NULL);
-    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
-    hid_t d = H5I_INVALID_HID;
-    int ok = g >= 0 && s >= 0 && dcpl >= 0 &&
-             (d = H5Dcreate2(g, "tet_corners", H5T_STD_I32LE, s, H5P_DEFAULT, dcpl,
-                             H5P_DEFAULT)) >= 0 &&
-             H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, idx) >= 0;
-    if (d >= 0)
-        H5Dclose(d);
-    if (dcpl >= 0)
-        H5Pclose(dcpl);
-    if (s >= 0)
-        H5Sclose(s);
-    if (g >= 0)
-        H5Gclose(g);
+    int failed = write_xdmf_ints(h, "tet_corners", idx, n);
     free(idx);
-    return ok ? CF_OK : h5_fail(err, h->path, "writing /xdmf/tet_corners");
+    return failed ? h5_fail(err, h->path, "writing /xdmf/tet_corners") : CF_OK;
 }
 
 /* The XDMF topology cells of frame t are its alive columns; they are kept in
@@ -1650,24 +1658,7 @@ static cf_status write_connectivity(cf_h5 *h, cf_error *err)
 {
     if (h->nalive == 0)
         return CF_OK;
-    hsize_t n = (hsize_t)h->nalive;
-    hid_t g = make_group(h->file, "xdmf");
-    hid_t s = H5Screate_simple(1, &n, NULL);
-    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
-    hid_t d = H5I_INVALID_HID;
-    int ok = g >= 0 && s >= 0 && dcpl >= 0 &&
-             (d = H5Dcreate2(g, "polyvertex", H5T_STD_I32LE, s, H5P_DEFAULT, dcpl, H5P_DEFAULT)) >=
-                 0 &&
-             H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, h->alive) >= 0;
-    if (d >= 0)
-        H5Dclose(d);
-    if (dcpl >= 0)
-        H5Pclose(dcpl);
-    if (s >= 0)
-        H5Sclose(s);
-    if (g >= 0)
-        H5Gclose(g);
-    if (!ok)
+    if (write_xdmf_ints(h, "polyvertex", h->alive, (hsize_t)h->nalive) != 0)
         return h5_fail(err, h->path, "writing /xdmf/polyvertex");
     return write_corner_index(h, err);
 }
