@@ -32,7 +32,10 @@ expect 1 "bench --set without --scene" "$exe" bench --set duration=1
 expect 2 "bench --scene with a bad value" "$exe" bench --scene "$tmp/bad.lua" -m "$meshes"
 expect 2 "scene value out of range" "$exe" run "$tmp/bad.lua" --mesh-dir "$meshes"
 expect 2 "missing scene file" "$exe" run "$tmp/none.lua"
-expect 2 "open surface" "$exe" mesh "$tmp/open.obj" -o "$tmp/m"
+expect 2 "open surface, --no-repair" "$exe" mesh "$tmp/open.obj" -o "$tmp/m" --no-repair
+expect 2 "open surface, repaired: a sheet is no solid" "$exe" mesh "$tmp/open.obj" -o "$tmp/m"
+grep -q 'is an open sheet, not a solid' "$tmp/log" ||
+    { echo "FAIL  the sheet is not said to be one"; fails=$((fails + 1)); }
 # A closed surface with a stray vertex: refused before tetgen, naming it.
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e10\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' >"$tmp/far.obj"
 expect 2 "a vertex far out" "$exe" mesh "$tmp/far.obj" -o "$tmp/far"

@@ -39,6 +39,14 @@ for f in render.py cohfrac_h5.py; do
     sed -i '/^if __name__ == "__main__":/i print("installed helper", file=__import__("sys").stderr)' "$py/$f"
 done
 cp "$src/tests/data/box_break.lua" "$tmp/box.lua"
+# The surface repair runs the installed cohfrac-repair (libexec/cohfrac,
+# found beside the program): mark it, then mesh a box with a face missing.
+rep=$prefix/libexec/cohfrac/cohfrac-repair
+[ -x "$rep" ] || { echo "FAIL: $rep was not installed"; exit 1; }
+mv "$rep" "$rep.real"
+printf '#!/bin/sh\ntouch "$0.used"\nexec "$0.real" "$@"\n' > "$rep"
+chmod +x "$rep"
+printf 'OFF\n8 10 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n3 0 2 3\n3 0 3 1\n3 4 5 7\n3 4 7 6\n3 0 1 5\n3 0 5 4\n3 2 6 7\n3 2 7 3\n3 0 4 6\n3 0 6 2\n' > "$tmp/open.off"
 cd /
 "$prefix/bin/cohfrac" run "$tmp/box.lua" -q --set duration=0.05 -o "$tmp/box.h5" \
     --set 'bodies[1].mesh={type="sphere", radius=0.1, mesh_size=0.05}' > "$tmp/run.txt"
@@ -48,6 +56,10 @@ ls "$tmp/cache/cohfrac/meshes/"sphere_*.msh >/dev/null 2>&1 ||
 "$prefix/bin/cohfrac" export "$tmp/box.h5" --format pvd -o "$tmp/pvd" 2> "$tmp/pvd.txt"
 grep -q 'installed helper' "$tmp/pvd.txt" || { echo "FAIL: export pvd did not run the installed helper"; exit 1; }
 [ -f "$tmp/pvd/box_break.pvd" ] && [ -s "$tmp/box.glb" ]
+env -u COHFRAC_REPAIR "$prefix/bin/cohfrac" mesh "$tmp/open.off" -o "$tmp/open" -q 2> "$tmp/mesh.txt"
+[ -f "$rep.used" ] || { echo "FAIL: mesh did not run the installed cohfrac-repair"; cat "$tmp/mesh.txt"; exit 1; }
+grep -q '1 hole(s) filled' "$tmp/mesh.txt" || { echo "FAIL: the open box was not closed"; cat "$tmp/mesh.txt"; exit 1; }
+echo "installed mesh from /: $(grep -o '1 hole(s) filled' "$tmp/mesh.txt") by the installed cohfrac-repair"
 echo "installed run from /: $(grep -m1 '^fragments' "$tmp/run.txt"); export gltf and pvd written"
 if command -v ffmpeg >/dev/null; then
     "$prefix/bin/cohfrac" render "$tmp/box.h5" --fps 10 --size 320x240 -o "$tmp/movie" 2> "$tmp/render.txt"

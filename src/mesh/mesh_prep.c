@@ -367,15 +367,37 @@ static cf_status check_span(const cf_surface *s, const char *what, cf_error *err
     return CF_OK;
 }
 
+static double surface_area(const cf_surface *s)
+{
+    double a = 0;
+    for (int t = 0; t < s->n_tris; t++) {
+        const double *p = &s->v[3 * s->tri[3 * t]], *q = &s->v[3 * s->tri[3 * t + 1]],
+                     *r = &s->v[3 * s->tri[3 * t + 2]];
+        double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+        double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                       u[0] * w[1] - u[1] * w[0]};
+        a += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    }
+    return a;
+}
+
+/* The diagonal of a surface's bounding box (file units). */
+static double bbox_diagonal(const cf_surface *s)
+{
+    double lo[3], hi[3], d[3];
+    points_bbox(s->v, s->n_verts, lo, hi);
+    for (int k = 0; k < 3; k++)
+        d[k] = hi[k] - lo[k];
+    return v3_norm(d);
+}
+
 /* Replaces `s` by its alpha wrap at the size CGAL's repair uses
  * (bullet_bridge/cf_cgal.h), saying why on stderr. */
 static cf_status wrap_whole(const cf_mesh_prep_opts *o, cf_surface *s, const char *why,
                             cf_error *err)
 {
-    double lo[3], hi[3];
-    points_bbox(s->v, s->n_verts, lo, hi);
-    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double diag = bbox_diagonal(s);
     double alpha = diag / CFC_WRAP_ALPHA_DIVISOR, offset = diag / CFC_WRAP_OFFSET_DIVISOR;
     int n0 = s->n_tris;
     cf_status st = cf_surface_wrap(s, alpha, offset, err);
@@ -457,9 +479,20 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, i
                      n >= 64 ? " or more" : "");
         else
             snprintf(defect, sizeof defect, "is not a closed manifold surface (%s)", why);
+        /* A sheet is not a solid: its repair (the wrap) would be a shell as
+         * thin as the wrap's offset.  Before the repair: area and size. */
+        double sheet = 4.0 * surface_area(s) * bbox_diagonal(s) / CFC_WRAP_OFFSET_DIVISOR;
         if ((st = repair_surface(o, s, defect, err)) != CF_OK)
             return st;
         *repaired = 1;
+        double vol = fabs(cf_surface_volume(s));
+        if (!(vol > sheet))
+            return cf_error_set(err, CF_ERR_MESH_PARSE,
+                                "%s is an open sheet, not a solid: repaired, it encloses %.3g "
+                                "(file units cubed), no more than a shell as thin as the repair's "
+                                "offset around its faces.  Give a closed surface (a solid with "
+                                "thickness), then retry",
+                                o->input, vol);
         /* Exact intersection points rounded to double can cross again. */
         cf_error left;
         if ((st = check_intersections(s, o->input, v, &left)) == CF_ERR_SURFACE_INTERSECT &&
@@ -540,21 +573,6 @@ static int decimate_clean(const cf_surface *full, int tris, int limit, cf_surfac
         }
     }
     return 0;
-}
-
-static double surface_area(const cf_surface *s)
-{
-    double a = 0;
-    for (int t = 0; t < s->n_tris; t++) {
-        const double *p = &s->v[3 * s->tri[3 * t]], *q = &s->v[3 * s->tri[3 * t + 1]],
-                     *r = &s->v[3 * s->tri[3 * t + 2]];
-        double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-        double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-        double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                       u[0] * w[1] - u[1] * w[0]};
-        a += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    }
-    return a;
 }
 
 /* A clean decimation that needs more than WRAP_AFTER times the triangles

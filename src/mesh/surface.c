@@ -2,7 +2,10 @@
  * enclosed volume, closedness, self-intersection search, the valence-3
  * repair of docs/scenes.md, the general repair through CGAL and
  * decimation through meshoptimizer. */
+#define _GNU_SOURCE /* dladdr */
 #include "cohfrac/surface.h"
+
+#include <dlfcn.h>
 
 #include <errno.h>
 #include <limits.h>
@@ -995,13 +998,40 @@ int cf_surface_repair_valence3(cf_surface *s)
 /* General repair (CGAL, through cohfrac-repair)                          */
 /* ====================================================================== */
 
-/* The program: $COHFRAC_REPAIR, else the build tree's cohfrac-repair while
- * it exists, else the installed one (libexec/cohfrac). */
+/* The program: $COHFRAC_REPAIR; else the one installed beside the code
+ * that runs this (bin/../libexec/cohfrac, or from lib/ or lib/<triplet>/
+ * of the library), found through dladdr so that a relocated install works;
+ * else the build tree's; else the configured install path. */
 static const char *repair_program(void)
 {
     const char *env = getenv("COHFRAC_REPAIR");
     if (env && *env)
         return env;
+    /* The file that holds this code: the library (dladdr), or the program
+     * (/proc/self/exe: dladdr does not name the main program's file). */
+    static char found[PATH_MAX], self[PATH_MAX];
+    static const char here = 0;
+    Dl_info info;
+    const char *file = NULL;
+    if (dladdr(&here, &info) && info.dli_fname && info.dli_fname[0] == '/')
+        file = info.dli_fname;
+    else {
+        ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+        if (n > 0) {
+            self[n] = '\0';
+            file = self;
+        }
+    }
+    if (file) {
+        static const char *const up[] = {"/../libexec/cohfrac/cohfrac-repair",
+                                         "/../../libexec/cohfrac/cohfrac-repair"};
+        size_t dir = (size_t)(strrchr(file, '/') - file);
+        for (size_t k = 0; k < sizeof up / sizeof up[0]; k++)
+            if (snprintf(found, sizeof found, "%.*s%s", (int)dir, file, up[k]) <
+                    (int)sizeof found &&
+                access(found, X_OK) == 0)
+                return found;
+    }
     if (access(COHFRAC_REPAIR_BUILT, X_OK) == 0)
         return COHFRAC_REPAIR_BUILT;
     return COHFRAC_REPAIR_INSTALLED;
