@@ -479,9 +479,12 @@ static cf_status load_clean_surface(const cf_mesh_prep_opts *o, cf_surface *s, i
                      n >= 64 ? " or more" : "");
         else
             snprintf(defect, sizeof defect, "is not a closed manifold surface (%s)", why);
-        /* A sheet is not a solid: its repair (the wrap) would be a shell as
-         * thin as the wrap's offset.  Before the repair: area and size. */
-        double sheet = 4.0 * surface_area(s) * bbox_diagonal(s) / CFC_WRAP_OFFSET_DIVISOR;
+        /* An open sheet is not a solid: its repair (the wrap) is a shell
+         * the wrap's offset d thick on both sides, 2 d A for its area A; a
+         * closed plate of thickness t encloses t A / 2.  Open surfaces
+         * that enclose no more than 2.5 d A once repaired are sheets. */
+        double sheet = closed ? 0.0
+                              : 2.5 * surface_area(s) * bbox_diagonal(s) / CFC_WRAP_OFFSET_DIVISOR;
         if ((st = repair_surface(o, s, defect, err)) != CF_OK)
             return st;
         *repaired = 1;
