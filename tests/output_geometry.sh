@@ -54,6 +54,27 @@ grep -q 'frame_0000.vtu' "$tmp/pvd/box_break.pvd"
 /usr/bin/python3 -c "import h5py,sys; f=h5py.File(sys.argv[1]); t=f['visual/tet'][:]; n=len(f['mesh/rest/tets']); assert len(t) > 50000 and t.min() >= 0 and t.max() < n, (len(t), t.min(), t.max()); print(f'visual: {len(t)} triangles on {n} rest tets')" "$tmp/vis.h5"
 "$exe" export "$tmp/vis.h5" --format gltf -o "$tmp/vis.glb"
 /usr/bin/python3 "$src/tools/check_gltf.py" "$tmp/vis.h5" "$tmp/vis.glb"
+# The ParaView series draws it too: at a frame with every fragment rigid,
+# each visual triangle once (crack = 0), and the collision view beside it.
+"$exe" export "$tmp/vis.h5" --format pvd -o "$tmp/vispvd" > /dev/null
+/usr/bin/python3 - "$tmp/vis.h5" "$tmp/vispvd" "$src/tools" <<'PY'
+import os, sys
+sys.path.insert(0, sys.argv[3])
+import meshio
+import cohfrac_h5
+run = cohfrac_h5.load(sys.argv[1])
+n_vis = len(run.visual["triangles"])
+rigid = [k for k in range(len(run.times)) if run.fracture_tets_at(k) is None]
+assert rigid, "no frame with every fragment rigid"
+k = rigid[-1]
+m = meshio.read(os.path.join(sys.argv[2], f"frame_{k:04d}.vtu"))
+crack = m.cell_data["crack"][0]
+drawn = int((crack == 0).sum())
+assert drawn == n_vis, (drawn, n_vis)
+assert os.path.exists(os.path.join(sys.argv[2], "plaster_bunny_drop_collision.pvd"))
+print(f"pvd: frame {k} draws the {n_vis} visual triangles once, and {int(crack.sum())} crack "
+      "faces; the collision view is beside it")
+PY
 if ! command -v ffmpeg >/dev/null; then
     echo "ffmpeg is not installed (make test's set-up installs it): render not checked"
     exit 0

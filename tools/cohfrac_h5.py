@@ -72,6 +72,9 @@ class Run:
                                   else np.zeros(0))
             self.tet_maps = (f["mesh/tet_fragment/value"][:] if "mesh/tet_fragment" in f
                              else np.zeros((0, 0), np.int32))
+            vis = f.get("visual")
+            self.visual = ({k: vis[k][:] for k in ("vertices", "triangles", "tet")}
+                           if vis is not None else None)
             fm = f.get("fracture_mode")
             self.fracture_rows = ({k: fm[k][:len(fm["time"])] for k in fm.keys()}
                                   if fm is not None else None)
@@ -130,6 +133,34 @@ class Run:
             verts = (self.rest_nodes[used] - frag.com_rest) @ R.T + com
             yield i, verts, tris.reshape(-1, 3), frag.crack
 
+    def visual_at(self, frame):
+        """The object's own surface (/visual) on every alive fragment at a
+        frame, posed: yields (id, vertices [n][3] m, triangles [m][3]); each
+        visual triangle rides with the fragment that owns its tet.  Nothing
+        when the file has no /visual."""
+        if self.visual is None:
+            return
+        # The split by fragment changes only with the tet map: kept per map.
+        key = int(np.searchsorted(self.tet_map_times, self.times[frame], side="right"))
+        if getattr(self, "_visual_key", None) != key:
+            owner = self.tet_fragments_at(frame)[self.visual["tet"]]
+            order = np.argsort(owner, kind="stable")
+            ids, first = np.unique(owner[order], return_index=True)
+            parts = {}
+            for j, i in enumerate(ids):
+                tri = self.visual["triangles"][order[first[j]:(first[j + 1] if j + 1 < len(ids)
+                                                                else len(order))]]
+                used, tris = np.unique(tri, return_inverse=True)
+                parts[int(i)] = (used, tris.reshape(-1, 3))
+            self._visual_key, self._visual_parts = key, parts
+        for i in self.alive(frame):
+            if i not in self._visual_parts:
+                continue
+            used, tris = self._visual_parts[i]
+            com, R = self.pose(i, frame)
+            verts = (self.visual["vertices"][used] - self.fragments["com_rest"][i]) @ R.T + com
+            yield i, verts, tris
+
     def tet_fragments_at(self, frame):
         """The fragment of every rest tet at a frame ([nt] ids; 0 before the
         first map: the first body)."""
@@ -187,13 +218,17 @@ def von_mises(s):
                    + 3.0 * (yz ** 2 + xz ** 2 + xy ** 2))
 
 
-def export_pvd(run, out_dir):
-    """Write a ParaView time series: out_dir/frame_NNNN.vtu (through meshio)
-    and out_dir/<name>.pvd listing them with their times.  Each frame holds
-    every rigid fragment's posed surface as triangles and, where the file
-    has them (/fracture_mode), the tets of fracture-mode fragments as they
-    deform, each tet on its own four corners so that cracks open between
-    them.  Point data `velocity` (m s-1: the fragment's rigid motion
+def export_pvd(run, out_dir, view="visual"):
+    """Write a ParaView time series: out_dir/<prefix>_NNNN.vtu (through
+    meshio) and out_dir/<name>[_collision].pvd listing them with their
+    times.  Each frame holds every rigid fragment's posed surface as
+    triangles and, where the file has them (/fracture_mode), the tets of
+    fracture-mode fragments as they deform, each tet on its own four
+    corners so that cracks open between them.  With view "visual" and a
+    /visual surface in the file, a rigid fragment is drawn as its part of
+    the object's own surface plus its crack faces; with "collision" (or no
+    /visual) as the outer faces of its tets, the mesh the physics sees.
+    Point data `velocity` (m s-1: the fragment's rigid motion
     v + w x (x - com) at each point); cell data `fragment` (id), `crack`
     (1 on crack faces), `mode` (0 rigid, 1 fracture), `mass` (kg, the
     fragment's), `stress` (Pa, the Cauchy stress as 6 components xx yy zz
@@ -206,6 +241,8 @@ def export_pvd(run, out_dir):
     from xml.sax.saxutils import quoteattr
     with h5py.File(run.path, "r") as f:
         omega = f["particles/fragments/angular_velocity/value"][:len(run.times)]
+    visual = view == "visual" and run.visual is not None
+    prefix = "frame" if view == "visual" else "collision"
     os.makedirs(out_dir, exist_ok=True)
     entries = []
     for k, t in enumerate(run.times):
@@ -219,16 +256,27 @@ def export_pvd(run, out_dir):
         def rigid_velocity(i, x):
             return run.velocity[k, i] + np.cross(omega[k, i], x - run.position[k, i])
 
-        for i, verts, tri, cr in run.surfaces_at(k):
-            if i in deformed:
-                continue
+        def add_surface(i, verts, tri, crack):
+            nonlocal base
             n = len(tri)
             blocks.append(("triangle", tri + base, verts, rigid_velocity(i, verts), dict(
-                fragment=np.full(n, i, np.int32), crack=cr.astype(np.int32),
+                fragment=np.full(n, i, np.int32), crack=crack.astype(np.int32),
                 mode=np.full(n, run.mode[k, i], np.int32),
                 mass=np.full(n, run.fragments["mass"][i]), stress=np.zeros((n, 6)),
                 von_mises=np.zeros(n), damage=np.zeros(n))))
             base += len(verts)
+
+        for i, verts, tri, cr in run.surfaces_at(k):
+            if i in deformed:
+                continue
+            if visual:  # its crack faces here, its outer faces from /visual below
+                tri, cr = tri[cr == 1], cr[cr == 1]
+            if len(tri):
+                add_surface(i, verts, tri, cr)
+        if visual:
+            for i, verts, tri in run.visual_at(k):
+                if i not in deformed:
+                    add_surface(i, verts, tri, np.zeros(len(tri)))
         if fm is not None:
             n = len(fm["tet"])
             pts = fm["corners"].reshape(-1, 3)
@@ -240,7 +288,7 @@ def export_pvd(run, out_dir):
                 stress=fm["stress"], von_mises=von_mises(fm["stress"]), damage=fm["damage"])))
         if not blocks:
             continue
-        name = f"frame_{k:04d}.vtu"
+        name = f"{prefix}_{k:04d}.vtu"
         fields = blocks[0][4].keys()
         meshio.write(os.path.join(out_dir, name),
                      meshio.Mesh(np.concatenate([b[2] for b in blocks]),
@@ -249,7 +297,8 @@ def export_pvd(run, out_dir):
                                  cell_data={n: [b[4][n] for b in blocks] for n in fields}),
                      binary=True)
         entries.append(f'    <DataSet timestep="{t:.9g}" file={quoteattr(name)}/>')
-    pvd = os.path.join(out_dir, (run.name or "run") + ".pvd")
+    pvd = os.path.join(out_dir, (run.name or "run") + ("" if view == "visual" else "_collision")
+                       + ".pvd")
     with open(pvd, "w") as f:
         f.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
                 "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
@@ -266,11 +315,14 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description="Summarise a cohfrac output file, or write "
                                  "its fragments' surfaces as a ParaView time series.")
     ap.add_argument("h5")
-    ap.add_argument("--pvd", metavar="DIR", help="write DIR/frame_NNNN.vtu and DIR/<name>.pvd")
+    ap.add_argument("--pvd", metavar="DIR", help="write DIR/frame_NNNN.vtu and DIR/<name>.pvd "
+                    "and, with a /visual surface, the collision view DIR/<name>_collision.pvd")
     a = ap.parse_args()
     r = load(a.h5)
     if a.pvd:
         print(f"wrote {export_pvd(r, a.pvd)}")
+        if r.visual is not None:
+            print(f"wrote {export_pvd(r, a.pvd, 'collision')} (the tets' outer faces)")
         raise SystemExit(0)
     last = -1
     print(f"{r.path}: {len(r.times)} frames to t = {r.times[last]:.4g} s, "
