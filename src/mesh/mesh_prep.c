@@ -952,7 +952,14 @@ static cf_status tetrahedralise(const prep *p, const cf_surface *s, trial *best,
                 "  slivers: %d boundary cap(s) thinner than %.2g x the median tet peeled "
                 "(%.2g of the volume)\n",
                 peeled, PEEL_FRACTION, peeled_volume / vm);
-    return cf_mesh_check(&best->m, "tetgen output", err);
+    cf_error bad;
+    if ((st = cf_mesh_check(&best->m, "tetgen output", &bad)) != CF_OK)
+        return cf_error_set(err, st,
+                            "%s.  tetgen made it from the surface as decimated for "
+                            "--target-tets %d: ask for another --target-tets (the surface is "
+                            "decimated differently), or 0 for tetgen's own choice",
+                            bad.msg, o->target_tets);
+    return CF_OK;
 }
 
 cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
