@@ -893,6 +893,14 @@ static cf_status write_stamp(const cf_mesh_prep_opts *o, const char *key, const 
     return st;
 }
 
+/* Drops a trial's mesh and decimated surface, for another try. */
+static void forget_trial(trial *best, cf_surface *dec)
+{
+    cf_mesh_free(&best->m);
+    *best = (trial){{0}, {0}};
+    cf_surface_free(dec);
+}
+
 /* Tetgen on the clean surface `s` (to the target, fit_size), the tets
  * oriented and checked (non-degenerate, filling the surface's volume):
  * *best, on *used (s or its decimation, kept in *dec). */
@@ -953,12 +961,16 @@ static cf_status tetrahedralise(const prep *p, const cf_surface *s, trial *best,
                 "(%.2g of the volume)\n",
                 peeled, PEEL_FRACTION, peeled_volume / vm);
     cf_error bad;
-    if ((st = cf_mesh_check(&best->m, "tetgen output", &bad)) != CF_OK)
+    if ((st = cf_mesh_check(&best->m, "tetgen output", &bad)) != CF_OK) {
+        char *advice = strstr(bad.msg, ": re-run tetgen"); /* for a user's own files */
+        if (advice)
+            *advice = '\0';
         return cf_error_set(err, st,
                             "%s.  tetgen made it from the surface as decimated for "
                             "--target-tets %d: ask for another --target-tets (the surface is "
                             "decimated differently), or 0 for tetgen's own choice",
                             bad.msg, o->target_tets);
+    }
     return CF_OK;
 }
 
@@ -1015,12 +1027,26 @@ cf_status cf_mesh_prepare(const cf_mesh_prep_opts *o, cf_error *err)
          * cuts, which tetgen can turn into flat tets or crash on. */
         char why[1200];
         snprintf(why, sizeof why, "as repaired, gives tetgen trouble (%s)", err->msg);
-        cf_mesh_free(&best.m);
-        best = (trial){{0}, {0}};
-        cf_surface_free(&dec);
+        forget_trial(&best, &dec);
         used = &s;
         if ((st = wrap_whole(o, &s, why, err)) == CF_OK)
             st = tetrahedralise(&pr, &s, &best, &dec, &used, err);
+    }
+    /* A flat tet comes from how the surface was decimated for the target:
+     * a target 15 % either side decimates it differently. */
+    static const double nudge[] = {0.85, 1.15};
+    cf_mesh_prep_opts alt = *o;
+    prep pr_alt = pr;
+    pr_alt.o = &alt;
+    for (int k = 0; k < 2 && st == CF_ERR_MESH_INVERTED && o->target_tets > 0 &&
+                    cf_wall_time() < pr.deadline;
+         k++) {
+        alt.target_tets = (int)lround(o->target_tets * nudge[k]);
+        fprintf(stderr, "cohfrac mesh: warning: %s; trying --target-tets %d\n", err->msg,
+                alt.target_tets);
+        forget_trial(&best, &dec);
+        used = &s;
+        st = tetrahedralise(&pr_alt, &s, &best, &dec, &used, err);
     }
     if (st != CF_OK)
         goto out;
