@@ -41,6 +41,10 @@ BOX = {"name": "box_break", "duration": 0.3,
        "obstacles": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]}],
        "solver": {"constraints": "xpbd", "threads": 1}}
 
+v = subprocess.run([exe, "--version"], capture_output=True, text=True, check=True).stdout.split()
+check("the library's version is the program's", cohfrac.version() == v[-1],
+      f"{cohfrac.version()} against {v[-1]}")
+
 with tempfile.TemporaryDirectory() as tmp:
     r = subprocess.run([exe, "run", os.path.join(src, "tests/data/box_break.lua"), "-q", "-t", "1",
                         "--set", "duration=0.3", "-o", os.path.join(tmp, "box.h5")],

@@ -8,6 +8,7 @@
  *   cohfrac/sim.h      the run loop: HDF5 output, progress, summary
  *   cohfrac/h5_output.h  the HDF5 writer
  *   cohfrac/export.h   glTF export of a run
+ *   cohfrac/version.h  COHFRAC_VERSION_* and cf_version()
  * See docs/architecture.md and examples/drop.c. */
 #ifndef COHFRAC_COHFRAC_H
 #define COHFRAC_COHFRAC_H
@@ -21,6 +22,7 @@
 #include "cohfrac/surface.h"
 #include "cohfrac/tetmesh.h"
 #include "cohfrac/types.h"
+#include "cohfrac/version.h"
 #include "cohfrac/world.h"
 
 #endif

@@ -32,7 +32,7 @@ import os
 
 import numpy as np
 
-__all__ = ["World", "CohfracError", "lua_table", "library"]
+__all__ = ["World", "CohfracError", "lua_table", "library", "version"]
 
 
 class CohfracError(RuntimeError):
@@ -129,6 +129,7 @@ def _declare(lib):
         "cf_world_state_hash": (ctypes.c_uint64, [P]),
         "cf_status_name": (S, [I]),
         "cf_status_exit_code": (I, [I]),
+        "cf_version": (S, []),
     }
     for name, (res, args) in sig.items():
         f = getattr(lib, name)
@@ -144,6 +145,11 @@ def library():
     if _lib is None:
         _lib = _load()
     return _lib
+
+
+def version():
+    """The loaded library's version, "MAJOR.MINOR.PATCH" (cf_version)."""
+    return library().cf_version().decode()
 
 
 def _lua_string(s):

@@ -4,6 +4,7 @@
  * Exit codes: 0 success, 1 usage, 2 bad input (mesh, surface, scene),
  * 3 diverged, 4 output not written, 5 external program or memory failure
  * (see include/cohfrac/error.h). */
+#include "cohfrac/version.h"
 #include "cohfrac/bench.h"
 #include "cohfrac/compare.h"
 #include "cohfrac/error.h"
@@ -26,9 +27,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#ifndef COHFRAC_VERSION
-#define COHFRAC_VERSION "0.0.0"
-#endif
 
 /* Each subcommand's help: `cohfrac SUB --help` prints its entry, `cohfrac
  * --help` all of them.  One meaning per option letter across subcommands:
@@ -914,7 +912,7 @@ static int dispatch(int argc, char **argv)
         return 0;
     }
     if (asks(argc, argv, "--version", NULL)) {
-        printf("cohfrac %s\n", COHFRAC_VERSION);
+        printf("cohfrac %s\n", COHFRAC_VERSION_STRING);
         return 0;
     }
     for (size_t i = 0; i < sizeof table / sizeof table[0]; i++) {

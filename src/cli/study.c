@@ -1,6 +1,7 @@
 /* cohfrac study: error against run time over a grid of settings
  * (include/cohfrac/study.h). */
 #define _GNU_SOURCE
+#include "cohfrac/version.h"
 #include "cohfrac/study.h"
 #include "cohfrac/surface.h"
 #include "cohfrac/world.h"
@@ -27,9 +28,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#ifndef COHFRAC_VERSION
-#define COHFRAC_VERSION "0.0.0"
-#endif
 
 static const char *const default_reference[] = {"solver.constraints=\"none\"",
                                                 "solver.cfl_fraction=0.5"};
@@ -159,7 +157,7 @@ static cf_status resolve_case(const cf_study_options *o, job *j, cf_study_case *
     if (st != CF_OK)
         return cf_error_set(err, st, "case '%s': %s", c->label, e2.msg);
     uint64_t h = cf_fnv1a(CF_FNV1A_SEED, sc.resolved, strlen(sc.resolved));
-    h = cf_fnv1a(h, COHFRAC_VERSION, strlen(COHFRAC_VERSION));
+    h = cf_fnv1a(h, COHFRAC_VERSION_STRING, strlen(COHFRAC_VERSION_STRING));
     snprintf(c->hash, sizeof c->hash, "%016" PRIx64, h);
     snprintf(name, 128, "%s", sc.name);
     if (cf_mpi_size() > 1 && cf_mpi_rank() == 0)
@@ -200,7 +198,7 @@ static cf_status write_case(const job *j, const cf_study_case *c, const char *ru
                             cf_error *err)
 {
     return write_run_file(runs, c->hash, "lua", err, "-- %s (resolved by cohfrac %s)\n%s",
-                          c->label, COHFRAC_VERSION, j->text);
+                          c->label, COHFRAC_VERSION_STRING, j->text);
 }
 
 /* A cached case: runs/<hash>.meta holds "exit wall cpu peak_rss". */
@@ -610,7 +608,7 @@ static cf_status write_md(const cf_study_options *o, const cf_study_result *res,
         snprintf(spread, sizeof spread, "%d at a time", o->jobs);
     fprintf(m, ". Machine: %s; cohfrac %s; %s. %d cases, %s with %d thread%s each; %d "
                "reused from the cache.\n\n",
-            mach, COHFRAC_VERSION, date, res->n_cases, spread, threads, threads > 1 ? "s" : "",
+            mach, COHFRAC_VERSION_STRING, date, res->n_cases, spread, threads, threads > 1 ? "s" : "",
             res->n_cached);
     fputs("**Reference**:", m);
     for (int i = 0; i < n_ref; i++)

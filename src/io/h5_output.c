@@ -25,6 +25,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
+#include "cohfrac/version.h"
 #include "cohfrac/h5_output.h"
 #include "h5_quiet.h"
 
@@ -43,9 +44,6 @@
 #include <sys/types.h>
 #include <unistd.h>
 
-#ifndef COHFRAC_VERSION
-#define COHFRAC_VERSION "0.1.0"
-#endif
 
 /* Chunk shapes.  Frames are flushed one at a time, and a flush rewrites every
  * chunk the frame touched, so the time extent of a chunk is kept small. */
@@ -623,7 +621,7 @@ static int write_h5md_group(hid_t file)
     if (ok) {
         sub = make_group(g, "creator");
         ok = sub >= 0 && write_string_attr(sub, "name", "cohfrac") == 0 &&
-             write_string_attr(sub, "version", COHFRAC_VERSION) == 0;
+             write_string_attr(sub, "version", COHFRAC_VERSION_STRING) == 0;
         if (sub >= 0)
             H5Gclose(sub);
     }
@@ -741,7 +739,7 @@ static cf_status build_layout(cf_h5 *h, const char *file_name, const char *scene
 
     hid_t root = H5Gopen2(h->file, "/", H5P_DEFAULT);
     int ok = root >= 0 && write_string_attr(root, "creator", "cohfrac") == 0 &&
-             write_string_attr(root, "version", COHFRAC_VERSION) == 0 &&
+             write_string_attr(root, "version", COHFRAC_VERSION_STRING) == 0 &&
              write_string_attr(root, "units", "SI") == 0 &&
              write_string_attr(root, "up_axis", "+z") == 0 &&
              write_string_attr(root, "quaternion_order", "wxyz") == 0 &&
