@@ -13,6 +13,7 @@
 #include "cohfrac/mesh.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
+#include "cohfrac/version.h"
 #include "cohfrac/world.h"
 #include "check.h"
 
@@ -84,6 +85,11 @@ static void test_api_world_equals_lua_scene(void **state)
     /* Every cohesive element was announced once; every fragment too (the
      * initial body at create, drained here with the first step's). */
     assert_int_equal(inserted, cf_world_cohesive_count(w));
+    cf_crack_row row;
+    assert_int_equal(cf_world_crack(w, inserted, &row), -1); /* past the end: refused */
+    assert_int_equal(cf_world_crack(w, -1, &row), -1);
+    assert_true(row.area == 0 && row.element == 0);
+    assert_string_equal(cf_version(), COHFRAC_VERSION_STRING);
     assert_int_equal(born, cf_world_fragments_ever(w));
     assert_true(handoffs >= 2); /* rigid -> fracture -> rigid */
     assert_true(fabs(cf_world_time(w) - 0.5) < 1e-12);

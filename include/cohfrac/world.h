@@ -311,9 +311,10 @@ typedef struct cf_crack_row {
     int failed;              /* 1: every node pair has failed (a free crack face) */
 } cf_crack_row;
 
-/* Number of cohesive elements, and element e's state (0 <= e < count). */
+/* Number of cohesive elements, and element e's state: 0, or -1 with *out
+ * zeroed for e outside 0 <= e < count. */
 int cf_world_cohesive_count(const cf_world *w);
-void cf_world_crack(const cf_world *w, int e, cf_crack_row *out);
+int cf_world_crack(const cf_world *w, int e, cf_crack_row *out);
 
 /* Crack area now, m^2 (cf_solid_crack_area). */
 double cf_world_crack_area(const cf_world *w);

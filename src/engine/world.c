@@ -805,13 +805,16 @@ int cf_world_tet_fragment(const cf_world *sim, int t)
 
 int cf_world_cohesive_count(const cf_world *sim) { return sim->solid.n_coh; }
 
-void cf_world_crack(const cf_world *sim, int e, cf_crack_row *r)
+int cf_world_crack(const cf_world *sim, int e, cf_crack_row *r)
 {
     memset(r, 0, sizeof *r);
+    if (e < 0 || e >= sim->solid.n_coh)
+        return -1;
     r->time = sim->t;
     r->element = e;
     cf_cohesive_state(&sim->solid, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
                       &r->failed);
+    return 0;
 }
 
 double cf_world_crack_area(const cf_world *sim) { return cf_solid_crack_area(&sim->solid); }
