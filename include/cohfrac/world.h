@@ -148,12 +148,12 @@ int cf_world_fragment_info(const cf_world *w, int id, cf_frag_info *out);
 int cf_world_fragments_ever(const cf_world *w);
 
 /* Simulated time, s. */
-double cf_world_time(const cf_world *sim);
+double cf_world_time(const cf_world *w);
 
 /* The fracture-mode step (solver.dt_fracture, or cfl_fraction x dt_cfl)
  * and the mesh's explicit stability limit dt_cfl (docs/physics.md §3), s. */
-double cf_world_dt_fracture(const cf_world *sim);
-double cf_world_dt_cfl(const cf_world *sim);
+double cf_world_dt_fracture(const cf_world *w);
+double cf_world_dt_cfl(const cf_world *w);
 
 /* The explicit stability limit of a Tet4 mesh before any world is made:
  * min over tets of h / c_d, h twice the inradius (6 V / total face area)
@@ -170,7 +170,7 @@ void cf_body_place(const cf_body_def *b, const cf_mesh *mesh, const double *x, i
                    double *out);
 
 /* The energy ledger and momenta now. */
-void cf_world_ledger(const cf_world *sim, cf_ledger *out);
+void cf_world_ledger(const cf_world *w, cf_ledger *out);
 
 /* One alive fragment's rigid state now (pose as docs/physics.md §1).  `kinetic` is
  * the kinetic energy of its nodes (fracture mode, pbd rigid backend) or of
@@ -195,28 +195,28 @@ typedef struct cf_fragment_state {
 
 /* The alive fragments now, in id order: writes up to `cap` to out (may be
  * NULL with cap 0) and returns how many are alive. */
-int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap);
+int cf_world_fragments(cf_world *w, cf_fragment_state *out, int cap);
 
 /* Number of tets of the scene's solid, and the fragment (id) that tet t
  * belongs to now: fragments of two runs of one scene are matched through
  * their tets.  -1 for t out of range. */
-int cf_world_tet_count(const cf_world *sim);
-int cf_world_tet_fragment(const cf_world *sim, int t);
+int cf_world_tet_count(const cf_world *w);
+int cf_world_tet_fragment(const cf_world *w, int t);
 
 /* The rest mesh as placed at create, before any node duplication: its
  * node count, the positions X[n][3] (m) in the world's node numbering, and
  * tet t's four nodes in that numbering (t in input order; returns 0, or -1
  * out of range).  A fragment's rest shape is its tets on these nodes; its
  * pose (cf_fragment_state com, quat) moves X - com_rest (cf_frag_info). */
-int cf_world_rest_node_count(const cf_world *sim);
-void cf_world_rest_nodes(const cf_world *sim, double *X);
-int cf_world_rest_tet(const cf_world *sim, int t, int nodes[4]);
+int cf_world_rest_node_count(const cf_world *w);
+void cf_world_rest_nodes(const cf_world *w, double *X);
+int cf_world_rest_tet(const cf_world *w, int t, int nodes[4]);
 
 /* The four corners of tet t (input numbering) now, x[4][3] in m: the
  * nodes of a fracture-mode or pbd-rigid fragment as they are, those of a
  * Bullet body its rest shape moved by the body's pose.  Returns 0, or -1
  * for t out of range. */
-int cf_world_tet_positions(const cf_world *sim, int t, double x[12]);
+int cf_world_tet_positions(const cf_world *w, int t, double x[12]);
 
 /* The tets of fracture-mode fragments now, for the viewers, in input order:
  * tets[k] (input numbering), stress[k][6] the Cauchy stress at the last
@@ -225,20 +225,20 @@ int cf_world_tet_positions(const cf_world *sim, int t, double x[12]);
  * the energy they dissipated over G_I times their area, docs/physics.md
  * §6).  Each array holds cf_world_tet_count() entries (times 6 for
  * stress).  Returns how many were written, -1 when out of memory. */
-int cf_world_fracture_tets(const cf_world *sim, int *tets, double *stress, double *damage);
+int cf_world_fracture_tets(const cf_world *w, int *tets, double *stress, double *damage);
 
 /* Support distance of fragment `id` along unit direction d now: the largest
  * (R (X - X_cm)).d over its nodes, m, with X the rest positions and R the
  * fragment's rigid pose (deformation is not seen); 0 for a dead or unknown
  * fragment. */
-double cf_world_fragment_support(cf_world *sim, int id, const double d[3]);
+double cf_world_fragment_support(cf_world *w, int id, const double d[3]);
 
 /* FNV-1a hash of the state's bits: every node's position and velocity,
  * each tet's fragment, each fragment's mode and its Bullet body's state.
  * Two runs of one scene give the same hash at the same step, for any thread
  * count (the element loops write per-element results and sum them in a
  * fixed order). */
-uint64_t cf_world_state_hash(const cf_world *sim);
+uint64_t cf_world_state_hash(const cf_world *w);
 
 /* Memory each subsystem of the run holds now, bytes; 0 for one the scene
  * does not use (nothing of it is allocated). */
@@ -260,7 +260,7 @@ typedef struct cf_memory {
                                      loop, cohfrac/sim.h; 0 from cf_world_memory) */
 } cf_memory;
 
-void cf_world_memory(const cf_world *sim, cf_memory *m);
+void cf_world_memory(const cf_world *w, cf_memory *m);
 
 /* The fracture-mode step so far, for benchmarks: steps taken, wall time
  * per stage (s, as in the run summary), and the sizes of what the step
@@ -279,7 +279,7 @@ typedef struct cf_step_stats {
     int serial_bars;                       /* bars no colour could take (swept on one thread) */
 } cf_step_stats;
 
-void cf_world_step_stats(const cf_world *sim, cf_step_stats *out);
+void cf_world_step_stats(const cf_world *w, cf_step_stats *out);
 
 /* The traffic model (docs/performance.md): the bytes one fracture-mode
  * step must move between memory and the cores at the least, each array
