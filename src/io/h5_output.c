@@ -161,7 +161,6 @@ struct cf_h5 {
     hsize_t ncracks;
     hid_t ftet[FT_COUNT];    /* /fracture_mode, created by the first cf_h5_add_fracture_tets */
     hsize_t nftets;
-    hsize_t ft_first, ft_count; /* the rows added for the frame being written */
     hid_t surface[SF_COUNT]; /* /surfaces */
     hsize_t nsurface;
     hid_t map_step, map_time, map_value; /* /mesh/tet_fragment, created on first use */
@@ -970,8 +969,9 @@ static cf_status write_frame_impl(cf_h5 *h, long step, double time, const cf_fra
     r->ncols = ncols;
     r->first = h->nalive;
     r->count = (hsize_t)n;
-    r->ft_first = h->ft_first, r->ft_count = h->ft_count;
-    h->ft_count = 0;
+    /* Its /fracture_mode rows: those added since the frame before. */
+    r->ft_first = T > 0 ? h->frames[T - 1].ft_first + h->frames[T - 1].ft_count : 0;
+    r->ft_count = h->nftets - r->ft_first;
     for (size_t c = 0; c < width; ++c)
         if (col_src[c] >= 0)
             h->alive[h->nalive++] = lo + (int)c;
@@ -1305,10 +1305,8 @@ static cf_status add_fracture_tets_impl(cf_h5 *h, int n, const int *tet, const d
                         bufs[c]) < 0)
             st = h5_fail(err, h->path, "appending to /fracture_mode/%s", FRACTURE_COLUMNS[c].name);
     free(times);
-    if (st == CF_OK) {
-        h->ft_first = h->nftets, h->ft_count = (hsize_t)n;
+    if (st == CF_OK)
         h->nftets += (hsize_t)n;
-    }
     return st;
 }
 
@@ -1926,7 +1924,6 @@ static void rollback(cf_h5 *h)
     for (int c = 0; c < FT_COUNT; ++c)
         trim_rows(h->ftet[c], h->nftets_flushed);
     h->nftets = h->nftets_flushed;
-    h->ft_count = 0;
     for (int c = 0; c < SF_COUNT; ++c)
         trim_rows(h->surface[c], h->nsurface_flushed);
     h->nsurface = h->nsurface_flushed;
