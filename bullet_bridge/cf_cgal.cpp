@@ -131,8 +131,7 @@ template <class Repair> bool attempt(Mesh &m, Repair how)
 
 // Removes the self-intersections of m: the union of its parts when they
 // overlap as separate closed surfaces; else autorefinement, which cuts the
-// surface along its intersections and removes the patches inside; else the
-// local repair that remeshes or fills around the intersecting faces.
+// surface along its intersections and removes the patches inside.
 // Returns the way that worked (cfc_repair_report.intersections_fixed), or
 // CFC_NOT_FIXED with m unchanged.
 int remove_intersections(Mesh &m)
@@ -177,10 +176,7 @@ bool repair_exactly(std::vector<Point> pts, std::vector<Polygon> polys, Mesh &m,
     return true;
 }
 
-// CGAL's 3D alpha wrapping of the soup: a closed, oriented 2-manifold free
-// of self-intersections that encloses every triangle at `offset`, whatever
-// the input's defects (Portaneri et al., ACM TOG 2022).  Features thinner
-// than about alpha are closed over.
+// The diagonal of the points' bounding box.
 double diagonal(const std::vector<Ki::Point_3> &p)
 {
     CGAL::Bbox_3 box;
@@ -270,6 +266,10 @@ int repair(const double *verts, int nv, const int *tris, int nt, double **v_out,
         r.wrap_offset = diag / CFC_WRAP_OFFSET_DIVISOR;
         r.intersections_fixed = CFC_WRAPPED;
         r.faces_reoriented = r.holes_filled = 0;
+        // CGAL's 3D alpha wrapping of the soup: a closed, oriented 2-manifold
+        // free of self-intersections that encloses every triangle at the
+        // offset, whatever the input's defects (Portaneri et al., ACM TOG
+        // 2022); features thinner than about alpha are closed over.
         Mesh_inexact w;
         CGAL::alpha_wrap_3(p, polys, r.wrap_alpha, r.wrap_offset, w);
         st = copy_out(w, v_out, nv_out, tri_out, nt_out);

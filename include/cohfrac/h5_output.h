@@ -141,7 +141,7 @@ cf_status cf_h5_write_parameter(cf_h5 *h, const char *name, const double *v, int
  * /fracture_mode (created on the first call, even with n = 0): tet [n]
  * (input numbering, as /mesh/rest/tets), corners [n][4][3] m (deformed,
  * cf_world_tet_positions), stress [n][6] Pa (Cauchy, xx yy zz yz xz xy),
- * damage [n] (0-1, cf_world_tet_fields) and the frame's time, s, on every
+ * damage [n] (0-1, cf_world_fracture_tets) and the frame's time, s, on every
  * row.  Reaches the disk with the next flush (the frame's). */
 cf_status cf_h5_add_fracture_tets(cf_h5 *h, int n, const int *tet, const double *corners,
                                   const double *stress, const double *damage, double time,

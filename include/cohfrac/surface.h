@@ -84,13 +84,14 @@ int cf_surface_check_closed(const cf_surface *s, char *why, size_t why_len);
 
 /* Repair a surface that is not a closed manifold or intersects itself, with
  * CGAL's Polygon Mesh Processing (bullet_bridge/cf_cgal.h, Debian
- * libcgal-dev): equal points joined, degenerate and repeated triangles
- * removed, one orientation, non-manifold vertices split, holes closed, and
- * intersecting triangles cut along their intersections with the parts
- * inside the enclosed volume removed (overlapping closed parts become the
- * surface of their union).  `s` is replaced; `report` (len bytes) says what
- * changed, one line.  CF_ERR_MESH_PARSE when CGAL cannot repair it,
- * CF_ERR_NOMEM.  The result is rounded to double: check it again. */
+ * libcgal-dev, run in the program cohfrac-repair): equal points joined,
+ * degenerate and repeated triangles removed, one orientation, holes
+ * closed, and intersections removed (overlapping closed parts become the
+ * surface of their union, else the surface is cut along its intersections
+ * and the parts inside removed); where no exact repair holds (non-manifold
+ * edges), the surface's alpha wrap.  `s` is replaced; `report` (len bytes)
+ * says what changed, one line.  CF_ERR_MESH_PARSE when CGAL cannot repair
+ * it, CF_ERR_NOMEM.  The result is rounded to double: check it again. */
 cf_status cf_surface_repair(cf_surface *s, char *report, size_t len, cf_error *err);
 
 /* Replace `s` by its alpha wrap (CGAL alpha_wrap_3, bullet_bridge/cf_cgal.h):

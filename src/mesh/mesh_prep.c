@@ -367,17 +367,17 @@ static cf_status check_span(const cf_surface *s, const char *what, cf_error *err
     return CF_OK;
 }
 
+/* The area of a surface (file units squared). */
 static double surface_area(const cf_surface *s)
 {
     double a = 0;
     for (int t = 0; t < s->n_tris; t++) {
-        const double *p = &s->v[3 * s->tri[3 * t]], *q = &s->v[3 * s->tri[3 * t + 1]],
-                     *r = &s->v[3 * s->tri[3 * t + 2]];
-        double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-        double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-        double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                       u[0] * w[1] - u[1] * w[0]};
-        a += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        const int *T = &s->tri[3 * t];
+        double u[3], w[3], c[3];
+        v3_sub(&s->v[3 * T[1]], &s->v[3 * T[0]], u);
+        v3_sub(&s->v[3 * T[2]], &s->v[3 * T[0]], w);
+        v3_cross(u, w, c);
+        a += 0.5 * v3_norm(c);
     }
     return a;
 }
