@@ -704,10 +704,15 @@ static cf_status write_particles_group(cf_h5 *h, cf_error *err)
     return st;
 }
 
-/* A group of row-appendable columns (/fragments, /handoffs). */
+/* A group of row-appendable columns (/fragments, /handoffs, ...), its
+ * datasets' ids in out; nothing to do once created (out[0] valid), so the
+ * groups written only by some runs (/cracks, /fracture_mode) are created on
+ * their first rows. */
 static cf_status write_row_group(cf_h5 *h, const char *name, const column_def *cols, int ncols,
                                  hid_t *out, cf_error *err)
 {
+    if (out[0] >= 0)
+        return CF_OK;
     hid_t g = make_group(h->file, name);
     int ok = g >= 0;
     for (int i = 0; i < ncols && ok; ++i) {
@@ -1240,17 +1245,12 @@ static cf_status add_cracks_impl(cf_h5 *h, const cf_crack_row *r, int n, cf_erro
         return cf_error_set(err, CF_ERR_OUTPUT, "cf_h5_add_cracks: no output file is open");
     if (n < 0 || (n > 0 && !r))
         return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': bad crack rows", h->path);
-    if (h->crack[0] < 0) {
-        cf_status st = write_row_group(h, "cracks", CRACK_COLUMNS, CR_COUNT, h->crack, err);
-        if (st != CF_OK)
-            return st;
-    }
-    if (n == 0)
-        return CF_OK;
+    cf_status st = write_row_group(h, "cracks", CRACK_COLUMNS, CR_COUNT, h->crack, err);
+    if (st != CF_OK || n == 0)
+        return st;
     /* Column by column from the rows. */
     int *ibuf = malloc((size_t)n * sizeof(int));
     double *dbuf = malloc((size_t)n * 3 * sizeof(double));
-    cf_status st = CF_OK;
     for (int c = 0; st == CF_OK && ibuf && dbuf && c < CR_COUNT; ++c) {
         for (int i = 0; i < n; ++i) {
             const cf_crack_row *q = &r[i];
@@ -1286,20 +1286,15 @@ static cf_status add_fracture_tets_impl(cf_h5 *h, int n, const int *tet, const d
     if (n < 0 || (n > 0 && (!tet || !corners || !stress || !damage)))
         return cf_error_set(err, CF_ERR_OUTPUT, "output file '%s': bad fracture-mode rows",
                             h->path);
-    if (h->ftet[0] < 0) {
-        cf_status st = write_row_group(h, "fracture_mode", FRACTURE_COLUMNS, FT_COUNT, h->ftet, err);
-        if (st != CF_OK)
-            return st;
-    }
-    if (n == 0)
-        return CF_OK;
+    cf_status st = write_row_group(h, "fracture_mode", FRACTURE_COLUMNS, FT_COUNT, h->ftet, err);
+    if (st != CF_OK || n == 0)
+        return st;
     double *times = malloc((size_t)n * sizeof *times);
     if (!times)
         return no_memory(err, h->path);
     for (int i = 0; i < n; i++)
         times[i] = time;
     const void *bufs[FT_COUNT] = {tet, corners, stress, damage, times};
-    cf_status st = CF_OK;
     for (int c = 0; c < FT_COUNT && st == CF_OK; ++c)
         if (append_rows(h->ftet[c], h->nftets, (hsize_t)n, mem_type(&FRACTURE_COLUMNS[c]),
                         bufs[c]) < 0)
