@@ -673,6 +673,54 @@ static void test_handoff_clears_obstacle_overlap(void **state)
     cf_scene_free(&sc);
 }
 
+/* A box wedged between the floor and a ceiling 10 mm lower than its top
+ * (explicit fracture mode, penalty contact): no translation clears it, so
+ * the hand-off into fracture mode puts the nodes still inside on the
+ * planes, squeezing the box by 10 %.  That strain energy is what the
+ * obstacles did to the box, and the ledger books it as a hand-off gain:
+ * the residual stays at round-off of the 2 J it starts with.  Left inside,
+ * the penalty springs (k = 0.01 m / dt^2 at 5 mm) would throw the nodes at
+ * hundreds of m/s. */
+static const char *wedge_scene =
+    "return {\n"
+    "  name = 'wedge', duration = 0.004, gravity = {0, 0, 0},\n"
+    "  material = {E = 1e5, nu = 0.25, rho = 1000, G_I = 1, sigma_max = 1e9,\n"
+    "              friction = 0, restitution = 0},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {2, 2, 2}},\n"
+    "             position = {0, 0, 0.0505}, velocity = {0, 0, -2}}},\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}},\n"
+    "               {type = 'plane', point = {0, 0, 0.09}, normal = {0, 0, -1}}},\n"
+    "  solver = {dt_rigid = 1e-3, impact_threshold = 1, quiet_steps = 100000,\n"
+    "            constraints = 'none', cfl_fraction = 0.5, obstacle_contact = 'penalty'},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void test_wedged_piece_enters_clear(void **state)
+{
+    (void)state;
+    cf_world_def sc;
+    cf_sim *sim = make_sim(wedge_scene, &sc);
+    double worst = 0, ke_max = 0;
+    int entered = 0;
+    cf_ledger l;
+    while (!cf_sim_done(sim)) {
+        advance(sim);
+        cf_world_ledger(cf_sim_world(sim), &l);
+        worst = fmax(worst, fabs(l.residual) / l.initial);
+        ke_max = fmax(ke_max, l.kinetic);
+        entered |= any_in_fracture_mode(sim);
+    }
+    printf("FIGURE wedged hand-off: strain energy put in %.4f J, largest kinetic %.4f J, "
+           "largest |residual| / input %.2e\n",
+           -l.handoff, ke_max, worst);
+    assert_true(entered);
+    assert_true(-l.handoff > 0.05);             /* the squeeze was booked */
+    assert_true(ke_max <= 2.0 - l.handoff + 1e-9);
+    assert_true(worst <= 1e-3);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
 /* An unbreakable elastic box lands at 2 m/s, and its quiet period (2 ms)
  * ends long before the impact does (a wave crosses it and back in 20 ms).
  * It stays in fracture mode while it still drives into the ground, and
@@ -880,6 +928,7 @@ int main(void)
         cmocka_unit_test(test_handback_in_flight_stays_rigid),
         cmocka_unit_test(test_mesh_obstacle_matches_plane),
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),
+        cmocka_unit_test(test_wedged_piece_enters_clear),
         cmocka_unit_test(test_no_return_while_driving_in),
         cmocka_unit_test(test_fracture_only_fragments_and_weibull),
         cmocka_unit_test(test_handoff_keeps_bonded_pieces_together),

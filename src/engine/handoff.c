@@ -335,9 +335,10 @@ static void place_rigid(cf_solid *s, const cf_fragment *f, const double com[3], 
 /* How deep fragment f's nodes reach into obstacle j (m, <= 0), and the
  * obstacle's normal at the deepest: at their current positions, or (R not
  * NULL) at those of its rest shape placed with rotation R and centre of
- * mass com. */
+ * mass com; either moved by shift. */
 static double deepest_overlap(const cf_world *sim, int j, const cf_fragment *f,
-                              const double com[3], const double R[9], double n[3])
+                              const double com[3], const double R[9], const double shift[3],
+                              double n[3])
 {
     const cf_solid *s = &sim->solid;
     double deepest = 0;
@@ -352,6 +353,7 @@ static double deepest_overlap(const cf_world *sim, int j, const cf_fragment *f,
         } else {
             memcpy(x, &s->x[3 * f->nodes.v[i]], sizeof x);
         }
+        v3_axpy(1.0, shift, x);
         double d = cf_obstacle_distance(&sim->obs, j, sim->t, x, nj);
         if (d < deepest)
             deepest = d, memcpy(n, nj, sizeof nj);
@@ -359,19 +361,62 @@ static double deepest_overlap(const cf_world *sim, int j, const cf_fragment *f,
     return deepest;
 }
 
+#define CLEAR_PASSES 8
+#define CLEAR_TOL 1e-12 /* m: overlaps left by rounding after the first pass */
+
+/* The translation (m) that takes fragment f (placed as deepest_overlap
+ * says) out of every obstacle.  One obstacle's push can send the piece
+ * into another (a sphere's normal below its equator points into the
+ * floor), so the obstacles are visited again until none overlaps, at most
+ * CLEAR_PASSES times; returns whether it is clear. */
+static int clearing_shift(const cf_world *sim, const cf_fragment *f, const double com[3],
+                          const double R[9], double shift[3])
+{
+    shift[0] = shift[1] = shift[2] = 0;
+    for (int pass = 0; pass < CLEAR_PASSES; pass++) {
+        int moved = 0;
+        for (int j = 0; j < sim->obs.n; j++) {
+            double n[3], deepest = deepest_overlap(sim, j, f, com, R, shift, n);
+            if (deepest < (pass ? -CLEAR_TOL : 0))
+                v3_axpy(-deepest, n, shift), moved = 1;
+        }
+        if (!moved)
+            return 1;
+    }
+    return 0;
+}
+
 /* Translate fragment f out of every obstacle its placed nodes overlap (a
- * rigid pose from Bullet rests within the contact margin; a best rigid fit
- * of deformed nodes can reach below the ground).  In fracture mode the PBD
- * projection would otherwise push the overlap out at dt_fracture, and the
- * bars would carry that push to the whole fragment as velocity: 2 mm over a
- * 5 us step is a rebound at metres per second. */
+ * rigid pose from Bullet rests within the contact margin, and a kinematic
+ * obstacle's push in one rigid step can reach centimetres into a body; a
+ * best rigid fit of deformed nodes can reach below the ground).  In
+ * fracture mode the PBD projection would otherwise push the overlap out
+ * at dt_fracture, and the bars would carry that push to the whole
+ * fragment as velocity: 2 mm over a 5 us step is a rebound at metres per
+ * second; the penalty contact's spring, k = 0.01 m / dt^2, would throw it
+ * harder still.  A piece no translation clears (wedged between obstacles:
+ * a moving sphere over a piece on the floor) has the nodes still inside
+ * put on the surface they are under.  That strains it: the energy, what
+ * the obstacles' push did to the piece, is booked as a hand-off gain
+ * (a negative hand-off loss). */
 static void clear_obstacles(cf_world *sim, const cf_fragment *f)
 {
     cf_solid *s = &sim->solid;
-    for (int j = 0; j < sim->obs.n; j++) {
-        double n[3], deepest = deepest_overlap(sim, j, f, NULL, NULL, n);
-        for (int i = 0; deepest < 0 && i < f->nodes.n; i++)
-            v3_axpy(-deepest, n, &s->x[3 * f->nodes.v[i]]);
+    double shift[3];
+    int clear = clearing_shift(sim, f, NULL, NULL, shift);
+    for (int i = 0; i < f->nodes.n; i++) {
+        double *x = &s->x[3 * f->nodes.v[i]];
+        v3_axpy(1.0, shift, x);
+        for (int j = 0; !clear && j < sim->obs.n; j++) {
+            double n[3], d = cf_obstacle_distance(&sim->obs, j, sim->t, x, n);
+            if (d < 0)
+                v3_axpy(-d, n, x);
+        }
+    }
+    if (!clear) {
+        double e = cf_tet4_energy_now(s, f->tets, f->nt, sim->def.solver.elasticity);
+        sim->flow.handoff -= e;
+        sim->flow.wedged += e;
     }
 }
 
@@ -383,10 +428,9 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
  * instead (the translation alone: momenta stay as they are). */
 static void lift_clear(cf_world *sim, const cf_fragment *g, double com[3], const double R[9])
 {
-    for (int j = 0; j < sim->obs.n; j++) {
-        double n[3], deepest = deepest_overlap(sim, j, g, com, R, n);
-        v3_axpy(-deepest, n, com);
-    }
+    double shift[3];
+    clearing_shift(sim, g, com, R, shift);
+    v3_axpy(1.0, shift, com);
 }
 
 cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err)

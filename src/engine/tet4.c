@@ -360,6 +360,21 @@ void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9
         sigma[k] = out[k][0];
 }
 
+double cf_tet4_energy_now(const cf_solid *s, const int *tets, int nt, cf_elasticity kind)
+{
+    double e = 0;
+    for (int i = 0; i < nt; i += LANES) {
+        int t[LANES], n = nt - i < LANES ? nt - i : LANES;
+        for (int l = 0; l < LANES; l++)
+            t[l] = tets[i + (l < n ? l : 0)];
+        tet_lanes L;
+        tet_lanes_eval(s, t, kind, &L);
+        for (int l = 0; l < n; l++)
+            e += (L.w[l] + L.wp[l]) * s->vol[t[l]];
+    }
+    return e;
+}
+
 void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt)
 {
     if (s->ep)

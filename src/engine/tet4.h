@@ -59,6 +59,13 @@ double cf_tet4_max_principal_bound(const double A[9]);
  * the rotation warm start and the plastic strain (neither updated). */
 void cf_tet4_stress(const cf_solid *s, int t, cf_elasticity kind, double sigma[9]);
 
+/* The energy (J) a force pass at the current positions would give the nt
+ * listed tets: strain energy, and the plastic work of their return to the
+ * yield surface when crushing.  Reads only (no warm start or plastic
+ * strain is updated); in tet order, one thread.  What a hand-off that
+ * moves nodes of an unstressed fragment puts in. */
+double cf_tet4_energy_now(const cf_solid *s, const int *tets, int nt, cf_elasticity kind);
+
 /* A fragment going back to rigid mode: its tets' plastic strain is dropped
  * with their elastic strain (a rigid fragment keeps the rest shape, so on
  * re-entry its nodes start from it unstressed).  The plastic work already

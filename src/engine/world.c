@@ -1061,7 +1061,9 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
 }
 
 /* Energy growth with no work input: kinetic + strain + cohesive energy
- * above (1 + max_energy_growth) times what was put in. */
+ * above (1 + max_energy_growth) times what was put in (the work of
+ * gravity, prescribed nodes and moving obstacles, and the squeeze of
+ * wedged pieces at their hand-offs). */
 static cf_status check_energy(cf_world *sim, cf_error *err)
 {
     cf_ledger l;
@@ -1069,7 +1071,7 @@ static cf_status check_energy(cf_world *sim, cf_error *err)
     double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated +
                   l.plastic_dissipated;
     double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
-                   fmax(0.0, l.work_obstacles);
+                   fmax(0.0, l.work_obstacles) + sim->flow.wedged;
     if (have <= (1 + sim->def.solver.max_energy_growth) * input + 1e-12)
         return CF_OK;
     char what[200];

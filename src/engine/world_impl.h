@@ -25,7 +25,9 @@ typedef struct cf_energy_flows {
     double pbd;        /* removed by the PBD/XPBD projection */
     double damping;    /* removed by global damping */
     double handoff;    /* non-rigid kinetic + strain + cohesive stored energy
-                          dropped at fracture -> rigid hand-offs */
+                          dropped at fracture -> rigid hand-offs, less wedged */
+    double wedged;     /* strain energy put in at rigid -> fracture hand-offs of
+                          pieces wedged between obstacles (part of handoff) */
     double integration; /* changed by Bullet's integrator in bodies touching nothing */
 } cf_energy_flows;
 
