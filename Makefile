@@ -25,6 +25,7 @@ meshes: build
 	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny --target-tets 200000
 	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_small --target-tets 15000
 	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_1k --target-tets 1000
+	$(BUILD)/cohfrac mesh $(BUNNY_OBJ) -o $(MESHES)/bunny_4k --target-tets 4000
 
 run: meshes
 	$(BUILD)/cohfrac run scenes/plaster_bunny_drop.lua --mesh-dir $(MESHES) -o out/plaster_bunny_drop.h5

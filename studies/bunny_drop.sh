@@ -1,5 +1,5 @@
 #!/bin/sh
-# Bunny drop (scenes/bunny_drop.lua, bunny_small): error against run time of
+# Bunny drop (scenes/source/bunny_drop.lua, bunny_small): error against run time of
 # the source's fracture-mode settings, dt_fracture x PBD iterations x
 # k_stiffness (the source's: 5e-6 s, 3, 0.9).
 #
@@ -16,8 +16,8 @@
 set -e
 jobs=${1:-2}
 cohfrac=${COHFRAC:-build/cohfrac}
-$cohfrac study scenes/bunny_drop.lua -j "$jobs" -o docs/studies/bunny_drop_explicit
-$cohfrac study scenes/bunny_drop.lua -j "$jobs" -o docs/studies/bunny_drop \
+$cohfrac study scenes/source/bunny_drop.lua -j "$jobs" -o docs/studies/bunny_drop_explicit
+$cohfrac study scenes/source/bunny_drop.lua -j "$jobs" -o docs/studies/bunny_drop \
   --vary 'solver.dt_fracture=5e-6,2e-5,1e-4' \
   --vary 'solver.pbd.iterations=1,3,10' \
   --vary 'solver.pbd.k_stiffness=0.5,0.9,1' \

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Rigid mode alone: the bunny drop (scenes/bunny_drop.lua, bunny_small)
+# Rigid mode alone: the bunny drop (scenes/source/bunny_drop.lua, bunny_small)
 # with fracture switched off (impact_threshold 1e9 m/s: the bunny never
 # leaves rigid mode), dt_rigid for Bullet against the source's damped PBD
 # rigid mode (k_damping 1), measured against Bullet at dt_rigid = 1e-4 s.
@@ -8,7 +8,7 @@
 # Results: docs/studies/rigid_dt/study.{md,csv,png}
 set -e
 cohfrac=${COHFRAC:-build/cohfrac}
-$cohfrac study scenes/bunny_drop.lua -j "${1:-2}" -o docs/studies/rigid_dt \
+$cohfrac study scenes/source/bunny_drop.lua -j "${1:-2}" -o docs/studies/rigid_dt \
   --set 'solver.impact_threshold=1e9' \
   --vary 'solver.dt_rigid=5e-4,1e-3,2e-3,5e-3' \
   --vary 'solver.rigid_backend="bullet","pbd"' \

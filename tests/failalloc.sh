@@ -57,7 +57,7 @@ sites=
 run() {
     rm -f "$tmp/o.h5" "$tmp/o.xdmf" "$tmp/report"
     case $1 in
-    bunny) set -- "$1" "$2" "$3" "$src/tests/data/pbd_bunny_drop.lua" -m "$meshes" ;;
+    bunny) set -- "$1" "$2" "$3" "$src/scenes/source/bunny_drop.lua" -m "$meshes" ;;
     box) set -- "$1" "$2" "$3" "$src/tests/data/box_break.lua" --set 'bodies[1].position={0,0,0.1005}' \
         --set 'bodies[1].velocity={0,0,-4.4}' --set output.frame_interval=0.001 ;;
     esac

@@ -124,7 +124,7 @@ fi
 if [ -z "${ASAN_OPTIONS:-}" ]; then
     oom_bad=""
     for v in 60000 65000 70000 75000 80000 85000 90000; do
-        (ulimit -v $v; exec "$exe" run "$src/tests/data/pbd_bunny_drop.lua" -q -m "$meshes" \
+        (ulimit -v $v; exec "$exe" run "$src/scenes/source/bunny_drop.lua" -q -m "$meshes" \
             -o "$tmp/oom.h5" --force) >"$tmp/oom.log" 2>&1
         rc=$?
         if { [ $rc -ne 4 ] && [ $rc -ne 5 ] && [ $rc -ne 0 ]; } ||
@@ -145,7 +145,7 @@ fi
 # otherwise).  Exit 4 naming the reason, no crash, and a file h5py opens.
 mkdir -p "$tmp/full"
 if mount -t tmpfs -o size=64k tmpfs "$tmp/full" 2>/dev/null; then
-    expect 4 "the output disk fills up" "$exe" run "$src/tests/data/pbd_bunny_drop.lua" -q -m "$meshes" \
+    expect 4 "the output disk fills up" "$exe" run "$src/scenes/source/bunny_drop.lua" -q -m "$meshes" \
         -o "$tmp/full/x.h5"
     if grep -q 'No space left on device' "$tmp/log" &&
        /usr/bin/python3 -c "import h5py, sys; h5py.File(sys.argv[1], 'r')" "$tmp/full/x.h5"; then
@@ -162,7 +162,7 @@ fi
 # The drop is lengthened so that it cannot end before the signal comes.
 for sig in INT TERM; do
     want=130; [ $sig = TERM ] && want=143
-    "$exe" run "$src/tests/data/pbd_bunny_drop.lua" -q -m "$meshes" -o "$tmp/sig.h5" --set duration=60 \
+    "$exe" run "$src/scenes/source/bunny_drop.lua" -q -m "$meshes" -o "$tmp/sig.h5" --set duration=60 \
         >/dev/null 2>"$tmp/sig.err" &
     pid=$!
     sleep 3
@@ -193,7 +193,7 @@ trap 'kill $busy_pids 2>/dev/null; rm -rf "$tmp"' EXIT
 timed_run() { # label, extra args: prints "wall hash"
     label=$1; shift
     t0=$(date +%s.%N)
-    "$exe" run "$src/tests/data/pbd_bunny_drop.lua" -q -m "$meshes" -o "$tmp/busy_$label.h5" "$@" \
+    "$exe" run "$src/scenes/source/bunny_drop.lua" -q -m "$meshes" -o "$tmp/busy_$label.h5" "$@" \
         >"$tmp/busy_$label.log" 2>&1
     t1=$(date +%s.%N)
     echo "$(awk "BEGIN { printf \"%.2f\", $t1 - $t0 }") $(sed -n 's/^state hash *\([0-9a-f]*\).*/\1/p' "$tmp/busy_$label.log")"

@@ -28,7 +28,7 @@ done
 
 for m in $moments; do
     rm -f "$tmp/k.h5" "$tmp/k.xdmf"
-    "$exe" run "$src/tests/data/pbd_bunny_drop.lua" -q -m "$meshes" -o "$tmp/k.h5" >/dev/null 2>&1 &
+    "$exe" run "$src/scenes/source/bunny_drop.lua" -q -m "$meshes" -o "$tmp/k.h5" >/dev/null 2>&1 &
     pid=$!
     sleep "$(echo "$m" | sed 's/.$/.&/; s/^\./0./')"
     kill -KILL $pid 2>/dev/null
