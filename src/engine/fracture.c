@@ -127,13 +127,8 @@ static int crush(cf_world *sim, cf_fragment *f, double t, double dt)
     for (int i = 0; i < sim->crushed.n; i++)
         for (int j = 0; j < 4; j++) {
             int tt = sim->crushed.v[i], a = s->tet[4 * tt + j];
-            double *x = &s->x[3 * a];
             s->wp[tt] += node_springs(sim, a, t, dt);
-            for (int o = 0; o < sim->obs.n && !cf_obstacles_clear(&sim->obs, x); o++) {
-                double n[3], d = cf_obstacle_distance(&sim->obs, o, t, x, n);
-                if (d < 0)
-                    v3_axpy(-d, n, x);
-            }
+            cf_obstacles_push_out(&sim->obs, t, &s->x[3 * a]);
         }
     return crushed;
 }

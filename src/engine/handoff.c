@@ -407,11 +407,8 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
     for (int i = 0; i < f->nodes.n; i++) {
         double *x = &s->x[3 * f->nodes.v[i]];
         v3_axpy(1.0, shift, x);
-        for (int j = 0; !clear && j < sim->obs.n; j++) {
-            double n[3], d = cf_obstacle_distance(&sim->obs, j, sim->t, x, n);
-            if (d < 0)
-                v3_axpy(-d, n, x);
-        }
+        if (!clear)
+            cf_obstacles_push_out(&sim->obs, sim->t, x);
     }
     if (!clear) {
         double e = cf_tet4_energy_now(s, f->tets, f->nt, sim->def.solver.elasticity);

@@ -78,6 +78,12 @@ static inline double cf_plane_distance(const cf_obstacle *o, const double p[3],
 int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], double t,
                          double p[3], double normal[3]);
 
+/* Move point p (at time t) onto the surface of each obstacle it lies
+ * inside, in obstacle order, along that obstacle's normal: a node put
+ * back on the surface where nothing may push it out over a step (a
+ * crushed tet's, a wedged piece's at its hand-off). */
+void cf_obstacles_push_out(const cf_obstacles *obs, double t, double p[3]);
+
 /* Whether p lies on or outside every obstacle when all are static planes
  * (planes_only), which cf_obstacles_project would then leave alone: its test
  * inline, for the nodes far from the ground (most of them), without its

@@ -91,6 +91,15 @@ void cf_obstacles_free(cf_obstacles *obs)
     obs->mesh = NULL, obs->range = NULL;
 }
 
+void cf_obstacles_push_out(const cf_obstacles *obs, double t, double p[3])
+{
+    for (int j = 0; j < obs->n && !cf_obstacles_clear(obs, p); j++) {
+        double n[3], d = cf_obstacle_distance(obs, j, t, p, n);
+        if (d < 0)
+            v3_axpy(-d, n, p);
+    }
+}
+
 int cf_obstacles_project(const cf_obstacles *obs, double t0, const double x[3], double t,
                          double p[3], double normal[3])
 {
