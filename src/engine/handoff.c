@@ -386,6 +386,23 @@ static int clearing_shift(const cf_world *sim, const cf_fragment *f, const doubl
     return 0;
 }
 
+/* Energy a hand-off puts in (J), booked as a gain of the hand-off flow and
+ * counted as input by the energy guard. */
+static void put_in(cf_world *sim, double e)
+{
+    sim->flow.handoff -= e;
+    sim->flow.put_in += e;
+}
+
+/* Gravity's potential that moving a piece of `mass` (kg) by `shift` (m)
+ * puts in, J: a plastically flattened 487 kg hollow sphere lifted 15 mm
+ * clear of the floor at its return to rigid mode gained 70 J, 1.1 % of
+ * its drop's input, that the ledger missed. */
+static double lift_energy(const cf_world *sim, double mass, const double shift[3])
+{
+    return -mass * v3_dot(sim->def.gravity, shift);
+}
+
 /* Translate fragment f out of every obstacle its placed nodes overlap (a
  * rigid pose from Bullet rests within the contact margin, and a kinematic
  * obstacle's push in one rigid step can reach centimetres into a body; a
@@ -398,7 +415,7 @@ static int clearing_shift(const cf_world *sim, const cf_fragment *f, const doubl
  * a moving sphere over a piece on the floor) has the nodes still inside
  * put on the surface they are under.  That strains it: the energy, what
  * the obstacles' push did to the piece, is booked as a hand-off gain
- * (a negative hand-off loss). */
+ * (a negative hand-off loss), as is gravity's potential of the shift. */
 static void clear_obstacles(cf_world *sim, const cf_fragment *f)
 {
     cf_solid *s = &sim->solid;
@@ -410,11 +427,9 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
         if (!clear)
             cf_obstacles_push_out(&sim->obs, sim->t, x);
     }
-    if (!clear) {
-        double e = cf_tet4_energy_now(s, f->tets, f->nt, sim->def.solver.elasticity);
-        sim->flow.handoff -= e;
-        sim->flow.wedged += e;
-    }
+    put_in(sim, lift_energy(sim, f->mass, shift));
+    if (!clear)
+        put_in(sim, cf_tet4_energy_now(s, f->tets, f->nt, sim->def.solver.elasticity));
 }
 
 /* A piece going back to rigid mode is its rest shape at the pose fitted
@@ -422,12 +437,14 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
  * shape reaches into it by about the compression.  Bullet's push-out of
  * such an overlap reads as a fresh impact, and the piece went straight
  * back to fracture mode; the pose is lifted clear of every obstacle
- * instead (the translation alone: momenta stay as they are). */
+ * instead (the translation alone: momenta stay as they are; gravity's
+ * potential of the lift is booked as a hand-off gain). */
 static void lift_clear(cf_world *sim, const cf_fragment *g, double com[3], const double R[9])
 {
     double shift[3];
     clearing_shift(sim, g, com, R, shift);
     v3_axpy(1.0, shift, com);
+    put_in(sim, lift_energy(sim, g->mass, shift));
 }
 
 cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err)

@@ -1071,7 +1071,7 @@ static cf_status check_energy(cf_world *sim, cf_error *err)
     double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated +
                   l.plastic_dissipated;
     double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
-                   fmax(0.0, l.work_obstacles) + sim->flow.wedged;
+                   fmax(0.0, l.work_obstacles) + sim->flow.put_in;
     if (have <= (1 + sim->def.solver.max_energy_growth) * input + 1e-12)
         return CF_OK;
     char what[200];

@@ -25,9 +25,11 @@ typedef struct cf_energy_flows {
     double pbd;        /* removed by the PBD/XPBD projection */
     double damping;    /* removed by global damping */
     double handoff;    /* non-rigid kinetic + strain + cohesive stored energy
-                          dropped at fracture -> rigid hand-offs, less wedged */
-    double wedged;     /* strain energy put in at rigid -> fracture hand-offs of
-                          pieces wedged between obstacles (part of handoff) */
+                          dropped at fracture -> rigid hand-offs, less put_in */
+    double put_in;     /* energy hand-offs put in (part of handoff): the strain
+                          of pieces wedged between obstacles entering fracture
+                          mode, and gravity's potential of pieces moved clear of
+                          obstacles */
     double integration; /* changed by Bullet's integrator in bodies touching nothing */
 } cf_energy_flows;
 
