@@ -13,11 +13,11 @@ static void pair_nodes(const cf_solid *s, const cf_cohesive *ce, int i, int *a, 
     *b = s->tet[4 * ce->tet[1] + ce->slot[1][i]];
 }
 
-/* Unit normal (A -> B) and area of element ce's mid-surface at positions pos. */
+/* Unit normal (A -> B) and area of element ce's mid-surface at positions
+ * pos, and the mid-points of its three pairs. */
 static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double *pos, int stride,
-                         int a[3], int b[3], double n[3])
+                         int a[3], int b[3], double n[3], double mid[3][3])
 {
-    double mid[3][3];
     for (int i = 0; i < 3; i++) {
         pair_nodes(s, ce, i, &a[i], &b[i]);
         for (int k = 0; k < 3; k++)
@@ -31,31 +31,18 @@ static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double 
     return 0.5 * nn;
 }
 
-/* Work absorbed by one scalar traction-opening component between the last
- * evaluation (d0, T0) and this one (d, T), trapezoidal in the opening.  The
- * normal law is discontinuous at zero opening (penalty below, cohesive
- * above): a step that crosses zero is split there, t0plus being the
- * cohesive traction at 0+. */
-static double component_work(double d0, double T0, double d, double T, double t0plus)
-{
-    if (d0 <= 0 && d > 0)
-        return -0.5 * T0 * d0 + 0.5 * (t0plus + T) * d;
-    if (d0 > 0 && d <= 0)
-        return -0.5 * (T0 + t0plus) * d0 + 0.5 * T * d;
-    return 0.5 * (T0 + T) * (d - d0);
-}
-
-/* Element ce's three node pairs: tractions, energies and state, and each
- * pair's force into out[0..2].  Writes only ce and out.  Returns its pairs
- * in complete failure. */
+/* Element ce's three node pairs: tractions, energies and state, and the
+ * forces on its nodes into out[0..2].  Writes only ce and out.  Returns its
+ * pairs in complete failure. */
 static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_law *law,
                           const void *params, double dt, double kp, cf_pair_force out[3])
 {
     int n_failed = 0, a[3], b[3];
-    double nrm[3];
-    for (int i = 0; i < 3; i++)
-        out[i].a = -1;
-    double area = mid_normal(s, ce, s->x, 3, a, b, nrm);
+    double nrm[3], mid[3][3];
+    memset(out, 0, 3 * sizeof *out);
+    double area = mid_normal(s, ce, s->x, 3, a, b, nrm, mid);
+    for (int i = 0; i < 3; i++) /* a crack not yet open at a vertex carries nothing */
+        out[i].a = a[i] == b[i] ? -1 : a[i], out[i].b = b[i];
     if (area == 0)
         return 0;
     /* The law of the facet's strength (material.strength). */
@@ -66,8 +53,9 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         law->scale(scaled, ce->strength);
         p = scaled;
     }
+    double elastic = 0;
     for (int i = 0; i < 3; i++) {
-        if (a[i] == b[i]) /* the crack has not opened at this vertex yet */
+        if (a[i] == b[i])
             continue;
         double d[3], tv[3];
         v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
@@ -75,10 +63,8 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         for (int k = 0; k < 3; k++)
             tv[k] = d[k] - dn * nrm[k];
         double dtl = v3_norm(tv);
-        double Tn, Tt, e0n, e0t;
-        law->envelope(p, 0, ce->dt_max[i], &e0n, &e0t);
-        double t0plus = ce->dn_max[i] > 0 ? 0 : e0n; /* secant or envelope at 0+ */
-        double *L = ce->last[i]; /* dn, dt, Tn, Tt at the last evaluation */
+        double Tn, Tt;
+        double *L = ce->last[i]; /* dn, Tn at the last evaluation */
         law->traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
         n_failed += ce->failed[i];
         /* Stability cap of a node pair at step dt: a node pair is shared
@@ -92,8 +78,8 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
              * stays engaged.  A pair that slid past its partner and comes
              * back into view already overlapped would be kicked apart
              * with energy 1/2 K_p dn^2 that no load put in. */
-            int engaged = !ce->started[i] || L[0] > 0 || L[2] < 0;
-            double facing = kp >= 0 && engaged && v3_dot(d, d) <= 0.25 * area;
+            int engaged = !ce->started[i] || L[0] > 0 || L[1] < 0;
+            int facing = kp >= 0 && engaged && v3_dot(d, d) <= 0.25 * area;
             Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
         }
         /* The tangential traction rises from zero with the capped
@@ -102,24 +88,35 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
          * direction set by round-off (time continuity, Papoulia et al.
          * 2003). */
         Tt = fmin(Tt, cap * dtl);
-        if (!ce->started[i]) {
-            law->envelope(p, 0, 0, &e0n, &e0t);
-            L[0] = 0, L[1] = 0, L[2] = e0n;
-            L[3] = ce->dt_max[i] > 0 ? 0 : e0t; /* secant or envelope at 0 */
-            ce->started[i] = 1;
-        }
-        ce->work[i] += area / 3.0 *
-                       (component_work(L[0], L[2], dn, Tn, t0plus) + 0.5 * (L[3] + Tt) * (dtl - L[1]));
-        double elastic = area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
-        ce->dissipated[i] = fmax(ce->dissipated[i], ce->work[i] - elastic);
-        ce->stored[i] = ce->work[i] - ce->dissipated[i];
-        L[0] = dn, L[1] = dtl, L[2] = Tn, L[3] = Tt;
-        double fvec[3] = {0, 0, 0};
-        v3_axpy(area / 3.0 * Tn, nrm, fvec);
+        double *fa = out[i].fa; /* pulls A towards B */
+        v3_axpy(area / 3.0 * Tn, nrm, fa);
         if (dtl > 0)
-            v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
-        out[i] = (cf_pair_force){a[i], b[i], {fvec[0], fvec[1], fvec[2]}};
+            v3_axpy(area / 3.0 * Tt / dtl, tv, fa);
+        for (int k = 0; k < 3; k++)
+            out[i].fb[k] = -fa[k];
+        elastic += area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
+        L[0] = dn, L[1] = Tn;
+        ce->started[i] = 1;
     }
+    /* The work absorbed is the trapezoid of the forces over the moves of the
+     * six nodes, -1/2 (F_n-1 + F_n) . (x_n - x_n-1): exactly what the
+     * leapfrog's kinetic energy product gives up to them (docs/physics.md
+     * §10).  Tractions times the scalar openings missed the turn of the
+     * normal and the change of area of facets that crush. */
+    for (int side = 0; side < 2; side++)
+        for (int i = 0; i < 3; i++) {
+            const double *x = &s->x[3 * (side ? b[i] : a[i])];
+            const double *fn = side ? out[i].fb : out[i].fa;
+            double *fo = ce->f_last[side][i], *xo = ce->x_last[side][i];
+            for (int q = 0; q < 3; q++) {
+                if (ce->evaluated)
+                    ce->work -= 0.5 * (fo[q] + fn[q]) * (x[q] - xo[q]);
+                fo[q] = fn[q], xo[q] = x[q];
+            }
+        }
+    ce->evaluated = 1;
+    ce->dissipated = fmax(ce->dissipated, ce->work - elastic);
+    ce->stored = ce->work - ce->dissipated;
     return n_failed;
 }
 
@@ -133,8 +130,8 @@ int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *para
     /* Elements share nodes: the sums in list and pair order, on one thread. */
     for (int j = 0; j < 3 * n; j++)
         if (pairs[j].a >= 0) {
-            v3_axpy(1.0, pairs[j].f, &s->f[3 * pairs[j].a]); /* pulls A towards B */
-            v3_axpy(-1.0, pairs[j].f, &s->f[3 * pairs[j].b]);
+            v3_axpy(1.0, pairs[j].fa, &s->f[3 * pairs[j].a]);
+            v3_axpy(1.0, pairs[j].fb, &s->f[3 * pairs[j].b]);
         }
     return n_failed;
 }
@@ -146,8 +143,7 @@ void cf_cohesive_energy(const cf_solid *s, const int *elems, int n, double *stor
     int count = elems ? n : s->n_coh;
     for (int e = 0; e < count; e++) {
         const cf_cohesive *ce = &s->coh[elems ? elems[e] : e];
-        for (int i = 0; i < 3; i++)
-            st += ce->stored[i], w += ce->dissipated[i];
+        st += ce->stored, w += ce->dissipated;
     }
     *stored = st;
     *dissipated = w;
@@ -158,12 +154,11 @@ double cf_cohesive_release(cf_solid *s, const int *elems, int n)
     double dropped = 0;
     for (int e = 0; e < n; e++) {
         cf_cohesive *ce = &s->coh[elems[e]];
-        for (int i = 0; i < 3; i++) {
-            dropped += ce->stored[i];
-            ce->work[i] -= ce->stored[i];
-            ce->stored[i] = 0;
-            ce->started[i] = 0;
-        }
+        dropped += ce->stored;
+        ce->work -= ce->stored;
+        ce->stored = 0;
+        memset(ce->started, 0, sizeof ce->started);
+        ce->evaluated = 0; /* the nodes move back to the rest shape */
     }
     return dropped;
 }
@@ -171,11 +166,9 @@ double cf_cohesive_release(cf_solid *s, const int *elems, int n)
 void cf_cohesive_fail(cf_solid *s, int e)
 {
     cf_cohesive *ce = &s->coh[e];
-    for (int i = 0; i < 3; i++) {
-        ce->failed[i] = 1;
-        ce->dissipated[i] += ce->stored[i];
-        ce->stored[i] = 0;
-    }
+    memset(ce->failed, 1, sizeof ce->failed);
+    ce->dissipated += ce->stored;
+    ce->stored = 0;
 }
 
 void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
@@ -183,7 +176,7 @@ void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
     for (int e = 0; e < n; e++) {
         int a[3], b[3];
         double nrm[3];
-        double area = mid_normal(s, &s->coh[elems[e]], s->p, 4, a, b, nrm);
+        double mid[3][3], area = mid_normal(s, &s->coh[elems[e]], s->p, 4, a, b, nrm, mid);
         if (area == 0)
             continue;
         for (int i = 0; i < 3; i++) {
@@ -209,8 +202,8 @@ double cf_cohesive_damage(const cf_solid *s, int e)
     if (ce->failed[0] && ce->failed[1] && ce->failed[2])
         return 1.0;
     int a[3], b[3];
-    double n[3], area = mid_normal(s, ce, s->x, 3, a, b, n);
-    double d = ce->dissipated[0] + ce->dissipated[1] + ce->dissipated[2];
+    double n[3], mid[3][3], area = mid_normal(s, ce, s->x, 3, a, b, n, mid);
+    double d = ce->dissipated;
     double full = s->mat.G_I * area;
     return full > 0 ? fmin(1.0, d / full) : 0.0;
 }
@@ -220,7 +213,8 @@ void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double norm
 {
     const cf_cohesive *ce = &s->coh[e];
     int a[3], b[3];
-    *area = mid_normal(s, ce, s->x, 3, a, b, normal);
+    double mid[3][3];
+    *area = mid_normal(s, ce, s->x, 3, a, b, normal, mid);
     *opening = *sliding = 0;
     *failed = ce->failed[0] && ce->failed[1] && ce->failed[2];
     centroid[0] = centroid[1] = centroid[2] = 0;

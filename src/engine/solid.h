@@ -29,15 +29,22 @@ typedef struct cf_cohesive {
     int slot[2][3];
     double dn_max[3], dt_max[3]; /* PPR history: largest openings, m */
     unsigned char failed[3];     /* complete failure per node pair */
-    /* Energy of each node pair (J): work absorbed so far (trapezoidal rule
-     * in the openings); dissipated, the largest (work - 1/2 T Delta A/3) so
-     * far, so that it never falls (unloading on the secant keeps it, the
-     * facing switch of the compression penalty and the change of area move
-     * the difference into stored); stored = work - dissipated. */
-    double work[3], stored[3], dissipated[3];
+    /* Energy of the element (J): work absorbed so far, the trapezoid of its
+     * forces over the moves of its six nodes (the work the leapfrog does,
+     * docs/physics.md §10); dissipated, the largest (work - elastic) so far,
+     * elastic = sum of 1/2 T Delta A/3 over its pairs, so that it never
+     * falls (unloading on the secant keeps it, the facing switch of the
+     * compression penalty and the change of area move the difference into
+     * stored); stored = work - dissipated. */
+    double work, stored, dissipated;
     double strength;             /* its facet's strength / sigma_max */
-    double last[3][4];           /* dn, dt, Tn, Tt at the last evaluation */
-    unsigned char started[3];    /* `last` holds an evaluation */
+    double last[3][2];           /* normal opening dn (m) and traction Tn (Pa) of each
+                                    pair at the last evaluation */
+    double f_last[2][3][3];      /* force on each node (side A, B; pair) at the last
+                                    evaluation, N */
+    double x_last[2][3][3];      /* where each node was then, m */
+    unsigned char started[3];    /* `last` holds an evaluation of the pair */
+    unsigned char evaluated;     /* f_last and x_last hold an evaluation */
 } cf_cohesive;
 
 typedef struct cf_solid {
