@@ -1062,8 +1062,9 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
 
 /* Energy growth with no work input: kinetic + strain + cohesive energy
  * above (1 + max_energy_growth) times what was put in (the work of
- * gravity, prescribed nodes and moving obstacles, and the squeeze of
- * wedged pieces at their hand-offs). */
+ * gravity, prescribed nodes and moving obstacles, and what hand-offs put
+ * in: the squeeze of wedged pieces, gravity's potential of pieces moved
+ * clear of obstacles). */
 static cf_status check_energy(cf_world *sim, cf_error *err)
 {
     cf_ledger l;
