@@ -13,11 +13,11 @@ static void pair_nodes(const cf_solid *s, const cf_cohesive *ce, int i, int *a, 
     *b = s->tet[4 * ce->tet[1] + ce->slot[1][i]];
 }
 
-/* Unit normal (A -> B) and area of element ce's mid-surface at positions
- * pos, and the mid-points of its three pairs. */
+/* Unit normal (A -> B) and area of element ce's mid-surface at positions pos. */
 static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double *pos, int stride,
-                         int a[3], int b[3], double n[3], double mid[3][3])
+                         int a[3], int b[3], double n[3])
 {
+    double mid[3][3];
     for (int i = 0; i < 3; i++) {
         pair_nodes(s, ce, i, &a[i], &b[i]);
         for (int k = 0; k < 3; k++)
@@ -31,18 +31,17 @@ static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double 
     return 0.5 * nn;
 }
 
-/* Element ce's three node pairs: tractions, energies and state, and the
- * forces on its nodes into out[0..2].  Writes only ce and out.  Returns its
- * pairs in complete failure. */
+/* Element ce's three node pairs: tractions, energies and state, and each
+ * pair's force into out[0..2].  Writes only ce and out.  Returns its pairs
+ * in complete failure. */
 static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_law *law,
                           const void *params, double dt, double kp, cf_pair_force out[3])
 {
     int n_failed = 0, a[3], b[3];
-    double nrm[3], mid[3][3];
-    memset(out, 0, 3 * sizeof *out);
-    double area = mid_normal(s, ce, s->x, 3, a, b, nrm, mid);
-    for (int i = 0; i < 3; i++) /* a crack not yet open at a vertex carries nothing */
-        out[i].a = a[i] == b[i] ? -1 : a[i], out[i].b = b[i];
+    double nrm[3];
+    for (int i = 0; i < 3; i++)
+        out[i].a = -1;
+    double area = mid_normal(s, ce, s->x, 3, a, b, nrm);
     if (area == 0)
         return 0;
     /* The law of the facet's strength (material.strength). */
@@ -55,7 +54,7 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
     }
     double elastic = 0;
     for (int i = 0; i < 3; i++) {
-        if (a[i] == b[i])
+        if (a[i] == b[i]) /* the crack has not opened at this vertex yet */
             continue;
         double d[3], tv[3];
         v3_sub(&s->x[3 * b[i]], &s->x[3 * a[i]], d);
@@ -88,33 +87,27 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
          * direction set by round-off (time continuity, Papoulia et al.
          * 2003). */
         Tt = fmin(Tt, cap * dtl);
-        double *fa = out[i].fa; /* pulls A towards B */
-        v3_axpy(area / 3.0 * Tn, nrm, fa);
+        double fvec[3] = {0, 0, 0}; /* pulls A towards B */
+        v3_axpy(area / 3.0 * Tn, nrm, fvec);
         if (dtl > 0)
-            v3_axpy(area / 3.0 * Tt / dtl, tv, fa);
-        for (int k = 0; k < 3; k++)
-            out[i].fb[k] = -fa[k];
+            v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
+        /* The work absorbed is the trapezoid of the force over the change of
+         * separation, 1/2 (F_n-1 + F_n) . (d_n - d_n-1): exactly what the
+         * leapfrog's kinetic energy product gives up to the pair's two
+         * forces, +F on A and -F on B (docs/physics.md §10).  Tractions times
+         * the scalar openings missed the turn of the normal and the change
+         * of area of facets that crush.  From the pair's first evaluation. */
+        double *fo = ce->f_last[i], *d_o = ce->d_last[i];
+        for (int k = 0; k < 3; k++) {
+            if (ce->started[i])
+                ce->work += 0.5 * (fo[k] + fvec[k]) * (d[k] - d_o[k]);
+            fo[k] = fvec[k], d_o[k] = d[k];
+        }
         elastic += area / 3.0 * 0.5 * (Tn * dn + Tt * dtl);
         L[0] = dn, L[1] = Tn;
         ce->started[i] = 1;
+        out[i] = (cf_pair_force){a[i], b[i], {fvec[0], fvec[1], fvec[2]}};
     }
-    /* The work absorbed is the trapezoid of the forces over the moves of the
-     * six nodes, -1/2 (F_n-1 + F_n) . (x_n - x_n-1): exactly what the
-     * leapfrog's kinetic energy product gives up to them (docs/physics.md
-     * §10).  Tractions times the scalar openings missed the turn of the
-     * normal and the change of area of facets that crush. */
-    for (int side = 0; side < 2; side++)
-        for (int i = 0; i < 3; i++) {
-            const double *x = &s->x[3 * (side ? b[i] : a[i])];
-            const double *fn = side ? out[i].fb : out[i].fa;
-            double *fo = ce->f_last[side][i], *xo = ce->x_last[side][i];
-            for (int q = 0; q < 3; q++) {
-                if (ce->evaluated)
-                    ce->work -= 0.5 * (fo[q] + fn[q]) * (x[q] - xo[q]);
-                fo[q] = fn[q], xo[q] = x[q];
-            }
-        }
-    ce->evaluated = 1;
     ce->dissipated = fmax(ce->dissipated, ce->work - elastic);
     ce->stored = ce->work - ce->dissipated;
     return n_failed;
@@ -130,8 +123,8 @@ int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *para
     /* Elements share nodes: the sums in list and pair order, on one thread. */
     for (int j = 0; j < 3 * n; j++)
         if (pairs[j].a >= 0) {
-            v3_axpy(1.0, pairs[j].fa, &s->f[3 * pairs[j].a]);
-            v3_axpy(1.0, pairs[j].fb, &s->f[3 * pairs[j].b]);
+            v3_axpy(1.0, pairs[j].f, &s->f[3 * pairs[j].a]); /* pulls A towards B */
+            v3_axpy(-1.0, pairs[j].f, &s->f[3 * pairs[j].b]);
         }
     return n_failed;
 }
@@ -157,8 +150,7 @@ double cf_cohesive_release(cf_solid *s, const int *elems, int n)
         dropped += ce->stored;
         ce->work -= ce->stored;
         ce->stored = 0;
-        memset(ce->started, 0, sizeof ce->started);
-        ce->evaluated = 0; /* the nodes move back to the rest shape */
+        memset(ce->started, 0, sizeof ce->started); /* the nodes move back to the rest shape */
     }
     return dropped;
 }
@@ -176,7 +168,7 @@ void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
     for (int e = 0; e < n; e++) {
         int a[3], b[3];
         double nrm[3];
-        double mid[3][3], area = mid_normal(s, &s->coh[elems[e]], s->p, 4, a, b, nrm, mid);
+        double area = mid_normal(s, &s->coh[elems[e]], s->p, 4, a, b, nrm);
         if (area == 0)
             continue;
         for (int i = 0; i < 3; i++) {
@@ -202,7 +194,7 @@ double cf_cohesive_damage(const cf_solid *s, int e)
     if (ce->failed[0] && ce->failed[1] && ce->failed[2])
         return 1.0;
     int a[3], b[3];
-    double n[3], mid[3][3], area = mid_normal(s, ce, s->x, 3, a, b, n, mid);
+    double n[3], area = mid_normal(s, ce, s->x, 3, a, b, n);
     double d = ce->dissipated;
     double full = s->mat.G_I * area;
     return full > 0 ? fmin(1.0, d / full) : 0.0;
@@ -213,8 +205,7 @@ void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double norm
 {
     const cf_cohesive *ce = &s->coh[e];
     int a[3], b[3];
-    double mid[3][3];
-    *area = mid_normal(s, ce, s->x, 3, a, b, normal, mid);
+    *area = mid_normal(s, ce, s->x, 3, a, b, normal);
     *opening = *sliding = 0;
     *failed = ce->failed[0] && ce->failed[1] && ce->failed[2];
     centroid[0] = centroid[1] = centroid[2] = 0;

@@ -22,8 +22,9 @@
  * load put in (measured: nodes at 100+ m/s in a 4.4 m/s drop), so the two
  * are never combined.  The tangential traction rises from
  * zero with the same capped stiffness (time continuity).
- * Each element's absorbed work (the trapezoid of its forces over its
- * nodes' moves, what the leapfrog's kinetic energy gives up to them) and
+ * Each element's absorbed work (the trapezoid of its pairs' forces over the
+ * change of their separations, what the leapfrog's kinetic energy gives up
+ * to them) and
  * stored energy are updated (cf_cohesive).  The penalty pushes along the
  * normal only, so it is not a potential: pressed faces that slide across a
  * turning normal can give out more than they took, and the stored energy
@@ -36,12 +37,11 @@
  * sums for any thread count. */
 #define CF_COHESIVE_PARALLEL_MIN 256
 
-/* The forces of this evaluation on one node pair of an element (N): fa on
- * node a (side A; it pulls a towards b), fb on node b (a < 0: the pair
- * carries none, the crack not yet open at that vertex). */
+/* One node pair's force of this evaluation: f (N) pulls node a towards b
+ * (a < 0: the pair carries none). */
 typedef struct cf_pair_force {
     int a, b;
-    double fa[3], fb[3];
+    double f[3];
 } cf_pair_force;
 
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,

@@ -29,9 +29,9 @@ typedef struct cf_cohesive {
     int slot[2][3];
     double dn_max[3], dt_max[3]; /* PPR history: largest openings, m */
     unsigned char failed[3];     /* complete failure per node pair */
-    /* Energy of the element (J): work absorbed so far, the trapezoid of its
-     * forces over the moves of its six nodes (the work the leapfrog does,
-     * docs/physics.md §10); dissipated, the largest (work - elastic) so far,
+    /* Energy of the element (J): work absorbed so far, the trapezoid of each
+     * pair's force over the change of its separation (the work the leapfrog
+     * does, docs/physics.md §10); dissipated, the largest (work - elastic) so far,
      * elastic = sum of 1/2 T Delta A/3 over its pairs, so that it never
      * falls (unloading on the secant keeps it, the facing switch of the
      * compression penalty and the change of area move the difference into
@@ -40,11 +40,10 @@ typedef struct cf_cohesive {
     double strength;             /* its facet's strength / sigma_max */
     double last[3][2];           /* normal opening dn (m) and traction Tn (Pa) of each
                                     pair at the last evaluation */
-    double f_last[2][3][3];      /* force on each node (side A, B; pair) at the last
-                                    evaluation, N */
-    double x_last[2][3][3];      /* where each node was then, m */
-    unsigned char started[3];    /* `last` holds an evaluation of the pair */
-    unsigned char evaluated;     /* f_last and x_last hold an evaluation */
+    double f_last[3][3];         /* each pair's force on its side-A node at the last
+                                    evaluation (minus it on side B), N */
+    double d_last[3][3];         /* each pair's separation x_B - x_A then, m */
+    unsigned char started[3];    /* `last`, f_last, d_last hold an evaluation of the pair */
 } cf_cohesive;
 
 typedef struct cf_solid {
