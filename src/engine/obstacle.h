@@ -109,11 +109,26 @@ double cf_obstacle_distance(const cf_obstacles *obs, int j, double t, const doub
                             double normal[3]);
 
 /* The two velocities there are: none (planes, meshes) and the constant
- * `velocity` of a kinematic obstacle (spheres, boxes). */
-void cf_obstacle_static_velocity(const cf_obstacle *o, double u[3]);
-void cf_obstacle_kinematic_velocity(const cf_obstacle *o, double u[3]);
+ * `velocity` of a kinematic obstacle (spheres, boxes).  Inline, with the
+ * centre below, so that the types depend on the table and never the other
+ * way round. */
+static inline void cf_obstacle_static_velocity(const cf_obstacle *o, double u[3])
+{
+    (void)o;
+    u[0] = u[1] = u[2] = 0.0;
+}
+
+static inline void cf_obstacle_kinematic_velocity(const cf_obstacle *o, double u[3])
+{
+    for (int k = 0; k < 3; k++)
+        u[k] = o->velocity[k];
+}
 
 /* Where a kinematic obstacle's centre is at time t: center + t velocity. */
-void cf_obstacle_center(const cf_obstacle *o, double t, double c[3]);
+static inline void cf_obstacle_center(const cf_obstacle *o, double t, double c[3])
+{
+    for (int k = 0; k < 3; k++)
+        c[k] = o->center[k] + t * o->velocity[k];
+}
 
 #endif

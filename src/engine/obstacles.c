@@ -33,24 +33,6 @@ double cf_obstacle_distance(const cf_obstacles *obs, int j, double t, const doub
     return cf_obstacle_kind_of(o->type)->distance(obs, j, t, p, normal);
 }
 
-void cf_obstacle_static_velocity(const cf_obstacle *o, double u[3])
-{
-    (void)o;
-    u[0] = u[1] = u[2] = 0.0;
-}
-
-void cf_obstacle_kinematic_velocity(const cf_obstacle *o, double u[3])
-{
-    for (int k = 0; k < 3; k++)
-        u[k] = o->velocity[k];
-}
-
-void cf_obstacle_center(const cf_obstacle *o, double t, double c[3])
-{
-    for (int k = 0; k < 3; k++)
-        c[k] = o->center[k] + t * o->velocity[k];
-}
-
 cf_status cf_obstacles_create(cf_obstacles *obs, const cf_world_def *def, cfb_world *bullet,
                               int *body, cf_error *err)
 {
