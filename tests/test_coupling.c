@@ -468,7 +468,7 @@ static void test_debris_stays_rigid_and_conserves(void **state)
         advance(sim);
         for (int i = 0; i < w->n_frag; i++)
             debris_in_fracture +=
-                cf_fragment_is_debris(w, &w->frag[i]) && w->frag[i].mode == CF_MODE_FRACTURE;
+                cf_fragment_is_debris(&w->frag[i], &w->def.solver) && w->frag[i].mode == CF_MODE_FRACTURE;
     }
     cf_world_stats st;
     cf_world_stats_get(w, &st);
@@ -482,12 +482,12 @@ static void test_debris_stays_rigid_and_conserves(void **state)
         if (f->mode == CF_MODE_DEAD)
             continue;
         mass += f->mass;
-        if (!cf_fragment_is_debris(w, f))
+        if (!cf_fragment_is_debris(f, &w->def.solver))
             continue;
         debris++, debris_mass += f->mass;
         hulls += f->hulls.n_hulls;
         double com[3], R[9], v[3], om[3];
-        cf_fragment_pose((cf_world *)w, i, com, R, v, om);
+        cf_fragment_pose_peek(&w->frag[i], &w->solid, w->bullet, com, R, v, om);
         lowest = fmin(lowest, com[2]);
     }
     printf("FIGURE debris: %d of %d pieces debris (%.4g kg of %.4g), %d convex hulls among "
@@ -552,10 +552,10 @@ static void crush_run(double sc_strength, double eps, int *crushed, double *fast
             continue;
         (*crushed)++;
         assert_int_equal(f->nt, 1);
-        assert_true(cf_fragment_is_debris(w, f));
+        assert_true(cf_fragment_is_debris(f, &w->def.solver));
         assert_int_equal(f->mode, CF_MODE_RIGID);
         double com[3], R[9], v[3], om[3];
-        cf_fragment_pose((cf_world *)w, i, com, R, v, om);
+        cf_fragment_pose_peek(&w->frag[i], &w->solid, w->bullet, com, R, v, om);
         *fastest = fmax(*fastest, sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
     }
     cf_world_stats st;

@@ -7,7 +7,7 @@
 #include "check.h"
 
 #include "fixtures.h"
-#include "fragments.h"
+#include "pieces.h"
 #include "linalg.h"
 
 #include <math.h>

@@ -10,7 +10,7 @@
 #include "cohesive_ppr.h"
 
 #include "fixtures.h"
-#include "fragments.h"
+#include "pieces.h"
 #include "insertion.h"
 #include "linalg.h"
 #include "pbd.h"

@@ -24,7 +24,8 @@ static void apex_ratio_is_e_squared(void **state)
     cf_sim *sim = verify_open("bounce.lua", NULL, &sc);
     cf_error err;
     double com[3], R[9], v[3], w[3];
-    cf_fragment_pose(cf_sim_world(sim), 0, com, R, v, w);
+    cf_fragment_pose(&cf_sim_world(sim)->frag[0], &cf_sim_world(sim)->solid,
+                     cf_sim_world(sim)->bullet, com, R, v, w);
     double bottom = INFINITY;
     for (int i = 0; i < cf_sim_world(sim)->solid.n_nodes; i++)
         bottom = fmin(bottom, cf_sim_world(sim)->solid.x[3 * i + 2]);
@@ -35,7 +36,8 @@ static void apex_ratio_is_e_squared(void **state)
     while (!cf_sim_done(sim) && phase < 2) {
         if (cf_sim_advance(sim, &err) != CF_OK)
             fail_msg("%s", err.msg);
-        cf_fragment_pose(cf_sim_world(sim), 0, com, R, v, w);
+        cf_fragment_pose(&cf_sim_world(sim)->frag[0], &cf_sim_world(sim)->solid,
+                     cf_sim_world(sim)->bullet, com, R, v, w);
         double t = cf_world_time(cf_sim_world(sim));
         if (phase == 0 && v[2] > 0)
             phase = 1;

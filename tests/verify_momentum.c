@@ -44,8 +44,9 @@ static void momentum_to_round_off(void **state)
      * into) to rigid mode (pbd rigid backend: no Bullet world in this scene)
      * and fly on. */
     cf_world *w = cf_sim_world(sim);
+    cf_handoff_record rec;
     for (int fi = 0, n = w->n_frag; fi < n; fi++)
-        if (w->frag[fi].mode == CF_MODE_FRACTURE && cf_handoff_to_rigid(w, fi, &err) != CF_OK)
+        if (w->frag[fi].mode == CF_MODE_FRACTURE && cf_handoff_to_rigid(w, fi, &rec, &err) != CF_OK)
             fail_msg("%s", err.msg);
     double after_handoff = drift(sim, P0), worst_rigid = 0;
     int pieces = 0;

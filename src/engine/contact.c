@@ -146,7 +146,7 @@ int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, c
             hi[d] = fmax(hi[d], s->x[3 * f->nodes.v[i] + d] + pad);
         }
     double size = 0;
-    int root = cf_fragment_root(sim, fi);
+    int root = cf_fragment_root(sim->frag, fi);
     for (int g = 0; g < sim->n_frag; g++) {
         const cf_fragment *o = &sim->frag[g];
         /* Fragments of one body do not collide (as in Bullet, §9): their
@@ -155,7 +155,7 @@ int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, c
          * ground's penalty then springs it back with energy no load put
          * in).  Debris has no hulls: a sphere in Bullet, too small to hold
          * a node (§9.2). */
-        if (cf_fragment_root(sim, g) == root || o->hulls.n_hulls == 0 ||
+        if (cf_fragment_root(sim->frag, g) == root || o->hulls.n_hulls == 0 ||
             !cf_boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
             continue;
         if (add_hulls(sim, g, hs))
@@ -284,7 +284,7 @@ int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes
         double Jl = v3_norm(sum[g].J), dv = Jl / sim->frag[g].mass;
         double room = Jl > 0 ? bounce * sum[g].vmax - v3_dot(st.v, sum[g].J) / Jl : dv;
         sum[g].beta = dv > room ? fmax(0.0, room) / dv : 1.0;
-        gained -= cf_body_kinetic_energy(sim, g);
+        gained -= cf_body_kinetic_energy(&sim->frag[g], &st);
     }
     for (int i = 0; i < ni->n; i++) {
         int g = ni->frag[i];
@@ -326,7 +326,8 @@ int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes
                 st.w[k] = sum[g].w0[k] + gamma * dw[k];
             cfb_set_state(sim->bullet, o->body, &st);
         }
-        gained += cf_body_kinetic_energy(sim, g);
+        cfb_get_state(sim->bullet, o->body, &st); /* as Bullet holds it */
+        gained += cf_body_kinetic_energy(o, &st);
     }
     free(sum);
     *energy = gained;

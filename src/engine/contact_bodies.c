@@ -216,7 +216,7 @@ int cf_body_contact_needed(const cf_world *sim)
     for (int fi = 0; fi < sim->n_frag; fi++) {
         if (sim->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
-        int r = cf_fragment_root(sim, fi);
+        int r = cf_fragment_root(sim->frag, fi);
         if (first_root >= 0 && r != first_root)
             return 1;
         first_root = r;
@@ -237,7 +237,7 @@ int cf_body_contact(cf_world *sim, double h, double *removed)
     for (int fi = 0; fi < n; fi++)
         if (sim->frag[fi].mode == CF_MODE_FRACTURE) {
             node_box(&sim->solid, &sim->frag[fi], &box[6 * fi]);
-            root[fi] = cf_fragment_root(sim, fi);
+            root[fi] = cf_fragment_root(sim->frag, fi);
         }
     int rc = 0;
     moved_nodes mv = {0};

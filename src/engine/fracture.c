@@ -674,18 +674,10 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         f->pending.contact += removed + w_obs + w_bc;
 }
 
-void cf_fragment_book_pending(cf_world *sim, cf_fragment *f)
-{
-    cf_energy_flows *p = &f->pending, *w = &sim->flow;
-    w->boundary += p->boundary, w->obstacles += p->obstacles;
-    w->contact += p->contact, w->pbd += p->pbd;
-    memset(p, 0, sizeof *p);
-}
-
 cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture)
 {
     cf_fragment *f = &sim->frag[fi];
-    cf_fragment_book_pending(sim, f);
+    cf_fragment_book_pending(f, &sim->flow);
     cf_status st = forces(sim, f, t, dt, fracture);
     if (st != CF_OK)
         return st;

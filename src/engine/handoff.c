@@ -11,67 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-int cf_fragment_new(cf_world *sim, int parent, double birth_time)
-{
-    if (sim->n_frag == sim->cap_frag) {
-        int cap = sim->cap_frag ? 2 * sim->cap_frag : 16;
-        cf_fragment *p = realloc(sim->frag, (size_t)cap * sizeof *p);
-        if (!p)
-            return -1;
-        sim->frag = p, sim->cap_frag = cap;
-    }
-    cf_fragment *f = &sim->frag[sim->n_frag];
-    memset(f, 0, sizeof *f);
-    f->parent = parent;
-    f->birth_time = birth_time;
-    f->mode = CF_MODE_RIGID;
-    f->body = -1;
-    f->q_match[0] = 1;
-    f->separated = -1;
-    return sim->n_frag++;
-}
-
-int cf_fragment_root(const cf_world *sim, int fi)
-{
-    while (sim->frag[fi].parent >= 0)
-        fi = sim->frag[fi].parent;
-    return fi;
-}
-
 static const double PI = 3.14159265358979323846;
-
-/* Debris (docs/physics.md §9.2): a piece, not an initial body, of at most
- * solver.debris_tets tets (the mesh cannot resolve its breaking), or
- * whose sphere of equal volume is narrower than solver.debris_size.  A
- * property of the fragment's tets, so it holds from birth. */
-int cf_fragment_is_debris(const cf_world *sim, const cf_fragment *f)
-{
-    const cf_solver_settings *set = &sim->def.solver;
-    if (f->parent < 0)
-        return 0;
-    return f->nt <= set->debris_tets ||
-           (set->debris_size > 0 && cbrt(6 * f->volume / PI) < set->debris_size);
-}
-
-/* Mass and centre of mass from the tets (identical to the lumped ones); the
- * inertia of the lumped masses, the solver's own discretisation, so that a
- * hand-off preserves linear and angular momentum and never adds kinetic
- * energy (the tet second moment of docs/physics.md §9 would give a single tet 1/5 of
- * its lumped inertia, and the rigid spin 5 times the energy). */
-void cf_fragment_rest_props(cf_world *sim, int fi)
-{
-    cf_fragment *f = &sim->frag[fi];
-    cf_mass_props mp;
-    double I[9];
-    cf_tet_mass_props(&sim->solid, f->tets, f->nt, sim->solid.X, &mp);
-    f->mass = mp.mass;
-    f->volume = 0;
-    for (int i = 0; i < f->nt; i++)
-        f->volume += sim->solid.vol[f->tets[i]];
-    memcpy(f->com_rest, mp.com, sizeof mp.com);
-    cf_nodes_inertia(&sim->solid, f->nodes.v, f->nodes.n, sim->solid.X, mp.com, I);
-    sym3_eigen(I, f->principal, f->Q);
-}
 
 /* Convex decomposition of fragment fi (docs/physics.md §9), kept in the principal
  * frame for Bullet and for fracture-mode contact.  A fragment's tets never
@@ -117,6 +57,13 @@ static double debris_radius(const cf_world *sim, const cf_fragment *f, const dou
     return r;
 }
 
+/* Bullet collision margin of fragment fi: 0.1% of its size, m (Bullet's
+ * default 4 cm would hold small fragments off the ground). */
+static double collision_margin(const cf_world *sim, int fi)
+{
+    return 1e-3 * cbrt(sim->frag[fi].mass / sim->solid.mat.rho);
+}
+
 /* Rotation of the Bullet body frame: rest->current R times principal axes Q. */
 cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const double R[9],
                                const double v[3], const double w[3], cf_error *err)
@@ -130,7 +77,7 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     memcpy(st.pos, pos, sizeof st.pos);
     memcpy(st.v, v, sizeof st.v);
     memcpy(st.w, w, sizeof st.w);
-    if (cf_fragment_is_debris(sim, f))
+    if (cf_fragment_is_debris(f, &sim->def.solver))
         f->body = cfb_add_sphere_body(sim->bullet, f->mass, f->principal, debris_radius(sim, f, pos),
                                       &st, s->mat.friction, s->mat.restitution);
     else if (decompose_fragment(sim, f))
@@ -138,7 +85,7 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     else
         f->body = cfb_add_compound_body(sim->bullet, f->mass, f->principal, f->hulls.pts,
                                         f->hulls.start, f->hulls.n_hulls,
-                                        cf_fragment_margin(sim, fi), &st, s->mat.friction,
+                                        collision_margin(sim, fi), &st, s->mat.friction,
                                         s->mat.restitution);
     if (f->body < 0)
         return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused fragment %d: %s", fi,
@@ -153,139 +100,22 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     return CF_OK;
 }
 
-/* Fragment fi's pose, its shape matching warm-started from (and leaving
- * its rotation in) q. */
-static void pose_from(const cf_world *sim, int fi, double q[4], double com[3], double R[9],
-                      double v[3], double w[3])
-{
-    const cf_fragment *f = &sim->frag[fi];
-    if (f->body >= 0) {
-        cfb_state st;
-        double Rb[9];
-        cfb_get_state(sim->bullet, f->body, &st);
-        quat_to_mat(st.quat, Rb);
-        m3_mul_nt(Rb, f->Q, R);
-        memcpy(com, st.pos, sizeof st.pos);
-        memcpy(v, st.v, sizeof st.v);
-        memcpy(w, st.w, sizeof st.w);
-        return;
-    }
-    cf_node_state ns;
-    cf_nodes_state(&sim->solid, f->nodes.v, f->nodes.n, q, &ns);
-    memcpy(com, ns.com, sizeof ns.com);
-    memcpy(R, ns.R, sizeof ns.R);
-    memcpy(v, ns.v, sizeof ns.v);
-    cf_nodes_angular_velocity(&sim->solid, f->nodes.v, f->nodes.n, ns.com, ns.L, w);
-}
-
-void cf_fragment_pose(cf_world *sim, int fi, double com[3], double R[9], double v[3], double w[3])
-{
-    pose_from(sim, fi, sim->frag[fi].q_match, com, R, v, w);
-}
-
-void cf_fragment_pose_peek(const cf_world *sim, int fi, double com[3], double R[9], double v[3],
-                           double w[3])
-{
-    double q[4];
-    memcpy(q, sim->frag[fi].q_match, sizeof q);
-    pose_from(sim, fi, q, com, R, v, w);
-}
-
-typedef struct {
-    const cf_solid *s;
-    const int *nodes;
-} node_list;
-
-/* The mass moment, sum m x, in the chunks the step's kinetic sums use
- * (fracture.c): the ledger's gravity work, the change of this sum, then
- * starts from the bits the step gives, not from M times the centre of
- * mass, which differs from them in the last bits (6e-12 J of work that
- * nothing did, at the first step of a resting plate). */
-static void mass_moment_chunk(void *ctx, int i0, int i1, double *acc)
-{
-    const node_list *c = ctx;
-    cf_nodes_mass_moment_add(c->s, c->nodes, i0, i1, acc);
-}
-
-void cf_fragment_ledger_reset(cf_world *sim, int fi)
-{
-    cf_fragment *f = &sim->frag[fi];
-    cf_fragment_book_pending(sim, f);
-    cf_node_state ns;
-    cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
-    f->e_kin = ns.ke;
-    f->e_strain = 0;
-    node_list c = {&sim->solid, f->nodes.v};
-    cf_sum_chunks(f->nodes.n, 3, 1, mass_moment_chunk, &c, f->mx);
-}
-
-void cf_body_spin(const cf_fragment *f, const cfb_state *st, double Iw[3])
-{
-    double Rb[9], wb[3];
-    quat_to_mat(st->quat, Rb);
-    m3_tmulv(Rb, st->w, wb);
-    for (int k = 0; k < 3; k++)
-        wb[k] *= f->principal[k];
-    m3_mulv(Rb, wb, Iw);
-}
-
-void cf_body_momenta(const cf_fragment *f, const cfb_state *st, double P[3], double L[3])
-{
-    double Iw[3], c[3];
-    cf_body_spin(f, st, Iw);
-    v3_cross(st->pos, st->v, c);
-    for (int k = 0; k < 3; k++) {
-        P[k] = f->mass * st->v[k];
-        L[k] = f->mass * c[k] + Iw[k];
-    }
-}
-
-/* Linear and angular momentum about the origin, m v and x cross m v. */
-static void momenta_chunk(void *ctx, int i0, int i1, double *acc)
-{
-    const node_list *c = ctx;
-    const cf_solid *s = c->s;
-    for (int i = i0; i < i1; i++) {
-        int a = c->nodes[i];
-        double x_v[3];
-        v3_axpy(s->m[a], &s->v[3 * a], acc);
-        v3_cross(&s->x[3 * a], &s->v[3 * a], x_v);
-        v3_axpy(s->m[a], x_v, &acc[3]);
-    }
-}
-
-void cf_fragment_momenta(const cf_world *sim, int fi, double P[3], double L[3])
-{
-    const cf_fragment *f = &sim->frag[fi];
-    const cf_solid *s = &sim->solid;
-    if (f->body >= 0) {
-        cfb_state st;
-        cfb_get_state(sim->bullet, f->body, &st);
-        cf_body_momenta(f, &st, P, L);
-        return;
-    }
-    node_list c = {s, f->nodes.v};
-    double PL[6];
-    cf_sum_chunks(f->nodes.n, 6, 1, momenta_chunk, &c, PL);
-    memcpy(P, PL, 3 * sizeof(double));
-    memcpy(L, &PL[3], 3 * sizeof(double));
-}
-
-/* Log a hand-off of fragment fi: momenta before (P0, L0) and after (P1, L1). */
+/* The record of a hand-off of fragment fi: momenta before (P0, L0) and
+ * after (P1, L1); the run's totals too. */
 static cf_status record_handoff(cf_world *sim, int fi, int direction, const double P0[3],
                                 const double L0[3], const double P1[3], const double L1[3],
-                                double loss, cf_error *err)
+                                double loss, cf_handoff_record *r)
 {
-    cf_handoff_record r = {sim->t, fi, direction, 0, {0}, {0}, loss};
-    v3_sub(P1, P0, r.momentum_change);
-    v3_sub(L1, L0, r.angular_momentum_change);
-    double pn = v3_norm(P0), dp = v3_norm(r.momentum_change);
-    r.momentum_error = pn > 0 ? dp / pn : dp;
+    *r = (cf_handoff_record){sim->t, fi, direction, 0, {0}, {0}, loss};
+    v3_sub(P1, P0, r->momentum_change);
+    v3_sub(L1, L0, r->angular_momentum_change);
+    double pn = v3_norm(P0), dp = v3_norm(r->momentum_change);
+    r->momentum_error = pn > 0 ? dp / pn : dp;
     sim->n_handoffs++;
-    if (r.momentum_error > sim->max_momentum_error)
-        sim->max_momentum_error = r.momentum_error;
+    if (r->momentum_error > sim->max_momentum_error)
+        sim->max_momentum_error = r->momentum_error;
     sim->total_handoff_loss += loss;
-    return cf_world_push_handoff(sim, &r, err);
+    return CF_OK;
 }
 
 /* Fragment's cohesive elements: those whose two tets both belong to it. */
@@ -447,16 +277,17 @@ static void lift_clear(cf_world *sim, const cf_fragment *g, double com[3], const
     put_in(sim, lift_energy(sim, g->mass, shift));
 }
 
-cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err)
+cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_handoff_record *rec,
+                                 cf_error *err)
 {
     cf_fragment *f = &sim->frag[fi];
     cf_solid *s = &sim->solid;
-    cf_fragment_book_pending(sim, f);
+    cf_fragment_book_pending(f, &sim->flow);
     double P0[3], L0[3], P1[3], L1[3];
     if (st)
         cf_body_momenta(f, st, P0, L0);
     else
-        cf_fragment_momenta(sim, fi, P0, L0);
+        cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P0, L0);
     /* Fracture mode starts from the rigid motion: from the Bullet body, or,
      * with the pbd backend, from its nodes' best rigid fit (shape matching)
      * and momenta, so that the bars start at rest length instead of
@@ -483,12 +314,12 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     f->separated = -1;
     f->steps = f->quiet = 0;
     f->t_enter = sim->t;
-    cf_fragment_ledger_reset(sim, fi);
+    cf_fragment_ledger_reset(&sim->frag[fi], &sim->solid, &sim->flow);
     f->e_enter = f->e_kin;
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
-    cf_fragment_momenta(sim, fi, P1, L1);
-    return record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, err);
+    cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P1, L1);
+    return record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, rec);
 }
 
 /* The tets grouped by component, in list order within each: component c
@@ -566,7 +397,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         free(comp);
         return k < 0 ? -1 : 0;
     }
-    cf_fragment_book_pending(sim, f);
+    cf_fragment_book_pending(f, &sim->flow);
     /* The parent's per-node leapfrog kinetic energy terms, by node id. */
     int *index = malloc((size_t)s->n_nodes * sizeof(int));
     unsigned char *seen = calloc((size_t)s->n_nodes, 1);
@@ -576,7 +407,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         index[f->nodes.v[i]] = i;
     *first = sim->n_frag;
     for (int c = 0; rc == 0 && c < k; c++)
-        if (cf_fragment_new(sim, fi, sim->t) < 0)
+        if (cf_fragment_new(&sim->frag, &sim->n_frag, &sim->cap_frag, fi, sim->t) < 0)
             rc = -1;
     for (int c = 0; rc == 0 && c < k; c++) {
         int ci = *first + c;
@@ -585,7 +416,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
             break;
         }
         cf_fragment *g = &sim->frag[ci], *p = &sim->frag[fi]; /* the array may have moved */
-        cf_fragment_rest_props(sim, ci);
+        cf_fragment_rest_props(&sim->frag[ci], &sim->solid);
         g->mode = CF_MODE_FRACTURE;
         g->steps = p->steps, g->quiet = p->quiet, g->t_enter = p->t_enter;
         g->e_enter = p->e_enter;
@@ -622,16 +453,11 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
     return rc ? -1 : k;
 }
 
-double cf_fragment_margin(const cf_world *sim, int fi)
-{
-    return 1e-3 * cbrt(sim->frag[fi].mass / sim->solid.mat.rho);
-}
-
-cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
+cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_error *err)
 {
     cf_solid *s = &sim->solid;
     cf_fragment *f = &sim->frag[fi];
-    cf_fragment_book_pending(sim, f);
+    cf_fragment_book_pending(f, &sim->flow);
     int nt = f->nt;
     int *tets = f->tets;
     int *comp = malloc((size_t)nt * sizeof(int));
@@ -658,7 +484,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
     cf_node_state before;
     cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &before);
     double P0[3], L0[3], P1[3] = {0, 0, 0}, L1[3] = {0, 0, 0}, ke_after = 0;
-    cf_fragment_momenta(sim, fi, P0, L0);
+    cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P0, L0);
 
     /* One component: the fragment stays itself; several: children. */
     int first = fi;
@@ -666,7 +492,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
         f->mode = CF_MODE_DEAD;
         first = sim->n_frag;
         for (int c = 0; c < k; c++)
-            if (cf_fragment_new(sim, fi, sim->t) < 0) {
+            if (cf_fragment_new(&sim->frag, &sim->n_frag, &sim->cap_frag, fi, sim->t) < 0) {
                 free(grouped), free(cstart), free(seen);
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
             }
@@ -688,7 +514,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
          * moments (a cube) got other axes from the round-off of the node
          * order, and its hulls were posed turned, deep in the ground. */
         if (k > 1)
-            cf_fragment_rest_props(sim, ci);
+            cf_fragment_rest_props(&sim->frag[ci], &sim->solid);
         g->mode = CF_MODE_RIGID;
         memcpy(g->q_match, sim->frag[fi].q_match, sizeof g->q_match);
         cf_node_state ns;
@@ -709,7 +535,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
             }
             g->steps = 0;
-            cf_fragment_ledger_reset(sim, ci);
+            cf_fragment_ledger_reset(&sim->frag[ci], &sim->solid, &sim->flow);
         }
     }
     /* Fragments of one initial body do not collide with each other in
@@ -717,7 +543,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
      * thousands of touching pieces would dominate Bullet's narrow phase
      * (about 14 times the rigid-step cost on a shattering sphere). */
     if (sim->bullet) {
-        int root = cf_fragment_root(sim, fi);
+        int root = cf_fragment_root(sim->frag, fi);
         for (int a = 0; a < k; a++)
             cfb_set_family(sim->bullet, sim->frag[first + a].body, root);
     }
@@ -728,12 +554,12 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_error *err)
     free(tets), free(grouped), free(cstart), free(seen);
     for (int c = 0; c < k; c++) {
         double P[3], L[3];
-        cf_fragment_momenta(sim, first + c, P, L);
+        cf_fragment_momenta(&sim->frag[first + c], &sim->solid, sim->bullet, P, L);
         v3_axpy(1.0, P, P1);
         v3_axpy(1.0, L, L1);
     }
     double loss = before.ke - ke_after;
     if (sim->bullet) /* the pbd rigid backend keeps the nodes' velocities: damping removes it */
         sim->flow.handoff += loss;
-    return record_handoff(sim, fi, 1, P0, L0, P1, L1, loss, err);
+    return record_handoff(sim, fi, 1, P0, L0, P1, L1, loss, rec);
 }

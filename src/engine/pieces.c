@@ -1,4 +1,4 @@
-#include "fragments.h"
+#include "pieces.h"
 
 #include "linalg.h"
 

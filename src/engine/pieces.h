@@ -1,7 +1,7 @@
-/* Fragments: connected pieces of the solid, their mass properties and their
- * rigid state (docs/physics.md §1, §9). */
-#ifndef COHFRAC_FRAGMENTS_H
-#define COHFRAC_FRAGMENTS_H
+/* Pieces: connected parts of a set of tets, their mass properties and the
+ * rigid state of a set of nodes (docs/physics.md §1, §9). */
+#ifndef COHFRAC_PIECES_H
+#define COHFRAC_PIECES_H
 
 #include "solid.h"
 

@@ -233,7 +233,7 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
     int k = cf_label_components(s, all, nt, comp);
     int ok = k >= 0;
     for (int c = 0; ok && c < k; c++)
-        ok = cf_fragment_new(sim, -1, 0.0) >= 0;
+        ok = cf_fragment_new(&sim->frag, &sim->n_frag, &sim->cap_frag, -1, 0.0) >= 0;
     for (int t = 0; ok && t < nt; t++) {
         cf_fragment *f = &sim->frag[comp[t]];
         if (!f->tets && !(f->tets = malloc((size_t)nt * sizeof(int)))) { /* trimmed below */
@@ -282,8 +282,8 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
         int *tt = realloc(f->tets, (size_t)f->nt * sizeof(int));
         if (tt)
             f->tets = tt;
-        cf_fragment_rest_props(sim, fi);
-        cf_fragment_ledger_reset(sim, fi);
+        cf_fragment_rest_props(&sim->frag[fi], &sim->solid);
+        cf_fragment_ledger_reset(&sim->frag[fi], &sim->solid, &sim->flow);
         if (fracture) {
             f->mode = CF_MODE_FRACTURE;
             f->t_enter = 0;
@@ -348,7 +348,8 @@ static int alive_fragments(const cf_world *sim, int *in_fracture)
     return n;
 }
 
-cf_status cf_world_push_handoff(cf_world *sim, const cf_handoff_record *r, cf_error *err)
+/* The event of a hand-off the step made. */
+static cf_status handoff_event(cf_world *sim, const cf_handoff_record *r, cf_error *err)
 {
     cf_event e = {.type = CF_EVENT_HANDOFF, .time = sim->t, .first = r->fragment, .count = 1,
                   .alive = alive_fragments(sim, NULL), .handoff = *r};
@@ -388,7 +389,7 @@ int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
     o->n_tets = f->nt;
     memcpy(o->inertia_principal, f->principal, sizeof f->principal);
     o->n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
-    o->debris = cf_fragment_is_debris(sim, f);
+    o->debris = cf_fragment_is_debris(f, &sim->def.solver);
     o->hull_volume_error = cf_hulls_error(&f->hulls);
     o->decomposition_time = f->decompose_time;
     memcpy(o->com_rest, f->com_rest, sizeof o->com_rest);
@@ -599,30 +600,11 @@ void cf_world_destroy(cf_world *sim)
     free(sim);
 }
 
-/* Kinetic energy (J) of rigid fragment f in Bullet state st. */
-static double state_kinetic_energy(const cf_fragment *f, const cfb_state *st)
-{
-    double Rb[9], wb[3];
-    quat_to_mat(st->quat, Rb);
-    m3_tmulv(Rb, st->w, wb); /* body-frame angular velocity */
-    double e = 0.5 * f->mass * v3_dot(st->v, st->v);
-    for (int k = 0; k < 3; k++)
-        e += 0.5 * f->principal[k] * wb[k] * wb[k];
-    return e;
-}
-
-double cf_body_kinetic_energy(const cf_world *sim, int fi)
-{
-    cfb_state st;
-    cfb_get_state(sim->bullet, sim->frag[fi].body, &st);
-    return state_kinetic_energy(&sim->frag[fi], &st);
-}
-
 /* Kinetic energy minus gravity's potential work: what a Bullet body keeps
  * in free flight, J. */
 static double body_energy(const cf_world *sim, const cf_fragment *f, const cfb_state *st)
 {
-    return state_kinetic_energy(f, st) - f->mass * v3_dot(sim->def.gravity, st->pos);
+    return cf_body_kinetic_energy(f, st) - f->mass * v3_dot(sim->def.gravity, st->pos);
 }
 
 /* The ledger; the momenta too with `momenta` (for fragments in fracture
@@ -639,7 +621,7 @@ static void ledger(const cf_world *sim, cf_ledger *l, int momenta)
         if (f->body >= 0) {
             cfb_state st;
             cfb_get_state(sim->bullet, f->body, &st);
-            l->kinetic += state_kinetic_energy(f, &st);
+            l->kinetic += cf_body_kinetic_energy(f, &st);
             v3_axpy(f->mass, st.pos, l->mass_moment);
             if (momenta)
                 cf_body_momenta(f, &st, P, L);
@@ -648,7 +630,7 @@ static void ledger(const cf_world *sim, cf_ledger *l, int momenta)
             l->strain += f->e_strain;
             v3_axpy(1.0, f->mx, l->mass_moment);
             if (momenta)
-                cf_fragment_momenta(sim, fi, P, L);
+                cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P, L);
         }
         v3_axpy(1.0, P, l->momentum);
         v3_axpy(1.0, L, l->angular_momentum);
@@ -689,7 +671,7 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
             o->mode = f->mode, o->n_tets = f->nt, o->mass = f->mass;
             memcpy(o->principal, f->principal, sizeof o->principal);
             memcpy(o->axes, f->Q, sizeof o->axes);
-            cf_fragment_pose_peek(sim, fi, o->com, R, o->v, o->w);
+            cf_fragment_pose_peek(&sim->frag[fi], &sim->solid, sim->bullet, o->com, R, o->v, o->w);
             mat_to_quat(R, o->quat);
             for (int k = 0; k < 3; k++)
                 o->momentum[k] = f->mass * o->v[k];
@@ -697,7 +679,7 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
                 cfb_state st;
                 cfb_get_state(sim->bullet, f->body, &st);
                 cf_body_spin(f, &st, o->angular_momentum);
-                o->kinetic = state_kinetic_energy(f, &st);
+                o->kinetic = cf_body_kinetic_energy(f, &st);
             } else {
                 cf_node_state ns;
                 cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
@@ -718,7 +700,7 @@ double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
         return 0;
     const cf_fragment *f = &sim->frag[id];
     double com[3], R[9], v[3], w[3], Rd[3], best = -INFINITY;
-    cf_fragment_pose_peek(sim, id, com, R, v, w);
+    cf_fragment_pose_peek(&sim->frag[id], &sim->solid, sim->bullet, com, R, v, w);
     m3_tmulv(R, d, Rd); /* (R r).d = r.(R^T d), r from the rest centre of mass */
     for (int i = 0; i < f->nodes.n; i++) {
         double r[3];
@@ -754,7 +736,7 @@ int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
     const cf_fragment *f = &sim->frag[fi];
     double com[3], R[9], v[3], w[3];
     if (f->body >= 0) /* rigid in Bullet: the nodes are not moved, the pose is */
-        cf_fragment_pose_peek(sim, fi, com, R, v, w);
+        cf_fragment_pose_peek(&sim->frag[fi], &sim->solid, sim->bullet, com, R, v, w);
     for (int j = 0; j < 4; j++) {
         int a = s->tet[4 * st + j];
         if (f->body < 0) {
@@ -836,7 +818,7 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 static int can_break(const cf_world *sim, const cf_fragment *f)
 {
     const cf_solid *s = &sim->solid;
-    if (sim->def.solver.criterion == CF_CRITERION_NONE || cf_fragment_is_debris(sim, f))
+    if (sim->def.solver.criterion == CF_CRITERION_NONE || cf_fragment_is_debris(f, &sim->def.solver))
         return 0;
     for (int i = 0; i < f->nt; i++)
         for (int k = 0; k < 4; k++) {
@@ -892,8 +874,11 @@ static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
             if (f->mode != CF_MODE_RIGID || f->body < 0 || !impact(sim, f))
                 continue;
             double th = cf_wall_time();
-            st = cf_handoff_to_fracture(sim, fi, &pre[fi], err);
+            cf_handoff_record r;
+            st = cf_handoff_to_fracture(sim, fi, &pre[fi], &r, err);
             sim->prof.handoff += cf_wall_time() - th;
+            if (st == CF_OK)
+                st = handoff_event(sim, &r, err);
             hit++;
         }
         if (st != CF_OK || hit == 0 || pass == CF_MAX_RESTEPS)
@@ -939,7 +924,10 @@ static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
         if (sim->frag[fi].mode != CF_MODE_RIGID)
             continue;
         if (cf_pbd_impact(sim, fi, dt) && can_break(sim, &sim->frag[fi])) {
-            cf_status st = cf_handoff_to_fracture(sim, fi, NULL, err);
+            cf_handoff_record r;
+            cf_status st = cf_handoff_to_fracture(sim, fi, NULL, &r, err);
+            if (st == CF_OK)
+                st = handoff_event(sim, &r, err);
             if (st != CF_OK)
                 return st;
             continue;
@@ -1045,9 +1033,9 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
         }
         /* Inverted tets counted over the fragment's whole initial body in
          * fracture mode (one inverted tet is all of a one-tet piece). */
-        int root = cf_fragment_root(sim, fi), inv = 0, nt = 0;
+        int root = cf_fragment_root(sim->frag, fi), inv = 0, nt = 0;
         for (int g = 0; f->n_inverted > 0 && g < n; g++)
-            if (sim->frag[g].mode == CF_MODE_FRACTURE && cf_fragment_root(sim, g) == root)
+            if (sim->frag[g].mode == CF_MODE_FRACTURE && cf_fragment_root(sim->frag, g) == root)
                 inv += sim->frag[g].n_inverted, nt += sim->frag[g].nt;
         if (inv > set->max_inverted_fraction * nt) {
             snprintf(what, sizeof what,
@@ -1106,7 +1094,7 @@ static int impact_unfinished(cf_world *sim, int fi)
     const cf_solid *s = &sim->solid;
     double com[3], R[9], v[3], w[3], P[3], L[3], r[3], wr[3], vr[3];
     double reach = sim->def.solver.dt_rigid;
-    cf_fragment_pose(sim, fi, com, R, v, w);
+    cf_fragment_pose(&sim->frag[fi], &sim->solid, sim->bullet, com, R, v, w);
     int touching = 0;
     for (int i = 0; i < f->nodes.n; i++) {
         const double *x = &s->x[3 * f->nodes.v[i]];
@@ -1129,7 +1117,7 @@ static int impact_unfinished(cf_world *sim, int fi)
     if (!touching)
         return 0;
     double Lo[3]; /* the spin's angular momentum, about the centre of mass */
-    cf_fragment_momenta(sim, fi, P, L);
+    cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P, L);
     v3_cross(com, P, r);
     v3_sub(L, r, Lo);
     double rigid = 0.5 * f->mass * v3_dot(v, v) + 0.5 * v3_dot(w, Lo);
@@ -1149,13 +1137,16 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         int timed_out = sim->t - f->t_enter >= set->max_fracture_time - 1e-12;
-        if (!timed_out && !cf_fragment_is_debris(sim, f) &&
+        if (!timed_out && !cf_fragment_is_debris(f, &sim->def.solver) &&
             (f->quiet < set->quiet_steps || impact_unfinished(sim, fi)))
             continue;
         int first_new = sim->n_frag;
         double th = cf_wall_time();
-        cf_status st = cf_handoff_to_rigid(sim, fi, err);
+        cf_handoff_record r;
+        cf_status st = cf_handoff_to_rigid(sim, fi, &r, err);
         sim->prof.handoff += cf_wall_time() - th;
+        if (st == CF_OK)
+            st = handoff_event(sim, &r, err);
         if (st == CF_OK)
             st = fragments_born(sim, first_new, err);
         if (st != CF_OK)
@@ -1312,7 +1303,7 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
         const cf_fragment *f = &sim->frag[fi];
         if (f->mode != CF_MODE_DEAD)
             o->mass_alive += f->mass;
-        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(sim, f)) {
+        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(f, &sim->def.solver)) {
             o->debris++;
             o->debris_mass += f->mass;
             continue;
