@@ -11,7 +11,7 @@
 
 #include "cohfrac/sim.h"
 #include "cohfrac/scene.h"
-#include "world_impl.h"
+#include "handoff.h"
 #include "verify.h"
 
 static double drift(const cf_sim *sim, const double P0[3])

@@ -2,7 +2,6 @@
 #include "contact.h"
 
 #include "linalg.h"
-#include "world_impl.h"
 
 #include <ccd/ccd.h>
 #include <math.h>
@@ -60,13 +59,13 @@ int cf_boxes_overlap(const double lo0[3], const double hi0[3], const double lo1[
 }
 
 /* Append body fragment g's hulls in world coordinates. */
-static int add_hulls(cf_world *sim, int g, cf_hull_set *hs)
+static int add_hulls(const cf_contact_ctx *ctx, int g, cf_hull_set *hs)
 {
-    const cf_fragment *f = &sim->frag[g];
+    const cf_fragment *f = &ctx->frag[g];
     const cf_hulls *h = &f->hulls;
     cfb_state st;
     double R[9];
-    cfb_get_state(sim->bullet, f->body, &st);
+    cfb_get_state(ctx->bullet, f->body, &st);
     quat_to_mat(st.quat, R);
     int nv0 = hs->start[hs->n], nv = h->start[h->n_hulls], n = hs->n + h->n_hulls;
     double *pts = realloc(hs->pts, (size_t)(nv0 + nv) * 3 * sizeof(double));
@@ -112,32 +111,32 @@ static int add_hulls(cf_world *sim, int g, cf_hull_set *hs)
     return 0;
 }
 
-int cf_body_boxes(cf_world *sim, double **boxes)
+int cf_body_boxes(const cf_contact_ctx *ctx, double **boxes)
 {
-    double *b = realloc(*boxes, (size_t)(sim->n_frag > 0 ? sim->n_frag : 1) * 6 * sizeof(double));
+    double *b = realloc(*boxes, (size_t)(ctx->n_frag > 0 ? ctx->n_frag : 1) * 6 * sizeof(double));
     if (!b)
         return -1;
     *boxes = b;
-    for (int g = 0; g < sim->n_frag; g++) {
-        const cf_fragment *o = &sim->frag[g];
+    for (int g = 0; g < ctx->n_frag; g++) {
+        const cf_fragment *o = &ctx->frag[g];
         double *lo = &b[6 * g], *hi = lo + 3;
-        if (!sim->bullet || o->mode != CF_MODE_RIGID || o->body < 0 ||
-            cfb_get_aabb(sim->bullet, o->body, lo, hi))
+        if (!ctx->bullet || o->mode != CF_MODE_RIGID || o->body < 0 ||
+            cfb_get_aabb(ctx->bullet, o->body, lo, hi))
             for (int d = 0; d < 3; d++)
                 lo[d] = INFINITY, hi[d] = -INFINITY; /* overlaps nothing */
     }
     return 0;
 }
 
-int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, cf_hull_set *hs)
+int cf_hull_set_gather(const cf_contact_ctx *ctx, int fi, double pad, const double *boxes, cf_hull_set *hs)
 {
-    const cf_fragment *f = &sim->frag[fi];
-    const cf_solid *s = &sim->solid;
+    const cf_fragment *f = &ctx->frag[fi];
+    const cf_solid *s = ctx->solid;
     hs->n = 0;
     if (!hs->start && !(hs->start = calloc(1, sizeof(int))))
         return -1;
     hs->start[0] = 0;
-    if (!sim->bullet)
+    if (!ctx->bullet)
         return 0;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int i = 0; i < f->nodes.n; i++)
@@ -146,19 +145,19 @@ int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, c
             hi[d] = fmax(hi[d], s->x[3 * f->nodes.v[i] + d] + pad);
         }
     double size = 0;
-    int root = cf_fragment_root(sim->frag, fi);
-    for (int g = 0; g < sim->n_frag; g++) {
-        const cf_fragment *o = &sim->frag[g];
+    int root = cf_fragment_root(ctx->frag, fi);
+    for (int g = 0; g < ctx->n_frag; g++) {
+        const cf_fragment *o = &ctx->frag[g];
         /* Fragments of one body do not collide (as in Bullet, §9): their
          * hulls overlap where a crack face is not convex, and a hull that
          * pushes a sibling's node pushes it into whatever holds it (the
          * ground's penalty then springs it back with energy no load put
          * in).  Debris has no hulls: a sphere in Bullet, too small to hold
          * a node (§9.2). */
-        if (cf_fragment_root(sim->frag, g) == root || o->hulls.n_hulls == 0 ||
+        if (cf_fragment_root(ctx->frag, g) == root || o->hulls.n_hulls == 0 ||
             !cf_boxes_overlap(lo, hi, &boxes[6 * g], &boxes[6 * g + 3]))
             continue;
-        if (add_hulls(sim, g, hs))
+        if (add_hulls(ctx, g, hs))
             return -1;
         size = fmax(size, cbrt(o->mass / s->mat.rho));
     }
@@ -258,48 +257,48 @@ typedef struct {
     int hit;
 } push_sum;
 
-int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes, double *energy)
+int cf_node_impulses_flush(const cf_contact_ctx *ctx, cf_node_impulses *ni, const int *nodes, double *energy)
 {
-    int n = sim->n_frag;
+    int n = ctx->n_frag;
     /* Without the sums the pushes could not be bounded: an error, not
      * unbounded impulses. */
     push_sum *sum = calloc((size_t)n + 1, sizeof *sum);
     if (!sum)
         return -1;
-    double gained = 0, bounce = 1.0 + sim->solid.mat.restitution;
+    double gained = 0, bounce = 1.0 + ctx->solid->mat.restitution;
     for (int i = 0; i < ni->n; i++) {
         int g = ni->frag[i];
-        if (g < 0 || sim->frag[g].body < 0)
+        if (g < 0 || ctx->frag[g].body < 0)
             continue;
         v3_axpy(-1.0, &ni->J[3 * i], sum[g].J);
-        sum[g].vmax = fmax(sum[g].vmax, v3_norm(&sim->solid.v[3 * nodes[i]]));
+        sum[g].vmax = fmax(sum[g].vmax, v3_norm(&ctx->solid->v[3 * nodes[i]]));
         sum[g].hit = 1;
     }
     for (int g = 0; g < n; g++) {
         if (!sum[g].hit)
             continue;
         cfb_state st;
-        cfb_get_state(sim->bullet, sim->frag[g].body, &st);
+        cfb_get_state(ctx->bullet, ctx->frag[g].body, &st);
         memcpy(sum[g].w0, st.w, sizeof st.w);
-        double Jl = v3_norm(sum[g].J), dv = Jl / sim->frag[g].mass;
+        double Jl = v3_norm(sum[g].J), dv = Jl / ctx->frag[g].mass;
         double room = Jl > 0 ? bounce * sum[g].vmax - v3_dot(st.v, sum[g].J) / Jl : dv;
         sum[g].beta = dv > room ? fmax(0.0, room) / dv : 1.0;
-        gained -= cf_body_kinetic_energy(&sim->frag[g], &st);
+        gained -= cf_body_kinetic_energy(&ctx->frag[g], &st);
     }
     for (int i = 0; i < ni->n; i++) {
         int g = ni->frag[i];
         if (g < 0)
             continue;
-        cf_fragment *o = &sim->frag[g];
+        cf_fragment *o = &ctx->frag[g];
         double beta = sum[g].beta;
         double J[3] = {-beta * ni->J[3 * i], -beta * ni->J[3 * i + 1], -beta * ni->J[3 * i + 2]};
         if (o->body >= 0) {
-            cfb_apply_impulse(sim->bullet, o->body, J, &ni->point[3 * i]);
+            cfb_apply_impulse(ctx->bullet, o->body, J, &ni->point[3 * i]);
             o->pushed += v3_norm(J);
         }
         if (beta < 1.0) { /* what the body did not take stays with the node */
             int a = nodes[i];
-            double *va = &sim->solid.v[3 * a], m = sim->solid.m[a];
+            double *va = &ctx->solid->v[3 * a], m = ctx->solid->m[a];
             gained -= 0.5 * m * v3_dot(va, va);
             v3_axpy(-(1.0 - beta) / m, &ni->J[3 * i], va);
             gained += 0.5 * m * v3_dot(va, va);
@@ -310,9 +309,9 @@ int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes
     for (int g = 0; g < n; g++) { /* the spin the pushes gave, bounded likewise */
         if (!sum[g].hit)
             continue;
-        const cf_fragment *o = &sim->frag[g];
+        const cf_fragment *o = &ctx->frag[g];
         cfb_state st;
-        cfb_get_state(sim->bullet, o->body, &st);
+        cfb_get_state(ctx->bullet, o->body, &st);
         double dw[3], Rb[9], wb[3], e = 0, v2 = bounce * sum[g].vmax;
         v3_sub(st.w, sum[g].w0, dw);
         quat_to_mat(st.quat, Rb);
@@ -324,9 +323,9 @@ int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes
             double gamma = sqrt(limit / e);
             for (int k = 0; k < 3; k++)
                 st.w[k] = sum[g].w0[k] + gamma * dw[k];
-            cfb_set_state(sim->bullet, o->body, &st);
+            cfb_set_state(ctx->bullet, o->body, &st);
         }
-        cfb_get_state(sim->bullet, o->body, &st); /* as Bullet holds it */
+        cfb_get_state(ctx->bullet, o->body, &st); /* as Bullet holds it */
         gained += cf_body_kinetic_energy(o, &st);
     }
     free(sum);

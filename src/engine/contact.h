@@ -10,7 +10,8 @@
 #ifndef COHFRAC_CONTACT_H
 #define COHFRAC_CONTACT_H
 
-typedef struct cf_world cf_world;
+#include "fragment.h"
+
 typedef struct cff_mesh cff_mesh;
 
 /* Whether boxes [lo0, hi0] and [lo1, hi1] (m) overlap, touching included;
@@ -39,15 +40,70 @@ typedef struct cf_node_impulses {
     double *point;     /* [n][3] last contact point, m */
 } cf_node_impulses;
 
+/* The boundary of a fracture-mode fragment as a deforming triangle mesh:
+ * the faces of its tets used by one of its tets only (crack faces opened by
+ * node duplication included), outward, in an FCL hierarchy refitted to the
+ * nodes' current positions before every query pass. */
+typedef struct cf_frag_surface {
+    cff_mesh *mesh;    /* NULL until first needed */
+    int *node;         /* [nv] solid node of each surface vertex */
+    int *slot;         /* [nv] its index in the fragment's node list */
+    int *tri;          /* [ntri][3] surface vertices, counter-clockwise from outside */
+    double *xv;        /* [nv][3] the vertices' current positions, m (refit scratch) */
+    int nv, ntri;
+    int built_nodes;   /* the fragment's node count when built: node
+                          duplication changes the surface */
+} cf_frag_surface;
+
+/* What the contact of one fragment keeps between its steps, kept by the
+ * contact module in a table keyed by fragment (cf_contact_caches), not in
+ * the fragment record: the impulses its nodes gave rigid bodies, the
+ * hulls of the rigid bodies near it, its boundary. */
+typedef struct cf_contact_cache {
+    cf_node_impulses push; /* fracture mode: impulses its nodes gave bodies */
+    cf_hull_set near;      /* fracture mode: hulls of the rigid bodies near it
+                              this rigid step */
+    cf_frag_surface surface; /* fracture mode: its boundary, for contact with
+                              other bodies' fragments */
+} cf_contact_cache;
+
+/* The table: v[0..cap), zeroed when grown. */
+typedef struct cf_contact_caches {
+    cf_contact_cache *v;
+    int cap;
+} cf_contact_caches;
+
+/* Room for fragments 0..n-1 (new entries empty; pointers into the table do
+ * not survive the call).  Returns 0, or -1 out of memory. */
+int cf_contact_caches_reserve(cf_contact_caches *c, int n);
+
+/* Frees what fragment fi's entry holds and leaves it empty. */
+void cf_contact_cache_clear(cf_contact_caches *c, int fi);
+
+/* Frees the table and every entry. */
+void cf_contact_caches_free(cf_contact_caches *c);
+
+/* What the contact stages read and write: the fragment table frag[0..n_frag)
+ * with its caches, the solid and the Bullet world (NULL for the pbd rigid
+ * backend). */
+typedef struct cf_contact_ctx {
+    cf_fragment *frag;
+    cf_contact_cache *cache; /* [n_frag] */
+    int n_frag;
+    cf_solid *solid;
+    cfb_world *bullet;
+} cf_contact_ctx;
+
 /* The world box of every fragment's Bullet body, once per rigid step:
  * (*boxes)[n_frag][6] = lo, hi (m); an empty box for fragments without a
  * rigid body.  Grows *boxes as needed.  Returns 0, or -1 out of memory. */
-int cf_body_boxes(cf_world *sim, double **boxes);
+int cf_body_boxes(const cf_contact_ctx *c, double **boxes);
 
 /* Hulls of every rigid Bullet fragment whose box (from cf_body_boxes)
  * overlaps fragment fi's node box grown by `pad` m.  Returns 0, or -1 out
  * of memory. */
-int cf_hull_set_gather(cf_world *sim, int fi, double pad, const double *boxes, cf_hull_set *hs);
+int cf_hull_set_gather(const cf_contact_ctx *c, int fi, double pad, const double *boxes,
+                       cf_hull_set *hs);
 void cf_hull_set_free(cf_hull_set *hs);
 
 /* Push the predicted position p of a node at x out of every hull of hs
@@ -82,29 +138,15 @@ void cf_node_impulses_free(cf_node_impulses *ni);
  * given back (angular momentum is not kept where it acts).  The energy the
  * bodies gained goes to *energy (J).  Returns 0, or -1 out of memory
  * (nothing applied). */
-int cf_node_impulses_flush(cf_world *sim, cf_node_impulses *ni, const int *nodes, double *energy);
-
-/* The boundary of a fracture-mode fragment as a deforming triangle mesh:
- * the faces of its tets used by one of its tets only (crack faces opened by
- * node duplication included), outward, in an FCL hierarchy refitted to the
- * nodes' current positions before every query pass. */
-typedef struct cf_frag_surface {
-    cff_mesh *mesh;    /* NULL until first needed */
-    int *node;         /* [nv] solid node of each surface vertex */
-    int *slot;         /* [nv] its index in the fragment's node list */
-    int *tri;          /* [ntri][3] surface vertices, counter-clockwise from outside */
-    double *xv;        /* [nv][3] the vertices' current positions, m (refit scratch) */
-    int nv, ntri;
-    int built_nodes;   /* the fragment's node count when built: node
-                          duplication changes the surface */
-} cf_frag_surface;
+int cf_node_impulses_flush(const cf_contact_ctx *c, cf_node_impulses *ni, const int *nodes,
+                           double *energy);
 
 void cf_frag_surface_free(cf_frag_surface *fs);
 
 /* Whether fracture-mode fragments of two initial bodies exist, so that
  * cf_body_contact has work: asked once per rigid step (sub-steps change no
  * fragment's mode). */
-int cf_body_contact_needed(const cf_world *sim);
+int cf_body_contact_needed(const cf_contact_ctx *c);
 
 /* Contact between fracture-mode fragments of different initial bodies
  * (fragments of one body do not collide with each other, as in Bullet),
@@ -128,6 +170,6 @@ int cf_body_contact_needed(const cf_world *sim);
  * partly into strain energy; so that the energy ledger balances.  Returns
  * 0, or -1 out of memory or on an FCL error (a message in
  * cff_last_error(); "out of memory" is not set there). */
-int cf_body_contact(cf_world *sim, double h, double *removed);
+int cf_body_contact(const cf_contact_ctx *c, double h, double *removed);
 
 #endif

@@ -4,7 +4,6 @@
 
 #include "cf_fcl.h"
 #include "linalg.h"
-#include "world_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -15,6 +14,39 @@ void cf_frag_surface_free(cf_frag_surface *fs)
     cff_mesh_destroy(fs->mesh);
     free(fs->node), free(fs->slot), free(fs->tri), free(fs->xv);
     memset(fs, 0, sizeof *fs);
+}
+
+/* The contact caches: a table keyed by fragment (contact.h). */
+int cf_contact_caches_reserve(cf_contact_caches *c, int n)
+{
+    if (n <= c->cap)
+        return 0;
+    int cap = c->cap ? c->cap : 16;
+    while (cap < n)
+        cap *= 2;
+    cf_contact_cache *v = realloc(c->v, (size_t)cap * sizeof *v);
+    if (!v)
+        return -1;
+    memset(&v[c->cap], 0, (size_t)(cap - c->cap) * sizeof *v);
+    c->v = v, c->cap = cap;
+    return 0;
+}
+
+void cf_contact_cache_clear(cf_contact_caches *c, int fi)
+{
+    if (fi >= c->cap)
+        return;
+    cf_node_impulses_free(&c->v[fi].push);
+    cf_hull_set_free(&c->v[fi].near);
+    cf_frag_surface_free(&c->v[fi].surface);
+}
+
+void cf_contact_caches_free(cf_contact_caches *c)
+{
+    for (int fi = 0; fi < c->cap; fi++)
+        cf_contact_cache_clear(c, fi);
+    free(c->v);
+    c->v = NULL, c->cap = 0;
 }
 
 /* The faces of f's tets that no other of its tets uses, on the current
@@ -171,10 +203,10 @@ static int move(cf_solid *s, moved_nodes *mv, const cf_fragment *f, int i, int a
 
 /* Every node of fragment fa inside box_b and behind fb's surface, projected
  * out with it (the constraint of contact.h).  Returns 0, or -1. */
-static int push_out(cf_world *sim, const cf_fragment *fa, const cf_fragment *fb,
+static int push_out(const cf_contact_ctx *ctx, const cf_fragment *fa, const cf_fragment *fb,
                     cf_frag_surface *sb, const double box_b[6], double h, moved_nodes *mv)
 {
-    cf_solid *s = &sim->solid;
+    cf_solid *s = ctx->solid;
     int fit = surface_refit(s, fb, sb);
     if (fit)
         return fit < 0 ? -1 : 0;
@@ -210,13 +242,13 @@ static int push_out(cf_world *sim, const cf_fragment *fa, const cf_fragment *fb,
     return 0;
 }
 
-int cf_body_contact_needed(const cf_world *sim)
+int cf_body_contact_needed(const cf_contact_ctx *ctx)
 {
     int first_root = -1;
-    for (int fi = 0; fi < sim->n_frag; fi++) {
-        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+    for (int fi = 0; fi < ctx->n_frag; fi++) {
+        if (ctx->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
-        int r = cf_fragment_root(sim->frag, fi);
+        int r = cf_fragment_root(ctx->frag, fi);
         if (first_root >= 0 && r != first_root)
             return 1;
         first_root = r;
@@ -224,10 +256,10 @@ int cf_body_contact_needed(const cf_world *sim)
     return 0;
 }
 
-int cf_body_contact(cf_world *sim, double h, double *removed)
+int cf_body_contact(const cf_contact_ctx *ctx, double h, double *removed)
 {
     *removed = 0;
-    int n = sim->n_frag;
+    int n = ctx->n_frag;
     double *box = malloc((size_t)n * 6 * sizeof(double));
     int *root = malloc((size_t)n * sizeof(int));
     if (!box || !root) {
@@ -235,26 +267,26 @@ int cf_body_contact(cf_world *sim, double h, double *removed)
         return -1;
     }
     for (int fi = 0; fi < n; fi++)
-        if (sim->frag[fi].mode == CF_MODE_FRACTURE) {
-            node_box(&sim->solid, &sim->frag[fi], &box[6 * fi]);
-            root[fi] = cf_fragment_root(sim->frag, fi);
+        if (ctx->frag[fi].mode == CF_MODE_FRACTURE) {
+            node_box(ctx->solid, &ctx->frag[fi], &box[6 * fi]);
+            root[fi] = cf_fragment_root(ctx->frag, fi);
         }
     int rc = 0;
     moved_nodes mv = {0};
     for (int i = 0; i < n && !rc; i++) {
-        cf_fragment *fa = &sim->frag[i];
+        cf_fragment *fa = &ctx->frag[i];
         if (fa->mode != CF_MODE_FRACTURE)
             continue;
         for (int j = i + 1; j < n && !rc; j++) {
-            cf_fragment *fb = &sim->frag[j];
+            cf_fragment *fb = &ctx->frag[j];
             if (fb->mode != CF_MODE_FRACTURE || root[j] == root[i] ||
                 !cf_boxes_overlap(&box[6 * i], &box[6 * i + 3], &box[6 * j], &box[6 * j + 3]))
                 continue;
-            rc = push_out(sim, fa, fb, &fb->surface, &box[6 * j], h, &mv) ||
-                 push_out(sim, fb, fa, &fa->surface, &box[6 * i], h, &mv);
+            rc = push_out(ctx, fa, fb, &ctx->cache[j].surface, &box[6 * j], h, &mv) ||
+                 push_out(ctx, fb, fa, &ctx->cache[i].surface, &box[6 * i], h, &mv);
         }
     }
-    *removed = -moved_work(&mv, &sim->solid);
+    *removed = -moved_work(&mv, ctx->solid);
     moved_free(&mv);
     free(box), free(root);
     return rc ? -1 : 0;

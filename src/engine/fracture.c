@@ -1,5 +1,5 @@
 /* The in-house solver step (source Table 6.2, docs/physics.md §4), per fragment. */
-#include "world_impl.h"
+#include "fracture.h"
 
 #include "chunks.h"
 #include "linalg.h"
@@ -7,9 +7,18 @@
 
 #include <stdlib.h>
 #include <string.h>
-static int ensure_scratch(cf_fragment *f)
+
+/* Fragment f's contact cache (contact.h), kept in the world's table, which
+ * cf_solver_step makes room in. */
+static cf_contact_cache *cache_of(const cf_world *sim, const cf_fragment *f)
 {
-    if (cf_node_impulses_reserve(&f->push, f->nodes.n))
+    return &sim->contact.v[f - sim->frag];
+}
+
+static int ensure_scratch(cf_world *sim, cf_fragment *f)
+{
+    if (cf_contact_caches_reserve(&sim->contact, sim->n_frag) ||
+        cf_node_impulses_reserve(&cache_of(sim, f)->push, f->nodes.n))
         return -1;
     if (f->pairs_cap < f->coh.n) {
         int cap = f->coh.n + f->coh.n / 2 + 16;
@@ -382,7 +391,7 @@ static cf_status forces(cf_world *sim, cf_fragment *f, double t, double dt, int 
         f->quiet = inserted ? 0 : f->quiet + 1;
         t0 = cf_wall_time();
     }
-    if (ensure_scratch(f))
+    if (ensure_scratch(sim, f))
         return CF_ERR_NOMEM;
     if (fracture) {
         cf_tet4_scatter(s, f->tets, f->nt, f->nodes.v, f->nodes.n, g);
@@ -516,15 +525,16 @@ static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next,
         v3_sub(&s->p[4 * a], before, dp);
         w = s->m[a] * v3_dot(dp, u) / dt;
     }
-    if (f->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
+    cf_contact_cache *cc = cache_of(sim, f);
+    if (cc->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
         double *pa = &s->p[4 * a], dJ[3];
         memcpy(before, pa, sizeof before);
-        int h = cf_hull_set_project(&f->near, &s->x[3 * a], pa);
+        int h = cf_hull_set_project(&cc->near, &s->x[3 * a], pa);
         if (h >= 0) {
             v3_sub(pa, before, dJ);
             for (int c = 0; c < 3; c++)
                 dJ[c] *= s->m[a] / dt;
-            cf_node_impulses_add(&f->push, i, f->near.frag[h], dJ, pa);
+            cf_node_impulses_add(&cc->push, i, cc->near.frag[h], dJ, pa);
         }
     }
     return w;
@@ -535,7 +545,7 @@ static void obstacle_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const step_sums *c = ctx;
     const cf_solid *s = &c->sim->solid;
-    int alone = c->f->near.n == 0; /* no rigid neighbour's hull to test */
+    int alone = cache_of(c->sim, c->f)->near.n == 0; /* no rigid neighbour's hull to test */
     if (alone && c->penalty)
         return; /* the obstacles acted as forces (penalty_chunk) */
     for (int i = i0; i < i1; i++) {
@@ -567,7 +577,8 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
     int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
     /* The obstacle pass on the threads unless hull pushes of rigid
      * neighbours (one list) or FCL queries need one thread. */
-    int obstacles_par = par && f->near.n == 0 && !mesh_obstacles(sim);
+    const cf_contact_cache *cc = cache_of(sim, f);
+    int obstacles_par = par && cc->near.n == 0 && !mesh_obstacles(sim);
     int bars = !explicit_step(set, fracture), penalty = penalty_step(set, fracture);
 #pragma omp parallel for schedule(static) if (par)
     for (int i = 0; i < nn; i++) {
@@ -635,7 +646,7 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
             cap = fmax(cap, v3_norm(vr) + v3_norm(u));
         }
         double speed = v3_norm(vnew), scale = 1.0;
-        if (bars && speed > cap && (f->near.n == 0 || f->push.frag[i] < 0))
+        if (bars && speed > cap && (cc->near.n == 0 || cc->push.frag[i] < 0))
             scale = cap / speed, n_capped++;
         double vout[3] = {scale * vnew[0], scale * vnew[1], scale * vnew[2]};
         f->term[i] =

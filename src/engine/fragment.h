@@ -8,7 +8,6 @@
 
 #include "cf_bullet.h"
 #include "cohesive.h"
-#include "contact.h"
 #include "decompose.h"
 #include "insertion.h"
 #include "pbd.h"
@@ -77,11 +76,6 @@ typedef struct cf_fragment {
     double decompose_time;   /* s of wall time to decompose it */
     double pushed;           /* N s: impulse fracture-mode nodes gave its body
                                 since the last rigid step (impact trigger) */
-    cf_node_impulses push;   /* fracture mode: impulses its nodes gave bodies */
-    cf_hull_set near;        /* fracture mode: hulls of the rigid bodies near it
-                                this rigid step */
-    cf_frag_surface surface; /* fracture mode: its boundary, for contact with
-                                other bodies' fragments */
 } cf_fragment;
 
 /* Appends a new fragment to the table frag[0..*n) of capacity *cap (grown

@@ -1,6 +1,8 @@
 /* Hand-off between rigid mode (Bullet, or the pbd rigid backend) and
  * fracture mode (docs/physics.md §9). */
-#include "world_impl.h"
+#include "handoff.h"
+
+#include "fracture.h"
 
 #include "chunks.h"
 #include "linalg.h"
@@ -549,8 +551,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
     }
     if (sim->bullet || k > 1)
         cf_bars_free(&sim->frag[fi].bars);
-    cf_hull_set_free(&sim->frag[fi].near);
-    cf_frag_surface_free(&sim->frag[fi].surface);
+    cf_contact_cache_clear(&sim->contact, fi);
     free(tets), free(grouped), free(cstart), free(seen);
     for (int c = 0; c < k; c++) {
         double P[3], L[3];

@@ -5,9 +5,10 @@
  * sub-cycled at dt_fracture; a fracture-mode fragment that falls apart is
  * split into its pieces at the end of the rigid step, and one quiet for
  * quiet_steps steps is handed back to rigid mode. */
-#include "world_impl.h"
-#include "hash.h"
+#include "fracture.h"
+#include "handoff.h"
 
+#include "hash.h"
 #include "linalg.h"
 #include "renumber.h"
 #include "sort.h"
@@ -583,11 +584,9 @@ void cf_world_destroy(cf_world *sim)
         free(f->v_old), free(f->term), free(f->pairs);
         cf_bars_free(&f->bars);
         cf_hulls_free(&f->hulls);
-        cf_node_impulses_free(&f->push);
-        cf_hull_set_free(&f->near);
-        cf_frag_surface_free(&f->surface);
     }
     free(sim->frag);
+    cf_contact_caches_free(&sim->contact);
     cf_obstacles_free(&sim->obs);
     free(sim->obstacle_body), free(sim->obstacle_moving);
     free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
@@ -981,17 +980,26 @@ static long sub_steps(const cf_world *sim, double dt, double *h)
     return n_sub;
 }
 
+/* The contact stages' view of the world (contact.h). */
+static cf_contact_ctx contact_ctx(cf_world *sim)
+{
+    return (cf_contact_ctx){sim->frag, sim->contact.v, sim->n_frag, &sim->solid, sim->bullet};
+}
+
 static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, cf_error *err)
 {
     const cf_solver_settings *set = &sim->def.solver;
     sim->h_fracture = h;
     int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
-    int bodies = cf_body_contact_needed(sim);
+    if (cf_contact_caches_reserve(&sim->contact, n))
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
+    cf_contact_ctx cx = contact_ctx(sim);
+    int bodies = cf_body_contact_needed(&cx);
     for (int fi = 0; fi < n; fi++) {
-        cf_fragment *f = &sim->frag[fi];
-        if (f->mode == CF_MODE_FRACTURE &&
-            ((!boxed++ && cf_body_boxes(sim, &sim->body_boxes)) ||
-             cf_hull_set_gather(sim, fi, contact_pad(sim, fi, dt), sim->body_boxes, &f->near)))
+        if (sim->frag[fi].mode == CF_MODE_FRACTURE &&
+            ((!boxed++ && cf_body_boxes(&cx, &sim->body_boxes)) ||
+             cf_hull_set_gather(&cx, fi, contact_pad(sim, fi, dt), sim->body_boxes,
+                                &sim->contact.v[fi].near)))
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
     }
     for (long k = 0; k < n_sub; k++) {
@@ -1005,7 +1013,8 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
         }
         if (bodies) {
             double removed, t0 = cf_wall_time();
-            if (cf_body_contact(sim, h, &removed))
+            cx = contact_ctx(sim);
+            if (cf_body_contact(&cx, h, &removed))
                 return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
                                     cff_last_error());
             sim->flow.contact += removed;
@@ -1019,10 +1028,12 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         double gained;
-        if (cf_node_impulses_flush(sim, &f->push, f->nodes.v, &gained))
+        cf_contact_cache *cc = &sim->contact.v[fi];
+        cx = contact_ctx(sim);
+        if (cf_node_impulses_flush(&cx, &cc->push, f->nodes.v, &gained))
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory pushing rigid fragments");
         sim->flow.contact -= gained;
-        f->near.n = 0;
+        cc->near.n = 0;
         char what[160];
         if (!nodes_sane(&sim->solid, f)) {
             snprintf(what, sizeof what,
@@ -1355,8 +1366,8 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
     m->bullet = b > sim->bullet_base ? b - sim->bullet_base : 0;
     for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
         m->collision += cff_mesh_bytes(sim->obs.mesh[j]);
-    for (int i = 0; i < sim->n_frag; i++) {
-        const cf_frag_surface *fs = &sim->frag[i].surface;
+    for (int i = 0; i < sim->contact.cap; i++) {
+        const cf_frag_surface *fs = &sim->contact.v[i].surface;
         m->collision += cff_mesh_bytes(fs->mesh) +
                         (unsigned long long)fs->nv * (I + 3 * D) + 3ull * fs->ntri * I;
     }

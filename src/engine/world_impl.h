@@ -1,5 +1,7 @@
-/* The simulation state shared by the driver (sim.c), the solver step
- * (fracture.c) and the mode hand-offs (handoff.c). */
+/* The world record: what the step (world.c) owns and the stages that take
+ * the whole world read, the solver step (fracture.h) and the mode
+ * hand-offs (handoff.h).  Data only: the functions are in those headers,
+ * so that this one includes no stage above it. */
 #ifndef COHFRAC_SIM_PRIVATE_H
 #define COHFRAC_SIM_PRIVATE_H
 
@@ -15,16 +17,6 @@
 #include "pbd.h"
 #include "solid.h"
 
-/* Convex decomposition settings (docs/physics.md §9): split until the hulls exceed
- * the tet volume by at most this fraction, into at most this many hulls (and
- * at most one per CF_HULL_TETS_PER_HULL tets of the fragment), cutting no
- * cell of fewer than twice CF_HULL_MIN_TETS tets. */
-#define CF_HULL_MAX_ERROR 0.05
-#define CF_HULL_MAX_COUNT 64
-#define CF_HULL_MIN_TETS 4
-#define CF_HULL_TETS_PER_HULL 2
-
-
 typedef struct cf_profile {
     double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s of wall time */
 } cf_profile;
@@ -37,6 +29,7 @@ struct cf_world {
     cf_obstacles obs;
     cf_fragment *frag;
     int n_frag, cap_frag;
+    cf_contact_caches contact; /* the fragments' contact caches, by fragment */
     cfb_world *bullet;       /* NULL for the pbd rigid backend */
     double t;                /* s */
     cf_world_tick_fn tick;   /* heartbeat inside a step (cf_world_set_tick), or NULL */
@@ -72,54 +65,5 @@ struct cf_world {
     cf_event *ev;            /* events since the caller last drained them */
     int n_ev, cap_ev;
 };
-
-/* One step of the in-house solver on fragment f (source Table 6.2): with
- * `fracture` set, stresses every check_interval steps, cohesive insertion,
- * internal and cohesive forces; otherwise (pbd rigid mode) global damping
- * instead.  Then prediction, PBD bars + collision constraints, velocity
- * update, friction and restitution.  t: time at the start of the step (s).
- * Returns CF_OK or CF_ERR_NOMEM. */
-cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture);
-
-/* Whether rigid fragment fi (nodes in the in-house solver) would hit an
- * obstacle during the next step of length dt faster than the impact
- * threshold (normal approach speed). */
-int cf_pbd_impact(const cf_world *sim, int fi, double dt);
-
-/* The energy (J) of the penalty contact's springs (docs/physics.md §7.1)
- * under fragment f's nodes at their positions now (time sim->t, the
- * stiffness of the last fracture step): the part of a fracture-mode
- * fragment's e_strain beyond its tets'.  0 without the penalty contact. */
-double cf_fragment_spring_energy(const cf_world *sim, const cf_fragment *f);
-
-/* Rigid -> fracture: nodes from the Bullet state `st` (x = R X + c,
- * v = v + w x r), body removed.  Fills *rec with the hand-off's record (the
- * step makes it an event) and adds it to the run's totals. */
-cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_handoff_record *rec,
-                                 cf_error *err);
-
-/* Fracture -> rigid: split fragment fi into its connected components; each
- * becomes a rigid fragment (a Bullet body with momentum-preserving
- * velocities, or a pbd rigid fragment).  Fills *rec with the hand-off's
- * record (momentum error, handoff_loss) and adds it to the run's totals. */
-cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_error *err);
-
-/* Fracture-only runs: split fracture-mode fragment fi into its connected
- * components, each a new fracture-mode fragment (its tets, nodes, bars and
- * cohesive elements; the ledger's kinetic energy, strain energy and mass
- * moment carried over node by node, so the ledger does not jump).  Sets
- * *first to the first new fragment and returns the number made (0: fi is
- * one piece and stays), or -1 when out of memory. */
-int cf_fragment_split_fracture(cf_world *sim, int fi, int *first);
-
-/* Add a Bullet body for rigid fragment fi with COM pos, rotation R (rest ->
- * current), velocity v and angular velocity w. */
-cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const double R[9],
-                               const double v[3], const double w[3], cf_error *err);
-
-/* A rigid step is re-run at most this many times for fragments that go to
- * fracture mode during it. */
-#define CF_MAX_RESTEPS 4
-
 
 #endif
