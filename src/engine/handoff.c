@@ -104,9 +104,9 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
 
 /* The record of a hand-off of fragment fi: momenta before (P0, L0) and
  * after (P1, L1); the run's totals too. */
-static cf_status record_handoff(cf_world *sim, int fi, int direction, const double P0[3],
-                                const double L0[3], const double P1[3], const double L1[3],
-                                double loss, cf_handoff_record *r)
+static void record_handoff(cf_world *sim, int fi, int direction, const double P0[3],
+                           const double L0[3], const double P1[3], const double L1[3], double loss,
+                           cf_handoff_record *r)
 {
     *r = (cf_handoff_record){sim->t, fi, direction, 0, {0}, {0}, loss};
     v3_sub(P1, P0, r->momentum_change);
@@ -117,7 +117,6 @@ static cf_status record_handoff(cf_world *sim, int fi, int direction, const doub
     if (r->momentum_error > sim->max_momentum_error)
         sim->max_momentum_error = r->momentum_error;
     sim->total_handoff_loss += loss;
-    return CF_OK;
 }
 
 /* Fragment's cohesive elements: those whose two tets both belong to it. */
@@ -321,7 +320,8 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
     cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P1, L1);
-    return record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, rec);
+    record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, rec);
+    return CF_OK;
 }
 
 /* The tets grouped by component, in list order within each: component c
@@ -562,5 +562,6 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
     double loss = before.ke - ke_after;
     if (sim->bullet) /* the pbd rigid backend keeps the nodes' velocities: damping removes it */
         sim->flow.handoff += loss;
-    return record_handoff(sim, fi, 1, P0, L0, P1, L1, loss, rec);
+    record_handoff(sim, fi, 1, P0, L0, P1, L1, loss, rec);
+    return CF_OK;
 }

@@ -357,6 +357,14 @@ static cf_status handoff_event(cf_world *sim, const cf_handoff_record *r, cf_err
     return push_event(sim, &e, err);
 }
 
+/* Fragment fi to fracture mode (cf_handoff_to_fracture), and its event. */
+static cf_status to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err)
+{
+    cf_handoff_record r;
+    cf_status rc = cf_handoff_to_fracture(sim, fi, st, &r, err);
+    return rc == CF_OK ? handoff_event(sim, &r, err) : rc;
+}
+
 /* Fragments first .. n_frag - 1 were born. */
 static cf_status fragments_born(cf_world *sim, int first, cf_error *err)
 {
@@ -873,11 +881,8 @@ static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
             if (f->mode != CF_MODE_RIGID || f->body < 0 || !impact(sim, f))
                 continue;
             double th = cf_wall_time();
-            cf_handoff_record r;
-            st = cf_handoff_to_fracture(sim, fi, &pre[fi], &r, err);
+            st = to_fracture(sim, fi, &pre[fi], err);
             sim->prof.handoff += cf_wall_time() - th;
-            if (st == CF_OK)
-                st = handoff_event(sim, &r, err);
             hit++;
         }
         if (st != CF_OK || hit == 0 || pass == CF_MAX_RESTEPS)
@@ -923,10 +928,7 @@ static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
         if (sim->frag[fi].mode != CF_MODE_RIGID)
             continue;
         if (cf_pbd_impact(sim, fi, dt) && can_break(sim, &sim->frag[fi])) {
-            cf_handoff_record r;
-            cf_status st = cf_handoff_to_fracture(sim, fi, NULL, &r, err);
-            if (st == CF_OK)
-                st = handoff_event(sim, &r, err);
+            cf_status st = to_fracture(sim, fi, NULL, err);
             if (st != CF_OK)
                 return st;
             continue;
@@ -993,7 +995,9 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
     int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
     if (cf_contact_caches_reserve(&sim->contact, n))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
-    cf_contact_ctx cx = contact_ctx(sim);
+    /* No fragment is made before the splits after these steps, so neither
+     * table moves while cx points into them. */
+    const cf_contact_ctx cx = contact_ctx(sim);
     int bodies = cf_body_contact_needed(&cx);
     for (int fi = 0; fi < n; fi++) {
         if (sim->frag[fi].mode == CF_MODE_FRACTURE &&
@@ -1013,7 +1017,6 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
         }
         if (bodies) {
             double removed, t0 = cf_wall_time();
-            cx = contact_ctx(sim);
             if (cf_body_contact(&cx, h, &removed))
                 return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
                                     cff_last_error());
@@ -1029,7 +1032,6 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
             continue;
         double gained;
         cf_contact_cache *cc = &sim->contact.v[fi];
-        cx = contact_ctx(sim);
         if (cf_node_impulses_flush(&cx, &cc->push, f->nodes.v, &gained))
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory pushing rigid fragments");
         sim->flow.contact -= gained;
