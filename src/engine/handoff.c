@@ -288,7 +288,7 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     if (st)
         cf_body_momenta(f, st, P0, L0);
     else
-        cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P0, L0);
+        cf_fragment_momenta(f, &sim->solid, sim->bullet, P0, L0);
     /* Fracture mode starts from the rigid motion: from the Bullet body, or,
      * with the pbd backend, from its nodes' best rigid fit (shape matching)
      * and momenta, so that the bars start at rest length instead of
@@ -315,11 +315,11 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     f->separated = -1;
     f->steps = f->quiet = 0;
     f->t_enter = sim->t;
-    cf_fragment_ledger_reset(&sim->frag[fi], &sim->solid, &sim->flow);
+    cf_fragment_ledger_reset(f, &sim->solid, &sim->flow);
     f->e_enter = f->e_kin;
     if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
-    cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P1, L1);
+    cf_fragment_momenta(f, &sim->solid, sim->bullet, P1, L1);
     record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, rec);
     return CF_OK;
 }
@@ -418,7 +418,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
             break;
         }
         cf_fragment *g = &sim->frag[ci], *p = &sim->frag[fi]; /* the array may have moved */
-        cf_fragment_rest_props(&sim->frag[ci], &sim->solid);
+        cf_fragment_rest_props(g, &sim->solid);
         g->mode = CF_MODE_FRACTURE;
         g->steps = p->steps, g->quiet = p->quiet, g->t_enter = p->t_enter;
         g->e_enter = p->e_enter;
@@ -486,7 +486,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
     cf_node_state before;
     cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &before);
     double P0[3], L0[3], P1[3] = {0, 0, 0}, L1[3] = {0, 0, 0}, ke_after = 0;
-    cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P0, L0);
+    cf_fragment_momenta(f, &sim->solid, sim->bullet, P0, L0);
 
     /* One component: the fragment stays itself; several: children. */
     int first = fi;
@@ -516,7 +516,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
          * moments (a cube) got other axes from the round-off of the node
          * order, and its hulls were posed turned, deep in the ground. */
         if (k > 1)
-            cf_fragment_rest_props(&sim->frag[ci], &sim->solid);
+            cf_fragment_rest_props(g, &sim->solid);
         g->mode = CF_MODE_RIGID;
         memcpy(g->q_match, sim->frag[fi].q_match, sizeof g->q_match);
         cf_node_state ns;
@@ -537,7 +537,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory at hand-off");
             }
             g->steps = 0;
-            cf_fragment_ledger_reset(&sim->frag[ci], &sim->solid, &sim->flow);
+            cf_fragment_ledger_reset(g, &sim->solid, &sim->flow);
         }
     }
     /* Fragments of one initial body do not collide with each other in

@@ -283,8 +283,8 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
         int *tt = realloc(f->tets, (size_t)f->nt * sizeof(int));
         if (tt)
             f->tets = tt;
-        cf_fragment_rest_props(&sim->frag[fi], &sim->solid);
-        cf_fragment_ledger_reset(&sim->frag[fi], &sim->solid, &sim->flow);
+        cf_fragment_rest_props(f, &sim->solid);
+        cf_fragment_ledger_reset(f, &sim->solid, &sim->flow);
         if (fracture) {
             f->mode = CF_MODE_FRACTURE;
             f->t_enter = 0;
@@ -637,7 +637,7 @@ static void ledger(const cf_world *sim, cf_ledger *l, int momenta)
             l->strain += f->e_strain;
             v3_axpy(1.0, f->mx, l->mass_moment);
             if (momenta)
-                cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P, L);
+                cf_fragment_momenta(f, &sim->solid, sim->bullet, P, L);
         }
         v3_axpy(1.0, P, l->momentum);
         v3_axpy(1.0, L, l->angular_momentum);
@@ -678,7 +678,7 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
             o->mode = f->mode, o->n_tets = f->nt, o->mass = f->mass;
             memcpy(o->principal, f->principal, sizeof o->principal);
             memcpy(o->axes, f->Q, sizeof o->axes);
-            cf_fragment_pose_peek(&sim->frag[fi], &sim->solid, sim->bullet, o->com, R, o->v, o->w);
+            cf_fragment_pose_peek(f, &sim->solid, sim->bullet, o->com, R, o->v, o->w);
             mat_to_quat(R, o->quat);
             for (int k = 0; k < 3; k++)
                 o->momentum[k] = f->mass * o->v[k];
@@ -707,7 +707,7 @@ double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
         return 0;
     const cf_fragment *f = &sim->frag[id];
     double com[3], R[9], v[3], w[3], Rd[3], best = -INFINITY;
-    cf_fragment_pose_peek(&sim->frag[id], &sim->solid, sim->bullet, com, R, v, w);
+    cf_fragment_pose_peek(f, &sim->solid, sim->bullet, com, R, v, w);
     m3_tmulv(R, d, Rd); /* (R r).d = r.(R^T d), r from the rest centre of mass */
     for (int i = 0; i < f->nodes.n; i++) {
         double r[3];
@@ -743,7 +743,7 @@ int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
     const cf_fragment *f = &sim->frag[fi];
     double com[3], R[9], v[3], w[3];
     if (f->body >= 0) /* rigid in Bullet: the nodes are not moved, the pose is */
-        cf_fragment_pose_peek(&sim->frag[fi], &sim->solid, sim->bullet, com, R, v, w);
+        cf_fragment_pose_peek(f, &sim->solid, sim->bullet, com, R, v, w);
     for (int j = 0; j < 4; j++) {
         int a = s->tet[4 * st + j];
         if (f->body < 0) {
@@ -1130,7 +1130,7 @@ static int impact_unfinished(cf_world *sim, int fi)
     if (!touching)
         return 0;
     double Lo[3]; /* the spin's angular momentum, about the centre of mass */
-    cf_fragment_momenta(&sim->frag[fi], &sim->solid, sim->bullet, P, L);
+    cf_fragment_momenta(f, &sim->solid, sim->bullet, P, L);
     v3_cross(com, P, r);
     v3_sub(L, r, Lo);
     double rigid = 0.5 * f->mass * v3_dot(v, v) + 0.5 * v3_dot(w, Lo);
