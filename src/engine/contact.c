@@ -128,7 +128,8 @@ int cf_body_boxes(const cf_contact_ctx *ctx, double **boxes)
     return 0;
 }
 
-int cf_hull_set_gather(const cf_contact_ctx *ctx, int fi, double pad, const double *boxes, cf_hull_set *hs)
+int cf_hull_set_gather(const cf_contact_ctx *ctx, int fi, double pad, const double *boxes,
+                       cf_hull_set *hs)
 {
     const cf_fragment *f = &ctx->frag[fi];
     const cf_solid *s = ctx->solid;
@@ -257,7 +258,8 @@ typedef struct {
     int hit;
 } push_sum;
 
-int cf_node_impulses_flush(const cf_contact_ctx *ctx, cf_node_impulses *ni, const int *nodes, double *energy)
+int cf_node_impulses_flush(const cf_contact_ctx *ctx, cf_node_impulses *ni, const int *nodes,
+                           double *energy)
 {
     int n = ctx->n_frag;
     /* Without the sums the pushes could not be bounded: an error, not

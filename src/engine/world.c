@@ -825,7 +825,8 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 static int can_break(const cf_world *sim, const cf_fragment *f)
 {
     const cf_solid *s = &sim->solid;
-    if (sim->def.solver.criterion == CF_CRITERION_NONE || cf_fragment_is_debris(f, &sim->def.solver))
+    const cf_solver_settings *set = &sim->def.solver;
+    if (set->criterion == CF_CRITERION_NONE || cf_fragment_is_debris(f, set))
         return 0;
     for (int i = 0; i < f->nt; i++)
         for (int k = 0; k < 4; k++) {
