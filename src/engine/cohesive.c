@@ -3,6 +3,7 @@
 #include "cohesive.h"
 
 #include "linalg.h"
+#include "parallel.h"
 
 #include <string.h>
 
@@ -117,9 +118,10 @@ int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *para
                        const int *elems, int n, double dt, double kp, cf_pair_force *pairs)
 {
     int n_failed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : n_failed) if (n >= CF_COHESIVE_PARALLEL_MIN)
-    for (int e = 0; e < n; e++)
-        n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, &pairs[3 * e]);
+    CF_PARALLEL(n >= CF_COHESIVE_PARALLEL_MIN,
+                "omp parallel for schedule(static) reduction(+ : n_failed)",
+        for (int e = 0; e < n; e++)
+            n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, &pairs[3 * e]););
     /* Elements share nodes: the sums in list and pair order, on one thread. */
     for (int j = 0; j < 3 * n; j++)
         if (pairs[j].a >= 0) {

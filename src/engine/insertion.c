@@ -1,6 +1,7 @@
 #include "insertion.h"
 
 #include "linalg.h"
+#include "parallel.h"
 #include "tet4.h"
 
 #include <stdlib.h>
@@ -156,9 +157,9 @@ enum { STAR_PARALLEL_MIN = 256 };
  * facets, from fewer stars. */
 static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowest)
 {
-#pragma omp parallel for schedule(static) if (marked->n >= STAR_PARALLEL_MIN)
-    for (int i = 0; i < marked->n; i++)
-        s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], frag, lowest);
+    CF_PARALLEL(marked->n >= STAR_PARALLEL_MIN, "omp parallel for schedule(static)",
+        for (int i = 0; i < marked->n; i++)
+            s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], frag, lowest););
     int kept = 0;
     for (int i = 0; i < marked->n; i++) {
         int n = marked->v[i];
@@ -281,15 +282,16 @@ static int owns(const cf_solid *s, int t, int j)
 static int qualify_near_marks(cf_solid *s, const cf_int_list *marked, cf_criterion rule)
 {
     int count = 0;
-#pragma omp parallel for schedule(static) reduction(+ : count) if (marked->n >= STAR_PARALLEL_MIN)
-    for (int i = 0; i < marked->n; i++) {
-        int n = marked->v[i], o = s->origin[n];
-        for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
-            int slot = s->vt_slot[j], t = slot / 4;
-            if (s->tet[slot] == n && owns(s, t, slot % 4))
-                count += (s->qualify[t] = qualifying_faces(s, t, rule)) != 0;
-        }
-    }
+    CF_PARALLEL(marked->n >= STAR_PARALLEL_MIN,
+                "omp parallel for schedule(static) reduction(+ : count)",
+        for (int i = 0; i < marked->n; i++) {
+            int n = marked->v[i], o = s->origin[n];
+            for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
+                int slot = s->vt_slot[j], t = slot / 4;
+                if (s->tet[slot] == n && owns(s, t, slot % 4))
+                    count += (s->qualify[t] = qualifying_faces(s, t, rule)) != 0;
+            }
+        });
     return count;
 }
 
@@ -324,10 +326,11 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
     /* The nodes of hot tets, marked; `out` lists them until the faces are
      * tested.  The source's rule needs their nodal values. */
     int first = nt, last = -1, par = nt >= CF_TET4_PARALLEL_MIN;
-#pragma omp parallel for schedule(static) reduction(min : first) reduction(max : last) if (par)
-    for (int i = 0; i < nt; i++)
-        if (s->hot[tets[i]])
-            first = i < first ? i : first, last = i;
+    CF_PARALLEL(par,
+                "omp parallel for schedule(static) reduction(min : first) reduction(max : last)",
+        for (int i = 0; i < nt; i++)
+            if (s->hot[tets[i]])
+                first = i < first ? i : first, last = i;);
     if (mark_hot_nodes(s, tets, first, last, out))
         return -1;
     if (rule == CF_CRITERION_SOURCE) /* no facet threshold lies below the bound's s1 */
@@ -668,16 +671,16 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
     ranked *r = malloc((size_t)nc * sizeof *r);
     if (!r)
         return -1;
-#pragma omp parallel for schedule(dynamic, 64) if (nc >= STAR_PARALLEL_MIN)
-    for (int i = 0; i < nc; i++) {
-        int f = cand->v[i], o[3];
-        double c[3];
-        face_vertices(s, s->facet[4 * f], s->facet[4 * f + 1], o);
-        centroid(s, o, c);
-        int touch = crack_contact(s, f, o, c, g->t, g->front_speed) == CF_TOUCH;
-        r[i].facet = touch ? -1 : f;
-        r[i].ratio = touch ? 0 : facet_ratio(s, f, rule);
-    }
+    CF_PARALLEL(nc >= STAR_PARALLEL_MIN, "omp parallel for schedule(dynamic, 64)",
+        for (int i = 0; i < nc; i++) {
+            int f = cand->v[i], o[3];
+            double c[3];
+            face_vertices(s, s->facet[4 * f], s->facet[4 * f + 1], o);
+            centroid(s, o, c);
+            int touch = crack_contact(s, f, o, c, g->t, g->front_speed) == CF_TOUCH;
+            r[i].facet = touch ? -1 : f;
+            r[i].ratio = touch ? 0 : facet_ratio(s, f, rule);
+        });
     int nr = 0;
     for (int i = 0; i < nc; i++)
         if (r[i].facet >= 0)

@@ -3,6 +3,7 @@
 #include "insertion.h"
 #include "lanes.h"
 #include "linalg.h"
+#include "parallel.h"
 
 #include <omp.h>
 #include <stdint.h>
@@ -128,9 +129,9 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
      * is each thread's copy for the reduction, which starts at 0, so a
      * test of rc there cannot see an earlier failure. */
     if (rc == 0) {
-#pragma omp parallel for schedule(static) reduction(| : rc) if (big)
-        for (int i = 0; i < nn; i++)
-            rc |= fill_node(s, nodes[i], NULL, NULL, NULL, NULL, 0, &start[i + 1]);
+        CF_PARALLEL(big, "omp parallel for schedule(static) reduction(| : rc)",
+            for (int i = 0; i < nn; i++)
+                rc |= fill_node(s, nodes[i], NULL, NULL, NULL, NULL, 0, &start[i + 1]););
     }
     int n = 0;
     if (rc == 0) {
@@ -149,11 +150,11 @@ int cf_bars_build(cf_bars *b, const cf_solid *s, const int *tets, int nt)
     if (rc || !ends || !e2 || !rest || !r2 || !compliance || !c2 || !lambda || !col || !color_start)
         rc = -1;
     if (rc == 0) {
-#pragma omp parallel for schedule(static) reduction(| : rc) if (big)
-        for (int i = 0; i < nn; i++) {
-            int m;
-            rc |= fill_node(s, nodes[i], NULL, ends, rest, compliance, start[i], &m);
-        }
+        CF_PARALLEL(big, "omp parallel for schedule(static) reduction(| : rc)",
+            for (int i = 0; i < nn; i++) {
+                int m;
+                rc |= fill_node(s, nodes[i], NULL, ends, rest, compliance, start[i], &m);
+            });
     }
     int groups = rc ? -1 : colour(ends, n, s->n_nodes, col);
     if (groups < 0)
@@ -493,8 +494,7 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
  * then all wait.  The last group holds bars no colour could take: one
  * thread, one bar i at a time in order (ONE).  SWEEP_EACH: ONE for every
  * bar, colours included. */
-#define SWEEP(b, W, RUN, ONE)                                                                  \
-    _Pragma("omp parallel if ((b)->n >= CF_BARS_PARALLEL_MIN)")                                \
+#define SWEEP_BODY(b, W, RUN, ONE)                                                             \
     {                                                                                          \
         long nth_ = omp_get_num_threads(), me_ = omp_get_thread_num();                         \
         for (int c = 0; c < (b)->n_colors && c < CF_BARS_COLORS; c++) {                        \
@@ -510,25 +510,34 @@ CF_LANE_CLONES static void project_run(const cf_bars *b, cf_solid *s, double k, 
         for (int i = (b)->color_start[CF_BARS_COLORS]; i < (b)->n; i++)                        \
             ONE;                                                                               \
     }
+/* On the threads only when they can share the work (parallel.h). */
+#define SWEEP(b, W, RUN, ONE)                                                                  \
+    do {                                                                                       \
+        if ((b)->n >= CF_BARS_PARALLEL_MIN && omp_get_max_threads() > 1) {                     \
+            _Pragma("omp parallel") SWEEP_BODY(b, W, RUN, ONE)                                 \
+        } else {                                                                               \
+            SWEEP_BODY(b, W, RUN, ONE)                                                         \
+        }                                                                                      \
+    } while (0)
 #define SWEEP_EACH(b, ONE) SWEEP(b, 1, for (int i = i0; i < i1; i++) ONE, ONE)
 
 void cf_bars_project(const cf_bars *b, cf_solid *s, double k, const double *speed, double *cap)
 {
     if (b->n > 0)
         SWEEP(b, LANES, project_run(b, s, k, speed, cap, i0, i1),
-              project_one(b, s, k, speed, cap, i))
+              project_one(b, s, k, speed, cap, i));
 }
 
 void cf_bars_neighbour_speed(const cf_bars *b, const double *speed, double *cap)
 {
     if (b->n > 0)
-        SWEEP_EACH(b, neighbour_speed(b, speed, cap, i))
+        SWEEP_EACH(b, neighbour_speed(b, speed, cap, i));
 }
 
 void cf_bars_project_xpbd(cf_bars *b, cf_solid *s, double dt, double scale)
 {
     if (b->n > 0)
-        SWEEP_EACH(b, project_bar_xpbd(b, s, dt, scale, i))
+        SWEEP_EACH(b, project_bar_xpbd(b, s, dt, scale, i));
 }
 
 void cf_bars_reset_lambda(cf_bars *b)

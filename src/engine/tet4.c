@@ -3,6 +3,7 @@
 #include "chunks.h"
 #include "lanes.h"
 #include "linalg.h"
+#include "parallel.h"
 
 #include <omp.h>
 
@@ -340,9 +341,11 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
     /* Threads only for fragments large enough to repay the fork and join:
      * hundreds of few-tet fragments in fracture mode ran slower on 2
      * threads than on 1. */
-#pragma omp parallel for schedule(static) reduction(+ : inverted, hot) if (nt >= CF_TET4_PARALLEL_MIN)
-    for (int i0 = 0; i0 < nt; i0 += LANES)
-        tet_block(s, &tets[i0], nt - i0 < LANES ? nt - i0 : LANES, kind, check, &inverted, &hot);
+    CF_PARALLEL(nt >= CF_TET4_PARALLEL_MIN,
+                "omp parallel for schedule(static) reduction(+ : inverted, hot)",
+        for (int i0 = 0; i0 < nt; i0 += LANES)
+            tet_block(s, &tets[i0], nt - i0 < LANES ? nt - i0 : LANES, kind, check, &inverted,
+                      &hot););
     if (n_hot)
         *n_hot = hot;
     return inverted;
@@ -395,27 +398,27 @@ void cf_tet4_scatter(cf_solid *s, const int *tets, int nt, const int *nodes, int
      * thread, so it is the tet-order sum for any thread count.  With the
      * nodes and tets in space-filling-curve order (renumber.h) the owner
      * test is a long run of the same answer. */
-#pragma omp parallel if (nt >= CF_TET4_PARALLEL_MIN)
-    {
-        long span = (long)hi - lo + 1, nth = omp_get_num_threads(), me = omp_get_thread_num();
-        int a0 = lo + (int)(span * me / nth), a1 = lo + (int)(span * (me + 1) / nth);
-        for (int i = 0; i < nn; i++) {
-            int a = nodes[i];
-            if (a >= a0 && a < a1)
-                for (int k = 0; k < 3; k++)
-                    s->f[3 * a + k] = s->m[a] * g[k];
-        }
-        for (int i = 0; i < nt; i++) {
-            const int *tn = &s->tet[4 * tets[i]];
-            const double *tf = &s->tf[12 * tets[i]];
-            for (int j = 0; j < 4; j++) {
-                int a = tn[j];
+    CF_PARALLEL(nt >= CF_TET4_PARALLEL_MIN, "omp parallel",
+        {
+            long span = (long)hi - lo + 1, nth = omp_get_num_threads(), me = omp_get_thread_num();
+            int a0 = lo + (int)(span * me / nth), a1 = lo + (int)(span * (me + 1) / nth);
+            for (int i = 0; i < nn; i++) {
+                int a = nodes[i];
                 if (a >= a0 && a < a1)
                     for (int k = 0; k < 3; k++)
-                        s->f[3 * a + k] += tf[3 * j + k];
+                        s->f[3 * a + k] = s->m[a] * g[k];
             }
-        }
-    }
+            for (int i = 0; i < nt; i++) {
+                const int *tn = &s->tet[4 * tets[i]];
+                const double *tf = &s->tf[12 * tets[i]];
+                for (int j = 0; j < 4; j++) {
+                    int a = tn[j];
+                    if (a >= a0 && a < a1)
+                        for (int k = 0; k < 3; k++)
+                            s->f[3 * a + k] += tf[3 * j + k];
+                }
+            }
+        });
 }
 
 typedef struct {
