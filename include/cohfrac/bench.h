@@ -8,7 +8,8 @@
  * fracture mode only, so that cohesive insertion really happens under
  * criterion "source" or "traction".  Every repeat builds the scene anew and
  * times `steps` fracture steps after `warmup` untimed ones; stage times are
- * the run profile's (stress, insertion, forces, PBD).
+ * the run profile's (cf_stage: the solver's stages, elasticity to the
+ * velocity update).
  *
  * In the same run it measures the machine's memory bandwidth with a
  * STREAM-like triad a = b + s c over three arrays of CF_BENCH_TRIAD_MB MiB
@@ -29,6 +30,7 @@
 
 #include "cohfrac/error.h"
 #include "cohfrac/scene.h"
+#include "cohfrac/world.h"
 
 #define CF_BENCH_TRIAD_MB 256
 
@@ -48,7 +50,7 @@ typedef struct cf_bench_options {
  * per step (median), stage shares (median repeat), insertions per repeat. */
 typedef struct cf_bench_timing {
     double ms_min, ms_median, cpu_ms;
-    double stress, insertion, forces, pbd; /* ms per step, median repeat */
+    double stage[CF_STAGE_COUNT]; /* ms per step in each stage, median repeat */
     long insertions;
 } cf_bench_timing;
 

@@ -262,6 +262,40 @@ typedef struct cf_memory {
 
 void cf_world_memory(const cf_world *w, cf_memory *m);
 
+/* The stages of a step, in the order they first run (docs/architecture.md,
+ * "The step, stage by stage", has a section per stage: what it reads and
+ * writes).  Each stage is a function of the same name in the engine and a
+ * timer of the same name in the profile (cf_world_stats.stage,
+ * cf_step_stats.stage).  The timers take turns: each charges the wall time
+ * since the last one stopped, so no time is counted twice and the stages
+ * add up to the step.  A stage may run several times in a step (collision
+ * runs in every projection sweep); with the pbd rigid backend the rigid
+ * fragments' damped steps run the solver's stages too. */
+#define CF_STAGES(X)                                                                               \
+    X(RIGID_STEP, rigid_step)         /* Bullet steps the rigid fragments; impacts */              \
+    X(ELASTICITY, elasticity)         /* Tet4 forces, stress, strain energy */                     \
+    X(INSERTION_CHECK, insertion_check) /* facets that meet the criterion; the growth rule */      \
+    X(NODE_DUPLICATION, node_duplication) /* cohesive elements inserted, nodes split; crushing */  \
+    X(COHESIVE_FORCES, cohesive_forces) /* PPR tractions and crack-face contact forces */          \
+    X(COLLISION, collision)           /* obstacles, rigid bodies' hulls, other bodies, friction */ \
+    X(INTEGRATION, integration)       /* velocity kick, ledger's kinetic energy, prediction */     \
+    X(PBD_PROJECTION, pbd_projection) /* PBD/XPBD bars and crack-face constraints */               \
+    X(VELOCITY_UPDATE, velocity_update) /* v = (p - x)/dt, x = p, the speed cap */                 \
+    X(SPLIT, split)                   /* fracture-mode fragments that fell apart */                \
+    X(HANDOFF, handoff)               /* rigid <-> fracture mode */                                \
+    X(CONVEX_DECOMPOSITION, convex_decomposition) /* a new rigid fragment's hulls */              \
+    X(BOOKKEEPING, bookkeeping)       /* events, the guards, the caller's heartbeat */
+
+typedef enum {
+#define CF_STAGE_ENUM(id, name) CF_STAGE_##id,
+    CF_STAGES(CF_STAGE_ENUM)
+#undef CF_STAGE_ENUM
+    CF_STAGE_COUNT
+} cf_stage;
+
+/* The stage's name ("elasticity"), or "?" for a value out of range. */
+const char *cf_stage_name(cf_stage s);
+
 /* The fracture-mode step so far, for benchmarks: steps taken, wall time
  * per stage (s, as in the run summary), and the sizes of what the step
  * works on now (fracture-mode fragments only). */
@@ -269,7 +303,7 @@ typedef struct cf_step_stats {
     long fracture_steps;                   /* fracture-mode fragment steps since creation */
     long long tet_steps;                   /* tets stepped, summed over those steps */
     double fracture_time;                  /* s simulated with a fragment in fracture mode */
-    double stress, insertion, forces, pbd; /* s of wall time since creation */
+    double stage[CF_STAGE_COUNT];          /* s of wall time since creation (cf_stage) */
     int tets, nodes, bars, cohesive;       /* in fracture mode now */
     int iterations;                        /* constraint iterations per step */
     int check;                             /* 1: the insertion criterion is checked */
@@ -337,7 +371,7 @@ void cf_world_initial_bounds(const cf_world *w, cf_initial_bounds *out);
 
 /* Figures for a run summary: sizes, steps per mode, fragments, hand-offs,
  * the convex decomposition of the rigid fragments alive now, and the wall
- * time each stage of the step took since create (s). */
+ * time each stage of the step took since create (s, cf_stage). */
 typedef struct cf_world_stats {
     int tets, nodes_input, nodes;       /* nodes after duplication */
     double dt_fracture, dt_cfl, dt_outer;/* s */
@@ -355,7 +389,7 @@ typedef struct cf_world_stats {
     int rigid_with_hulls, hulls;        /* Bullet bodies alive with hulls, and the hulls */
     double hull_error_median, hull_error_worst; /* hull volume / tet volume - 1 (NaN:
                                                  * no memory to sort them) */
-    double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s */
+    double stage[CF_STAGE_COUNT];       /* s of wall time in each stage since create */
 } cf_world_stats;
 
 void cf_world_stats_get(const cf_world *w, cf_world_stats *out);

@@ -103,7 +103,7 @@ static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_crit
 }
 
 typedef struct sample {
-    double ms, cpu_ms, stress, insertion, forces, pbd; /* per step */
+    double ms, cpu_ms, stage[CF_STAGE_COUNT]; /* per step */
     long insertions;
     cf_step_stats stats;
     double memory; /* engine bytes */
@@ -129,10 +129,8 @@ static cf_status time_steps(const cf_bench_options *o, const cf_world_def *sc, i
         cf_world_step_stats(cf_sim_world(sim), &b);
         double n = (double)(b.fracture_steps - a.fracture_steps);
         out->ms = 1e3 * wall / n, out->cpu_ms = 1e3 * cpu / n;
-        out->stress = 1e3 * (b.stress - a.stress) / n;
-        out->insertion = 1e3 * (b.insertion - a.insertion) / n;
-        out->forces = 1e3 * (b.forces - a.forces) / n;
-        out->pbd = 1e3 * (b.pbd - a.pbd) / n;
+        for (int i = 0; i < CF_STAGE_COUNT; i++)
+            out->stage[i] = 1e3 * (b.stage[i] - a.stage[i]) / n;
         out->insertions = b.cohesive - a.cohesive;
         out->stats = b;
         cf_memory m;
@@ -190,15 +188,21 @@ static void summarize(sample *s, int n, cf_bench_timing *t)
     for (int i = 0; i < n; i++)
         v[i] = s[i].cpu_ms;
     t->cpu_ms = median(v, n);
-    t->stress = s[mid].stress, t->insertion = s[mid].insertion;
-    t->forces = s[mid].forces, t->pbd = s[mid].pbd, t->insertions = s[mid].insertions;
+    memcpy(t->stage, s[mid].stage, sizeof t->stage);
+    t->insertions = s[mid].insertions;
 }
+
+/* The solver's stages, the bench's columns (cohfrac/world.h). */
+#define FIRST_STAGE CF_STAGE_ELASTICITY
+#define LAST_STAGE CF_STAGE_VELOCITY_UPDATE
 
 static void print_row(FILE *f, const char *what, const cf_bench_timing *t, int tets)
 {
-    fprintf(f, "  %-10s %8.2f %9.2f %8.2f %9.1f %8.2f %9.2f %7.2f %7.2f %10ld\n", what, t->ms_min,
-            t->ms_median, t->cpu_ms, 1e6 * t->ms_min / tets, t->stress, t->insertion, t->forces,
-            t->pbd, t->insertions);
+    fprintf(f, "  %-10s %8.2f %9.2f %8.2f %9.1f", what, t->ms_min, t->ms_median, t->cpu_ms,
+            1e6 * t->ms_min / tets);
+    for (int i = FIRST_STAGE; i <= LAST_STAGE; i++)
+        fprintf(f, " %*.2f", (int)strlen(cf_stage_name((cf_stage)i)), t->stage[i]);
+    fprintf(f, " %10ld\n", t->insertions);
 }
 
 cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *err)
@@ -269,11 +273,14 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
                 "solid: %d tets, %d nodes, %d bars (%d colours, %d bars on one thread) in fracture "
                 "mode at the end; engine memory %.0f B per tet\n"
                 "traffic model: %.1f MB per step -> floor %.3f ms at %.1f GB/s (docs/performance.md)\n"
-                "  %-10s %8s %9s %8s %9s %8s %9s %7s %7s %10s\n",
+                "  %-10s %8s %9s %8s %9s",
                 CF_BENCH_TRIAD_MB, r->bw_1t / 1e9, nt, r->bw_nt / 1e9, r->tets, r->nodes, r->bars,
                 r->colours, r->serial_bars, r->memory_per_tet,
                 r->bytes / 1e6, r->floor_ms, r->bw_nt / 1e9, "threads", "min ms", "median ms",
-                "CPU ms", "ns/tet", "stress", "insertion", "forces", "PBD", "insertions");
+                "CPU ms", "ns/tet");
+        for (int i = FIRST_STAGE; i <= LAST_STAGE; i++)
+            fprintf(log, " %s", cf_stage_name((cf_stage)i));
+        fprintf(log, " %10s\n", "insertions");
         char what[32];
         print_row(log, "1", &r->t1, r->tets);
         snprintf(what, sizeof what, "%d", nt);

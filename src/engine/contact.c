@@ -111,12 +111,8 @@ static int add_hulls(const cf_contact_ctx *ctx, int g, cf_hull_set *hs)
     return 0;
 }
 
-int cf_body_boxes(const cf_contact_ctx *ctx, double **boxes)
+void cf_body_boxes(const cf_contact_ctx *ctx, double *b)
 {
-    double *b = realloc(*boxes, (size_t)(ctx->n_frag > 0 ? ctx->n_frag : 1) * 6 * sizeof(double));
-    if (!b)
-        return -1;
-    *boxes = b;
     for (int g = 0; g < ctx->n_frag; g++) {
         const cf_fragment *o = &ctx->frag[g];
         double *lo = &b[6 * g], *hi = lo + 3;
@@ -125,7 +121,6 @@ int cf_body_boxes(const cf_contact_ctx *ctx, double **boxes)
             for (int d = 0; d < 3; d++)
                 lo[d] = INFINITY, hi[d] = -INFINITY; /* overlaps nothing */
     }
-    return 0;
 }
 
 int cf_hull_set_gather(const cf_contact_ctx *ctx, int fi, double pad, const double *boxes,
@@ -264,9 +259,11 @@ int cf_node_impulses_flush(const cf_contact_ctx *ctx, cf_node_impulses *ni, cons
     int n = ctx->n_frag;
     /* Without the sums the pushes could not be bounded: an error, not
      * unbounded impulses. */
-    push_sum *sum = calloc((size_t)n + 1, sizeof *sum);
+    size_t mark = cf_arena_mark(ctx->arena);
+    push_sum *sum = cf_arena_take(ctx->arena, ((size_t)n + 1) * sizeof *sum);
     if (!sum)
         return -1;
+    memset(sum, 0, ((size_t)n + 1) * sizeof *sum);
     double gained = 0, bounce = 1.0 + ctx->solid->mat.restitution;
     for (int i = 0; i < ni->n; i++) {
         int g = ni->frag[i];
@@ -330,7 +327,7 @@ int cf_node_impulses_flush(const cf_contact_ctx *ctx, cf_node_impulses *ni, cons
         cfb_get_state(ctx->bullet, o->body, &st); /* as Bullet holds it */
         gained += cf_body_kinetic_energy(o, &st);
     }
-    free(sum);
+    cf_arena_release(ctx->arena, mark);
     *energy = gained;
     return 0;
 }

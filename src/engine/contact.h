@@ -10,6 +10,7 @@
 #ifndef COHFRAC_CONTACT_H
 #define COHFRAC_CONTACT_H
 
+#include "arena.h"
 #include "fragment.h"
 
 typedef struct cff_mesh cff_mesh;
@@ -92,12 +93,13 @@ typedef struct cf_contact_ctx {
     int n_frag;
     cf_solid *solid;
     cfb_world *bullet;
+    cf_arena *arena;         /* the step's scratch (arena.h) */
 } cf_contact_ctx;
 
 /* The world box of every fragment's Bullet body, once per rigid step:
- * (*boxes)[n_frag][6] = lo, hi (m); an empty box for fragments without a
- * rigid body.  Grows *boxes as needed.  Returns 0, or -1 out of memory. */
-int cf_body_boxes(const cf_contact_ctx *c, double **boxes);
+ * boxes[n_frag][6] = lo, hi (m); an empty box for fragments without a
+ * rigid body. */
+void cf_body_boxes(const cf_contact_ctx *c, double *boxes);
 
 /* Hulls of every rigid Bullet fragment whose box (from cf_body_boxes)
  * overlaps fragment fi's node box grown by `pad` m.  Returns 0, or -1 out

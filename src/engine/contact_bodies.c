@@ -260,10 +260,11 @@ int cf_body_contact(const cf_contact_ctx *ctx, double h, double *removed)
 {
     *removed = 0;
     int n = ctx->n_frag;
-    double *box = malloc((size_t)n * 6 * sizeof(double));
-    int *root = malloc((size_t)n * sizeof(int));
+    size_t mark = cf_arena_mark(ctx->arena);
+    double *box = cf_arena_take(ctx->arena, (size_t)n * 6 * sizeof(double));
+    int *root = cf_arena_take(ctx->arena, (size_t)n * sizeof(int));
     if (!box || !root) {
-        free(box), free(root);
+        cf_arena_release(ctx->arena, mark);
         return -1;
     }
     for (int fi = 0; fi < n; fi++)
@@ -288,6 +289,6 @@ int cf_body_contact(const cf_contact_ctx *ctx, double h, double *removed)
     }
     *removed = -moved_work(&mv, ctx->solid);
     moved_free(&mv);
-    free(box), free(root);
+    cf_arena_release(ctx->arena, mark);
     return rc ? -1 : 0;
 }

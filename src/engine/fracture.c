@@ -3,6 +3,7 @@
 
 #include "chunks.h"
 #include "linalg.h"
+#include "parallel.h"
 #include "tet4.h"
 
 #include <stdlib.h>
@@ -142,22 +143,31 @@ static int crush(cf_world *sim, cf_fragment *f, double t, double dt)
     return crushed;
 }
 
-/* Extrinsic insertion at this check (time t, s) on the facets that qualify
- * and that the growth rule takes (cf_insertion_select). */
-static cf_status check_and_insert(cf_world *sim, cf_fragment *f, double t, double dt, int n_hot,
-                                  int *inserted)
+/* Stage insertion_check (source Table 6.2, docs/physics.md §5.1): the
+ * facets that meet the criterion at this check (time t, s; n_hot tets
+ * above the criterion's bound), then those the growth rule takes, in
+ * sim->cand.  Returns how many, or -1 out of memory. */
+static int insertion_check(cf_world *sim, const cf_fragment *f, double t, int n_hot)
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
-    double t0 = cf_wall_time();
     int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, &sim->cand);
     double d = set->min_piece_size; /* a sphere of diameter d */
     cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets,
                         0.5235987755982988 * d * d * d /* pi d^3 / 6 */, t};
     if (nc > 0)
         nc = cf_insertion_select(s, &sim->cand, set->criterion, &growth);
-    if (nc < 0)
-        return CF_ERR_NOMEM;
+    return nc;
+}
+
+/* Stage node_duplication (docs/physics.md §5): extrinsic insertion of a
+ * cohesive element on each of the nc facets insertion_check chose, with
+ * the node duplication that opens them; crushing (crush); the bars of the
+ * nodes whose star changed.  *inserted: elements plus crushed tets. */
+static cf_status node_duplication(cf_world *sim, cf_fragment *f, double t, double dt, int nc,
+                                  int *inserted)
+{
+    cf_solid *s = &sim->solid;
     sim->touched.n = 0;
     for (int i = 0; i < nc; i++)
         if (cf_crack_facet(s, sim->cand.v[i], &f->nodes, &sim->touched) ||
@@ -169,10 +179,8 @@ static cf_status check_and_insert(cf_world *sim, cf_fragment *f, double t, doubl
     if (cf_bars_patch(&f->bars, s, sim->touched.v, sim->touched.n, &sim->bar_scratch))
         return CF_ERR_NOMEM;
     *inserted = nc + crushed;
-    sim->prof.insertion += cf_wall_time() - t0;
     return CF_OK;
 }
-
 
 /* Energy a velocity change takes out of node i, J: from `from` to `to`.
  * The ledger's kinetic energy is the leapfrog product 1/2 m v_old . v
@@ -287,10 +295,11 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
     }
 }
 
-/* Friction and restitution (contact_chunk), after each node's velocity is
+/* Stage collision, after the velocity update: friction and restitution
+ * (contact_chunk), after each node's velocity is
  * shifted by dv (the speed cap's momentum, from project; zero: none); the
  * shift's energy is booked with the projection's. */
-static double contact_velocities(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog,
+static double collision_friction(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog,
                                  int penalty, const double dv[3])
 {
     step_sums c = {sim, f, t, dt, {dv[0], dv[1], dv[2]}, leapfrog, penalty};
@@ -365,56 +374,51 @@ static void penalty_chunk(void *ctx, int i0, int i1, double *acc)
     }
 }
 
-/* f = f_ext - f_int + f_coh at x_n; strain energy and inverted tets. */
-static cf_status forces(cf_world *sim, cf_fragment *f, double t, double dt, int fracture)
+/* Stage elasticity, its first part: the Tet4 kernel on every tet of f at
+ * x_n (corotational or Neo-Hookean forces per tet, rotation, inverted
+ * tets; the stress too when `check`), and the strain energy.  Returns how
+ * many tets are above the criterion's bound (cf_tet4_forces). */
+static int elasticity(cf_world *sim, cf_fragment *f, int check)
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
-    const double *g = sim->def.gravity;
-    double t0 = cf_wall_time();
-    f->e_strain = 0;
-    if (fracture) {
-        /* Stresses only when the criterion is checked at this step. */
-        int check = set->criterion != CF_CRITERION_NONE && (f->steps % set->check_interval) == 0;
-        cf_stress_check bound = cf_insertion_bound(s, set->criterion);
-        int n_hot = 0;
-        f->n_inverted = cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check ? &bound : NULL,
-                                       &n_hot);
-        f->e_strain = cf_tet4_strain_energy(s, f->tets, f->nt);
-        sim->prof.stress += cf_wall_time() - t0;
-        int inserted = 0;
-        if (check) {
-            cf_status st = check_and_insert(sim, f, t, dt, n_hot, &inserted);
-            if (st != CF_OK)
-                return st;
-        }
-        f->quiet = inserted ? 0 : f->quiet + 1;
-        t0 = cf_wall_time();
-    }
-    if (ensure_scratch(sim, f))
-        return CF_ERR_NOMEM;
-    if (fracture) {
-        cf_tet4_scatter(s, f->tets, f->nt, f->nodes.v, f->nodes.n, g);
-        /* With PBD the crack faces are kept apart by the constraint in the
-         * projection; the penalty is for explicit runs. */
-        double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;
-        cf_cohesive_forces(s, sim->law, sim->law_params, f->coh.v, f->coh.n, dt, kp, f->pairs);
-        if (penalty_step(set, fracture)) {
-            step_sums c = {sim, f, t, dt, {0, 0, 0}, 1, 1};
-            double e[2]; /* the springs' energy; moving obstacles' work */
-            cf_sum_chunks(f->nodes.n, 2, !mesh_obstacles(sim), penalty_chunk, &c, e);
-            f->e_strain += e[0];
-            f->pending.obstacles += e[1];
-        }
-    } else {
-        for (int i = 0; i < f->nodes.n; i++) {
-            int a = f->nodes.v[i];
-            for (int k = 0; k < 3; k++)
-                s->f[3 * a + k] = s->m[a] * g[k];
-        }
-    }
-    sim->prof.forces += cf_wall_time() - t0;
-    return CF_OK;
+    cf_stress_check bound = cf_insertion_bound(s, set->criterion);
+    int n_hot = 0;
+    f->n_inverted = cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check ? &bound : NULL,
+                                   &n_hot);
+    f->e_strain = cf_tet4_strain_energy(s, f->tets, f->nt);
+    return n_hot;
+}
+
+/* Stage elasticity, its second part: the tets' forces gathered at the
+ * nodes, with gravity: f = m g - f_int. */
+static void elasticity_scatter(cf_world *sim, cf_fragment *f)
+{
+    cf_tet4_scatter(&sim->solid, f->tets, f->nt, f->nodes.v, f->nodes.n, sim->def.gravity);
+}
+
+/* Stage cohesive_forces (docs/physics.md §6): the PPR tractions of f's
+ * cohesive elements and, in explicit runs, the crack faces' compression
+ * penalty, added to the node forces (with PBD the faces are kept apart by
+ * a constraint in pbd_projection instead). */
+static void cohesive_forces(cf_world *sim, cf_fragment *f, double dt)
+{
+    const cf_solver_settings *set = &sim->def.solver;
+    double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;
+    cf_cohesive_forces(&sim->solid, sim->law, sim->law_params, f->coh.v, f->coh.n, dt, kp,
+                       f->pairs);
+}
+
+/* Stage collision, as a force (explicit runs with the penalty contact,
+ * docs/physics.md §7.1): penalty_chunk on every node; the springs' energy
+ * goes with the strain energy. */
+static void collision_forces(cf_world *sim, cf_fragment *f, double t, double dt)
+{
+    step_sums c = {sim, f, t, dt, {0, 0, 0}, 1, 1};
+    double e[2]; /* the springs' energy; moving obstacles' work */
+    cf_sum_chunks(f->nodes.n, 2, !mesh_obstacles(sim), penalty_chunk, &c, e);
+    f->e_strain += e[0];
+    f->pending.obstacles += e[1];
 }
 
 /* The ledger's kinetic energy, the leapfrog product 1/2 m v_old . v, and
@@ -563,103 +567,139 @@ static void term_chunk(void *ctx, int i0, int i1, double *acc)
         acc[0] += c->f->term[i];
 }
 
-/* Prediction p = x + dt v, then the constraint projection: bars (PBD or
- * XPBD), crack-face contact, obstacles, the n_bc prescribed nodes.  dv
- * receives the velocity every node must gain to give back the momentum the
- * speed cap took (zero when it took none): contact_velocities adds it in
- * its pass over the nodes. */
-static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int fracture,
-                    int n_bc, double dv[3])
+/* Stage integration: v <- v + dt M^-1 f with the prescribed velocities
+ * and global damping (update_velocities), then the prediction
+ * p = x + dt v that the projection moves.  Clears the contact records
+ * (unless the penalty force made them) and, with bars, notes each node's
+ * predicted speed for the cap in velocity_update.  Returns the number of
+ * prescribed nodes. */
+static int integration(cf_world *sim, cf_fragment *f, double dt, int fracture)
+{
+    cf_solid *s = &sim->solid;
+    const cf_solver_settings *set = &sim->def.solver;
+    int n_bc = update_velocities(sim, f, dt, fracture);
+    const int *nodes = f->nodes.v;
+    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
+    int bars = !explicit_step(set, fracture), penalty = penalty_step(set, fracture);
+    CF_PARALLEL(par, "omp parallel for schedule(static)",
+        for (int i = 0; i < nn; i++) {
+            int a = nodes[i];
+            for (int k = 0; k < 3; k++)
+                s->p[4 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
+            s->p[4 * a + 3] = 1.0 / s->m[a];
+            if (!penalty) { /* the penalty force recorded its contacts (penalty_chunk) */
+                f->contact[i] = -1;
+                f->vn_pre[i] = 0;
+            }
+            if (bars) /* the predicted speed, for the cap (v stays until then) */
+                s->vcap[a] = s->speed[a] = v3_norm(&s->v[3 * a]);
+        });
+    return n_bc;
+}
+
+/* Stage pbd_projection, one sweep: the bars (PBD, or XPBD in fracture
+ * mode) and the crack faces' contact constraint.  *caps: whether the
+ * neighbours' speeds for the cap were taken (in the first PBD sweep). */
+static void pbd_projection(cf_world *sim, cf_fragment *f, double dt, int fracture, int *caps)
+{
+    cf_solid *s = &sim->solid;
+    const cf_solver_settings *set = &sim->def.solver;
+    if (set->constraints == CF_CONSTRAINTS_XPBD && fracture) {
+        cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
+    } else {
+        double k = cf_pbd_effective_stiffness(set->k_stiffness, set->iterations,
+                                              set->iteration_independent);
+        cf_bars_project(&f->bars, s, k, *caps ? NULL : s->speed, *caps ? NULL : s->vcap);
+        *caps = 1;
+    }
+    if (fracture)
+        cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
+}
+
+/* Stage collision, one sweep of the projection: obstacles and rigid
+ * neighbours' hulls node by node, each writing its own p (obstacle_chunk).
+ * Returns the moving obstacles' work, J. */
+static double collision_sweep(cf_world *sim, cf_fragment *f, double t_next, double dt,
+                              int penalty)
+{
+    int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
+    /* On the threads unless hull pushes of rigid neighbours (one list) or
+     * FCL queries need one thread. */
+    int obstacles_par = par && cache_of(sim, f)->near.n == 0 && !mesh_obstacles(sim);
+    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}, 0, penalty};
+    double w;
+    cf_sum_chunks(nn, 1, obstacles_par, obstacle_chunk, &sums, &w);
+    return w;
+}
+
+/* The prescribed nodes' predictions restored (a constraint of the
+ * projection); returns the work of their reactions, J. */
+static double prescribed_nodes(cf_world *sim, const cf_fragment *f, double dt, int n_bc)
+{
+    double w = 0;
+    for (int i = 0; n_bc > 0 && i < f->nodes.n; i++)
+        if (sim->solid.bc[f->nodes.v[i]] >= 0)
+            w += impose_boundary(sim, f->nodes.v[i], dt, 1);
+    return w;
+}
+
+/* Stage velocity_update: v <- (p - x)/dt ; x <- p, with a node's new speed
+ * bounded by the fastest predicted speed among itself and its bar
+ * neighbours, or, on a moving obstacle, by |u| + |v_pred - u| (a discrete
+ * maximum principle).  The constraints exchange momentum between
+ * neighbours and stop nodes at obstacles; a speed above every speed around
+ * it can only come from a violation left in the bars by the unconverged
+ * sweep, released within one step (violation/dt: measured 100-450 m/s on a
+ * node where a crack has just split a compressed impact zone, in a 4.4 m/s
+ * drop), energy that no load put in.  Nodes pushed by rigid neighbours'
+ * hulls are left as they are (their push is booked as an impulse on the
+ * body).  The projection's energy is the work of its impulses m (v - v_pred)
+ * (impulse_removes), booked when the next step starts, with the moving
+ * obstacles' and prescribed nodes' work w_obs and w_bc in it.  dv receives
+ * the velocity every node must gain to give back the momentum the speed
+ * cap took (zero when it took none): collision_friction adds it in its
+ * pass over the nodes. */
+static void velocity_update(cf_world *sim, cf_fragment *f, double dt, int fracture, int caps,
+                            double w_obs, double w_bc, double dv[3])
 {
     cf_solid *s = &sim->solid;
     const cf_solver_settings *set = &sim->def.solver;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
-    /* The obstacle pass on the threads unless hull pushes of rigid
-     * neighbours (one list) or FCL queries need one thread. */
     const cf_contact_cache *cc = cache_of(sim, f);
-    int obstacles_par = par && cc->near.n == 0 && !mesh_obstacles(sim);
-    int bars = !explicit_step(set, fracture), penalty = penalty_step(set, fracture);
-#pragma omp parallel for schedule(static) if (par)
-    for (int i = 0; i < nn; i++) {
-        int a = nodes[i];
-        for (int k = 0; k < 3; k++)
-            s->p[4 * a + k] = s->x[3 * a + k] + dt * s->v[3 * a + k];
-        s->p[4 * a + 3] = 1.0 / s->m[a];
-        if (!penalty) { /* the penalty force recorded its contacts (penalty_chunk) */
-            f->contact[i] = -1;
-            f->vn_pre[i] = 0;
-        }
-        if (bars) /* the predicted speed, for the cap below (v stays until then) */
-            s->vcap[a] = s->speed[a] = v3_norm(&s->v[3 * a]);
-    }
-    int iterations = bars ? set->iterations : 1;
-    double k = cf_pbd_effective_stiffness(set->k_stiffness, set->iterations,
-                                          set->iteration_independent);
-    if (set->constraints == CF_CONSTRAINTS_XPBD)
-        cf_bars_reset_lambda(&f->bars);
-    double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
-    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}, 0, penalty};
-    int caps = 0; /* the neighbours' speeds taken (below) in the first PBD sweep */
-    for (int it = 0; it < iterations; it++) {
-        if (bars && set->constraints == CF_CONSTRAINTS_XPBD && fracture) {
-            cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
-        } else if (bars) {
-            cf_bars_project(&f->bars, s, k, caps ? NULL : s->speed, caps ? NULL : s->vcap);
-            caps = 1;
-        }
-        if (fracture && bars)
-            cf_cohesive_project_contact(s, f->coh.v, f->coh.n);
-        double w; /* obstacles node by node, each writing its own p */
-        cf_sum_chunks(nn, 1, obstacles_par, obstacle_chunk, &sums, &w);
-        w_obs += w;
-        for (int i = 0; n_bc > 0 && i < nn; i++)
-            if (s->bc[nodes[i]] >= 0)
-                w_bc += impose_boundary(sim, nodes[i], dt, 1);
-    }
-    /* v <- (p - x)/dt ; x <- p, with a node's new speed bounded by the
-     * fastest predicted speed among itself and its bar neighbours, or, on a
-     * moving obstacle, by |u| + |v_pred - u| (a discrete maximum principle).
-     * The constraints exchange momentum between neighbours and stop nodes at
-     * obstacles; a speed above every speed around it can only come from a
-     * violation left in the bars by the unconverged sweep, released within
-     * one step (violation/dt: measured 100-450 m/s on a node where a crack
-     * has just split a compressed impact zone, in a 4.4 m/s drop), energy
-     * that no load put in.  Nodes pushed by rigid neighbours' hulls are left
-     * as they are (their push is booked as an impulse on the body).  The
-     * projection's energy is the work of its impulses m (v - v_pred)
-     * (impulse_removes), booked when the next step starts. */
+    int bars = !explicit_step(set, fracture);
     if (bars && !caps)
         cf_bars_neighbour_speed(&f->bars, s->speed, s->vcap);
     int n_capped = 0;
-#pragma omp parallel for schedule(static) reduction(+ : n_capped) if (par)
-    for (int i = 0; i < nn; i++) {
-        int a = nodes[i];
-        double *va = &s->v[3 * a], vnew[3];
-        for (int c = 0; c < 3; c++)
-            vnew[c] = (s->p[4 * a + c] - s->x[3 * a + c]) / dt;
-        double cap = s->vcap[a];
-        if (f->contact[i] >= 0) { /* a moving wall: |v' - u| <= |v - u| */
-            double u[3], vr[3];
-            cf_obstacle_velocity(&sim->obs.o[f->contact[i]], u);
-            v3_sub(va, u, vr);
-            cap = fmax(cap, v3_norm(vr) + v3_norm(u));
-        }
-        double speed = v3_norm(vnew), scale = 1.0;
-        if (bars && speed > cap && (cc->near.n == 0 || cc->push.frag[i] < 0))
-            scale = cap / speed, n_capped++;
-        double vout[3] = {scale * vnew[0], scale * vnew[1], scale * vnew[2]};
-        f->term[i] =
-            impulse_removes(s, f, i, va, vnew, 1) + impulse_removes(s, f, i, vnew, vout, 0);
-        for (int c = 0; c < 3; c++) {
-            va[c] = vout[c];
-            s->x[3 * a + c] = s->p[4 * a + c];
-            s->p[4 * a + c] = s->m[a] * (1.0 - scale) * vnew[c]; /* momentum the cap took */
-        }
-    }
+    CF_PARALLEL(par, "omp parallel for schedule(static) reduction(+ : n_capped)",
+        for (int i = 0; i < nn; i++) {
+            int a = nodes[i];
+            double *va = &s->v[3 * a], vnew[3];
+            for (int c = 0; c < 3; c++)
+                vnew[c] = (s->p[4 * a + c] - s->x[3 * a + c]) / dt;
+            double cap = s->vcap[a];
+            if (f->contact[i] >= 0) { /* a moving wall: |v' - u| <= |v - u| */
+                double u[3], vr[3];
+                cf_obstacle_velocity(&sim->obs.o[f->contact[i]], u);
+                v3_sub(va, u, vr);
+                cap = fmax(cap, v3_norm(vr) + v3_norm(u));
+            }
+            double speed = v3_norm(vnew), scale = 1.0;
+            if (bars && speed > cap && (cc->near.n == 0 || cc->push.frag[i] < 0))
+                scale = cap / speed, n_capped++;
+            double vout[3] = {scale * vnew[0], scale * vnew[1], scale * vnew[2]};
+            f->term[i] =
+                impulse_removes(s, f, i, va, vnew, 1) + impulse_removes(s, f, i, vnew, vout, 0);
+            for (int c = 0; c < 3; c++) {
+                va[c] = vout[c];
+                s->x[3 * a + c] = s->p[4 * a + c];
+                s->p[4 * a + c] = s->m[a] * (1.0 - scale) * vnew[c]; /* momentum the cap took */
+            }
+        });
     /* The momentum the cap took goes back to the whole fragment, so that the
      * projection keeps linear momentum (bars act in equal and opposite pairs;
      * the cap does not). */
+    step_sums sums = {sim, f, 0, dt, {0, 0, 0}, 0, 0};
     double removed;
     cf_sum_chunks(nn, 1, par, term_chunk, &sums, &removed);
     double dP[3] = {0, 0, 0}; /* zero unless the cap took some (then in node order) */
@@ -685,26 +725,77 @@ static void project(cf_world *sim, cf_fragment *f, double t_next, double dt, int
         f->pending.contact += removed + w_obs + w_bc;
 }
 
+/* One step of the in-house solver on fragment fi (fracture.h), stage by
+ * stage, each stage's time charged to its timer as it ends. */
 cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture)
 {
     cf_fragment *f = &sim->frag[fi];
-    cf_fragment_book_pending(f, &sim->flow);
-    cf_status st = forces(sim, f, t, dt, fracture);
-    if (st != CF_OK)
-        return st;
-    double t0 = cf_wall_time();
-    int n_bc = update_velocities(sim, f, dt, fracture);
-    double t1 = cf_wall_time();
-    sim->prof.forces += t1 - t0;
-    double dv[3];
-    project(sim, f, t + dt, dt, fracture, n_bc, dv);
+    cf_profile *prof = &sim->prof;
     const cf_solver_settings *set = &sim->def.solver;
-    f->pending.contact += contact_velocities(sim, f, t + dt, dt, explicit_step(set, fracture),
-                                             penalty_step(set, fracture), dv);
-    sim->prof.pbd += cf_wall_time() - t1;
+    int penalty = penalty_step(set, fracture), bars = !explicit_step(set, fracture);
+    cf_fragment_book_pending(f, &sim->flow);
+    f->e_strain = 0;
+    if (fracture) {
+        /* Stresses only when the criterion is checked at this step. */
+        int check = set->criterion != CF_CRITERION_NONE && (f->steps % set->check_interval) == 0;
+        int n_hot = elasticity(sim, f, check), inserted = 0;
+        cf_profile_lap(prof, CF_STAGE_ELASTICITY);
+        if (check) {
+            int nc = insertion_check(sim, f, t, n_hot);
+            cf_profile_lap(prof, CF_STAGE_INSERTION_CHECK);
+            cf_status st = nc < 0 ? CF_ERR_NOMEM : node_duplication(sim, f, t, dt, nc, &inserted);
+            cf_profile_lap(prof, CF_STAGE_NODE_DUPLICATION);
+            if (st != CF_OK)
+                return st;
+        }
+        f->quiet = inserted ? 0 : f->quiet + 1;
+    }
+    if (ensure_scratch(sim, f))
+        return CF_ERR_NOMEM;
+    if (fracture) {
+        elasticity_scatter(sim, f);
+        cf_profile_lap(prof, CF_STAGE_ELASTICITY);
+        cohesive_forces(sim, f, dt);
+        cf_profile_lap(prof, CF_STAGE_COHESIVE_FORCES);
+        if (penalty) {
+            collision_forces(sim, f, t, dt);
+            cf_profile_lap(prof, CF_STAGE_COLLISION);
+        }
+    } else {
+        cf_solid *s = &sim->solid;
+        for (int i = 0; i < f->nodes.n; i++) { /* pbd rigid mode: gravity alone */
+            int a = f->nodes.v[i];
+            for (int k = 0; k < 3; k++)
+                s->f[3 * a + k] = s->m[a] * sim->def.gravity[k];
+        }
+    }
+    int n_bc = integration(sim, f, dt, fracture);
+    cf_profile_lap(prof, CF_STAGE_INTEGRATION);
+    if (set->constraints == CF_CONSTRAINTS_XPBD)
+        cf_bars_reset_lambda(&f->bars);
+    double w_obs = 0, w_bc = 0; /* work of moving obstacles and prescribed nodes */
+    int caps = 0, iterations = bars ? set->iterations : 1;
+    for (int it = 0; it < iterations; it++) {
+        if (bars) {
+            pbd_projection(sim, f, dt, fracture, &caps);
+            cf_profile_lap(prof, CF_STAGE_PBD_PROJECTION);
+        }
+        w_obs += collision_sweep(sim, f, t + dt, dt, penalty);
+        cf_profile_lap(prof, CF_STAGE_COLLISION);
+        if (n_bc > 0) {
+            w_bc += prescribed_nodes(sim, f, dt, n_bc);
+            cf_profile_lap(prof, CF_STAGE_PBD_PROJECTION);
+        }
+    }
+    double dv[3];
+    velocity_update(sim, f, dt, fracture, caps, w_obs, w_bc, dv);
+    cf_profile_lap(prof, CF_STAGE_VELOCITY_UPDATE);
+    f->pending.contact += collision_friction(sim, f, t + dt, dt, !bars, penalty, dv);
+    cf_profile_lap(prof, CF_STAGE_COLLISION);
     f->steps++;
     return CF_OK;
 }
+
 int cf_pbd_impact(const cf_world *sim, int fi, double dt)
 {
     const cf_fragment *f = &sim->frag[fi];

@@ -25,23 +25,24 @@ static int decompose_fragment(cf_world *sim, cf_fragment *f)
 {
     if (f->hulls.n_hulls > 0)
         return 0;
-    double t0 = cf_wall_time();
+    cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF);
     cf_hulls_free(&f->hulls);
     int most = f->nt / CF_HULL_TETS_PER_HULL;
     most = most < 1 ? 1 : most > CF_HULL_MAX_COUNT ? CF_HULL_MAX_COUNT : most;
-    if (cf_decompose(&sim->solid, f->tets, f->nt, CF_HULL_MAX_ERROR, most, CF_HULL_MIN_TETS,
-                     &f->hulls))
-        return -1;
-    for (int i = 0; i < f->hulls.start[f->hulls.n_hulls]; i++) {
+    int fail = cf_decompose(&sim->solid, f->tets, f->nt, CF_HULL_MAX_ERROR, most,
+                            CF_HULL_MIN_TETS, &f->hulls);
+    for (int i = 0; !fail && i < f->hulls.start[f->hulls.n_hulls]; i++) {
         double r[3];
         v3_sub(&f->hulls.pts[3 * i], f->com_rest, r);
         m3_tmulv(f->Q, r, &f->hulls.pts[3 * i]);
     }
-    double dt = cf_wall_time() - t0;
-    sim->prof.decompose += dt;
-    f->decompose_time = dt;
-    if (sim->tick)
+    f->decompose_time = cf_profile_lap(&sim->prof, CF_STAGE_CONVEX_DECOMPOSITION);
+    if (fail)
+        return -1;
+    if (sim->tick) {
         sim->tick(sim->tick_user, sim->t);
+        cf_profile_lap(&sim->prof, CF_STAGE_BOOKKEEPING);
+    }
     return 0;
 }
 

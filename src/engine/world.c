@@ -10,6 +10,7 @@
 
 #include "hash.h"
 #include "linalg.h"
+#include "parallel.h"
 #include "renumber.h"
 #include "sort.h"
 
@@ -563,9 +564,15 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
         st = add_obstacles(sim, def, err);
     if (st == CF_OK)
         st = select_crack_plane(sim, err);
+    cf_profile_start(&sim->prof);
     if (st == CF_OK)
         st = make_initial_fragments(sim, def, body, err);
     free(body);
+    /* The initial bodies' convex decompositions are the run's; the rest of
+     * creation is no stage of a step. */
+    double hulls = sim->prof.stage[CF_STAGE_CONVEX_DECOMPOSITION];
+    memset(&sim->prof, 0, sizeof sim->prof);
+    sim->prof.stage[CF_STAGE_CONVEX_DECOMPOSITION] = hulls;
     if (st == CF_OK) { /* the ledger's reference state */
         cf_ledger l;
         cf_world_ledger(sim, &l);
@@ -595,9 +602,10 @@ void cf_world_destroy(cf_world *sim)
     }
     free(sim->frag);
     cf_contact_caches_free(&sim->contact);
+    cf_arena_free(&sim->arena);
     cf_obstacles_free(&sim->obs);
     free(sim->obstacle_body), free(sim->obstacle_moving);
-    free(sim->body_boxes), free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
+    free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
     free(sim->touched.v), free(sim->crushed.v);
     cf_bars_scratch_free(&sim->bar_scratch);
     free(sim->def.obstacles), free(sim->def.boundaries);
@@ -812,11 +820,12 @@ double cf_world_crack_area(const cf_world *sim) { return cf_solid_crack_area(&si
 static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 {
     int insane = 0;
-#pragma omp parallel for schedule(static) reduction(+ : insane) if (f->nodes.n >= CF_NODES_PARALLEL_MIN)
-    for (int i = 0; i < f->nodes.n; i++) {
-        const double *x = &s->x[3 * f->nodes.v[i]], *v = &s->v[3 * f->nodes.v[i]];
-        insane += !isfinite(x[0] + x[1] + x[2]) || !(v3_dot(v, v) < 1e10);
-    }
+    CF_PARALLEL(f->nodes.n >= CF_NODES_PARALLEL_MIN,
+                "omp parallel for schedule(static) reduction(+ : insane)",
+        for (int i = 0; i < f->nodes.n; i++) {
+            const double *x = &s->x[3 * f->nodes.v[i]], *v = &s->v[3 * f->nodes.v[i]];
+            insane += !isfinite(x[0] + x[1] + x[2]) || !(v3_dot(v, v) < 1e10);
+        });
     return insane == 0;
 }
 
@@ -854,7 +863,8 @@ static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
 {
     const cf_solver_settings *set = &sim->def.solver;
     int n = sim->n_frag, no = sim->def.n_obstacles;
-    cfb_state *pre = malloc((size_t)(n + no) * sizeof *pre), *pre_obs = pre + n;
+    size_t mark = cf_arena_mark(&sim->arena);
+    cfb_state *pre = cf_arena_take(&sim->arena, (size_t)(n + no) * sizeof *pre), *pre_obs = pre + n;
     if (!pre)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     for (int fi = 0; fi < n; fi++)
@@ -868,22 +878,20 @@ static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
         any_moving |= sim->obstacle_moving[j];
     cf_status st = CF_OK;
     for (int pass = 0; st == CF_OK; pass++) {
-        double t0 = cf_wall_time();
         /* Fails when Bullet ran out of memory, in this step or in an
          * earlier call that could not say so (the world is then unusable). */
         if (cfb_step(sim->bullet, dt, set->rigid_substeps) < 0) {
             st = bullet_error(err, "the rigid step");
             break;
         }
-        sim->prof.rigid += cf_wall_time() - t0;
         int hit = 0;
         for (int fi = 0; fi < n && st == CF_OK; fi++) {
             cf_fragment *f = &sim->frag[fi];
             if (f->mode != CF_MODE_RIGID || f->body < 0 || !impact(sim, f))
                 continue;
-            double th = cf_wall_time();
+            cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
             st = to_fracture(sim, fi, &pre[fi], err);
-            sim->prof.handoff += cf_wall_time() - th;
+            cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF);
             hit++;
         }
         if (st != CF_OK || hit == 0 || pass == CF_MAX_RESTEPS)
@@ -914,8 +922,9 @@ static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
         }
         sim->flow.contact += removed;
     }
-    free(pre);
+    cf_arena_release(&sim->arena, mark);
     sim->steps_rigid++;
+    cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
     return st;
 }
 
@@ -924,21 +933,24 @@ static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
 {
     if (sim->bullet)
         return bullet_step(sim, dt, err);
-    double t0 = cf_wall_time();
     for (int fi = 0; fi < sim->n_frag; fi++) {
         if (sim->frag[fi].mode != CF_MODE_RIGID)
             continue;
-        if (cf_pbd_impact(sim, fi, dt) && can_break(sim, &sim->frag[fi])) {
+        int hit = cf_pbd_impact(sim, fi, dt) && can_break(sim, &sim->frag[fi]);
+        cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
+        if (hit) {
             cf_status st = to_fracture(sim, fi, NULL, err);
+            cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF);
             if (st != CF_OK)
                 return st;
             continue;
         }
+        /* The damped step's own stages are timed as the solver's. */
         if (cf_solver_step(sim, fi, sim->t, dt, 0) != CF_OK)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory in the pbd rigid step");
     }
     sim->steps_rigid++;
-    sim->prof.rigid += cf_wall_time() - t0;
+    cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
     return CF_OK;
 }
 
@@ -962,11 +974,12 @@ static double contact_pad(const cf_world *sim, int fi, double dt)
 {
     const cf_fragment *f = &sim->frag[fi];
     double v2 = 0; /* a maximum: the same for any thread count */
-#pragma omp parallel for schedule(static) reduction(max : v2) if (f->nodes.n >= CF_NODES_PARALLEL_MIN)
-    for (int i = 0; i < f->nodes.n; i++) {
-        const double *v = &sim->solid.v[3 * f->nodes.v[i]];
-        v2 = fmax(v2, v3_dot(v, v));
-    }
+    CF_PARALLEL(f->nodes.n >= CF_NODES_PARALLEL_MIN,
+                "omp parallel for schedule(static) reduction(max : v2)",
+        for (int i = 0; i < f->nodes.n; i++) {
+            const double *v = &sim->solid.v[3 * f->nodes.v[i]];
+            v2 = fmax(v2, v3_dot(v, v));
+        });
     return dt * (sqrt(v2) + dt * v3_norm(sim->def.gravity));
 }
 
@@ -986,27 +999,50 @@ static long sub_steps(const cf_world *sim, double dt, double *h)
 /* The contact stages' view of the world (contact.h). */
 static cf_contact_ctx contact_ctx(cf_world *sim)
 {
-    return (cf_contact_ctx){sim->frag, sim->contact.v, sim->n_frag, &sim->solid, sim->bullet};
+    return (cf_contact_ctx){sim->frag, sim->contact.v, sim->n_frag, &sim->solid, sim->bullet,
+                            &sim->arena};
+}
+
+/* Stage collision, before the sub-steps: the hulls of the rigid bodies
+ * near each fracture-mode fragment, from the bodies' boxes taken once.
+ * Returns 0, or -1 out of memory. */
+static int gather_hulls(cf_world *sim, const cf_contact_ctx *cx, double dt)
+{
+    size_t mark = cf_arena_mark(&sim->arena);
+    double *boxes = NULL;
+    int rc = 0;
+    for (int fi = 0; fi < sim->n_frag && !rc; fi++) {
+        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+            continue;
+        if (!boxes) {
+            boxes = cf_arena_take(&sim->arena, (size_t)sim->n_frag * 6 * sizeof *boxes);
+            if (!boxes) {
+                rc = -1;
+                break;
+            }
+            cf_body_boxes(cx, boxes);
+        }
+        rc = cf_hull_set_gather(cx, fi, contact_pad(sim, fi, dt), boxes,
+                                &sim->contact.v[fi].near);
+    }
+    cf_arena_release(&sim->arena, mark);
+    return rc;
 }
 
 static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, cf_error *err)
 {
     const cf_solver_settings *set = &sim->def.solver;
     sim->h_fracture = h;
-    int n = sim->n_frag, boxed = 0; /* the rigid bodies' boxes are taken once */
+    int n = sim->n_frag;
     if (cf_contact_caches_reserve(&sim->contact, n))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
     /* No fragment is made before the splits after these steps, so neither
      * table moves while cx points into them. */
     const cf_contact_ctx cx = contact_ctx(sim);
     int bodies = cf_body_contact_needed(&cx);
-    for (int fi = 0; fi < n; fi++) {
-        if (sim->frag[fi].mode == CF_MODE_FRACTURE &&
-            ((!boxed++ && cf_body_boxes(&cx, &sim->body_boxes)) ||
-             cf_hull_set_gather(&cx, fi, contact_pad(sim, fi, dt), sim->body_boxes,
-                                &sim->contact.v[fi].near)))
-            return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
-    }
+    if (gather_hulls(sim, &cx, dt))
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
+    cf_profile_lap(&sim->prof, CF_STAGE_COLLISION);
     for (long k = 0; k < n_sub; k++) {
         for (int fi = 0; fi < n; fi++) {
             if (sim->frag[fi].mode != CF_MODE_FRACTURE)
@@ -1017,15 +1053,17 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
             sim->tet_steps_fracture += sim->frag[fi].nt;
         }
         if (bodies) {
-            double removed, t0 = cf_wall_time();
+            double removed;
             if (cf_body_contact(&cx, h, &removed))
                 return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
                                     cff_last_error());
             sim->flow.contact += removed;
-            sim->prof.bodies += cf_wall_time() - t0;
+            cf_profile_lap(&sim->prof, CF_STAGE_COLLISION);
         }
-        if (sim->tick)
+        if (sim->tick) {
             sim->tick(sim->tick_user, sim->t + (double)(k + 1) * h);
+            cf_profile_lap(&sim->prof, CF_STAGE_BOOKKEEPING);
+        }
     }
     for (int fi = 0; fi < n; fi++) {
         cf_fragment *f = &sim->frag[fi];
@@ -1037,6 +1075,7 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory pushing rigid fragments");
         sim->flow.contact -= gained;
         cc->near.n = 0;
+        cf_profile_lap(&sim->prof, CF_STAGE_COLLISION);
         char what[160];
         if (!nodes_sane(&sim->solid, f)) {
             snprintf(what, sizeof what,
@@ -1058,6 +1097,7 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
                      fi, inv, nt, set->max_inverted_fraction);
             return diverged(sim, err, what);
         }
+        cf_profile_lap(&sim->prof, CF_STAGE_BOOKKEEPING);
     }
     return CF_OK;
 }
@@ -1155,10 +1195,9 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
             (f->quiet < set->quiet_steps || impact_unfinished(sim, fi)))
             continue;
         int first_new = sim->n_frag;
-        double th = cf_wall_time();
         cf_handoff_record r;
         cf_status st = cf_handoff_to_rigid(sim, fi, &r, err);
-        sim->prof.handoff += cf_wall_time() - th;
+        cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF);
         if (st == CF_OK)
             st = handoff_event(sim, &r, err);
         if (st == CF_OK)
@@ -1166,6 +1205,7 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
         if (st != CF_OK)
             return st;
     }
+    cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF); /* the checks of those that stay */
     return CF_OK;
 }
 
@@ -1185,9 +1225,8 @@ static cf_status split_fragments(cf_world *sim, cf_error *err)
         if (sim->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
         int first = sim->n_frag;
-        double th = cf_wall_time();
         int k = cf_fragment_split_fracture(sim, fi, &first);
-        sim->prof.handoff += cf_wall_time() - th;
+        cf_profile_lap(&sim->prof, CF_STAGE_SPLIT);
         if (k < 0)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory splitting fragment %d", fi);
         if (k > 0) {
@@ -1197,6 +1236,14 @@ static cf_status split_fragments(cf_world *sim, cf_error *err)
         }
     }
     return CF_OK;
+}
+
+const char *cf_stage_name(cf_stage s)
+{
+#define CF_STAGE_NAME(id, name) #name,
+    static const char *const names[] = {CF_STAGES(CF_STAGE_NAME)};
+#undef CF_STAGE_NAME
+    return s >= 0 && s < CF_STAGE_COUNT ? names[s] : "?";
 }
 
 const cf_world_def *cf_world_definition(const cf_world *sim) { return &sim->def; }
@@ -1229,6 +1276,7 @@ double cf_world_dt_cfl(const cf_world *sim) { return sim->solid.dt_cfl; }
 
 cf_status cf_world_step(cf_world *sim, cf_error *err)
 {
+    cf_profile_start(&sim->prof);
     const cf_world_def *sc = &sim->def;
     double dt = sim->dt_outer, h, t0 = sim->t;
     long n_sub = sub_steps(sim, dt, &h);
@@ -1266,6 +1314,9 @@ cf_status cf_world_step(cf_world *sim, cf_error *err)
         st = return_to_rigid(sim, err);
     if (st == CF_OK)
         st = check_energy(sim, err);
+    if (cf_arena_end_step(&sim->arena) && st == CF_OK)
+        st = cf_error_set(err, CF_ERR_NOMEM, "out of memory growing the step's scratch");
+    cf_profile_lap(&sim->prof, CF_STAGE_BOOKKEEPING);
     return st;
 }
 
@@ -1306,9 +1357,7 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->cohesive = sim->solid.n_coh;
     o->handoffs = sim->n_handoffs;
     o->max_momentum_error = sim->max_momentum_error, o->handoff_loss = sim->total_handoff_loss;
-    o->rigid = p->rigid, o->stress = p->stress, o->insertion = p->insertion;
-    o->forces = p->forces, o->pbd = p->pbd, o->bodies = p->bodies, o->handoff = p->handoff;
-    o->decompose = p->decompose;
+    memcpy(o->stage, p->stage, sizeof o->stage);
     /* Convex decomposition of the rigid fragments alive now: median and worst
      * error (NaN when there is no memory to sort them: unknown, not 0). */
     double *e = malloc((size_t)(sim->n_frag + 1) * sizeof(double));
@@ -1382,8 +1431,7 @@ void cf_world_step_stats(const cf_world *sim, cf_step_stats *o)
     memset(o, 0, sizeof *o);
     o->fracture_steps = sim->steps_fracture;
     o->tet_steps = sim->tet_steps_fracture, o->fracture_time = sim->t_fracture;
-    o->stress = sim->prof.stress, o->insertion = sim->prof.insertion;
-    o->forces = sim->prof.forces, o->pbd = sim->prof.pbd;
+    memcpy(o->stage, sim->prof.stage, sizeof o->stage);
     for (int i = 0; i < sim->n_frag; i++) {
         const cf_fragment *f = &sim->frag[i];
         if (f->mode != CF_MODE_FRACTURE)

@@ -5,6 +5,7 @@
 #ifndef COHFRAC_SIM_PRIVATE_H
 #define COHFRAC_SIM_PRIVATE_H
 
+#include "arena.h"
 #include "cf_bullet.h"
 #include "clock.h"
 #include "cohesive.h"
@@ -15,11 +16,8 @@
 #include "insertion.h"
 #include "obstacle.h"
 #include "pbd.h"
+#include "profile.h"
 #include "solid.h"
-
-typedef struct cf_profile {
-    double rigid, stress, insertion, forces, pbd, bodies, handoff, decompose; /* s of wall time */
-} cf_profile;
 
 struct cf_world {
     cf_world_def def;        /* the world's copy (obstacles and boundaries too) */
@@ -41,7 +39,8 @@ struct cf_world {
     double dt_outer;         /* s: dt_rigid (fracture-only runs: a whole number of
                                 fracture steps) */
     double next_frame;       /* s */
-    cf_profile prof;
+    cf_profile prof;         /* wall time per stage (profile.h) */
+    cf_arena arena;          /* the step's scratch, empty between steps (arena.h) */
     long steps_rigid, steps_fracture;
     long long tet_steps_fracture; /* sum over fracture steps of the tets stepped */
     double t_fracture;       /* s of simulated time with a fragment in fracture mode */
@@ -53,7 +52,6 @@ struct cf_world {
     double wall_start;
     int *obstacle_body;      /* [n_obstacles] Bullet body of each obstacle */
     unsigned char *obstacle_moving; /* [n_obstacles] kinematic (restored on a re-step) */
-    double *body_boxes;      /* [n_frag][6] Bullet bodies' boxes (cf_body_boxes) */
     unsigned long long bullet_base; /* Bullet allocator bytes when the run was created */
     int *tet_of_user;        /* [n_tets] the solid's tet of each input tet (the solid is
                                 renumbered for locality at load: renumber.h) */

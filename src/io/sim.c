@@ -515,7 +515,7 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
 
 /* Remaining wall time of the run, s, from the cost of each mode measured
  * so far (docs/performance.md): the rigid steps and the output per
- * simulated second; the fracture-mode stages and the hand-offs per tet and
+ * simulated second; every other stage of the step (cf_stage) per tet and
  * fracture step, at the tets in fracture mode now.  While a fragment is in
  * fracture mode it counts as much fracture mode again as has run, at most
  * what the run has left: when it ends no measure says.  (The wall per
@@ -527,9 +527,10 @@ static double eta(const cf_sim *sim, const cf_world_stats *ws)
     cf_step_stats st;
     cf_world_step_stats(w, &st);
     double t = cf_world_time(w), left = fmax(0.0, sim->duration - t);
-    double fracture_wall = ws->stress + ws->insertion + ws->forces + ws->pbd + ws->bodies +
-                           ws->handoff;
-    double per_rigid = t > 0 ? (ws->rigid + sim->output_time) / t : 0;
+    double fracture_wall = 0; /* every stage but the rigid step's */
+    for (int i = 0; i < CF_STAGE_COUNT; i++)
+        fracture_wall += i == CF_STAGE_RIGID_STEP ? 0 : ws->stage[i];
+    double per_rigid = t > 0 ? (ws->stage[CF_STAGE_RIGID_STEP] + sim->output_time) / t : 0;
     /* Fracture mode costs per tet and step; what runs in it now sets the
      * rate (the tets stepped per simulated second). */
     double per_tet_step = st.tet_steps > 0 ? fracture_wall / (double)st.tet_steps : 0;
@@ -772,11 +773,15 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
     if (p.rigid_with_hulls > 0)
         fprintf(out, "convex hulls       %d over %d rigid fragments; hull volume / tet volume - 1: "
                      "median %.3g, worst %.3g; decomposition %.2f s (%.1f%% of wall time)\n",
-                p.hulls, p.rigid_with_hulls, p.hull_error_median, p.hull_error_worst, p.decompose,
-                100 * p.decompose / fmax(wall, 1e-300));
+                p.hulls, p.rigid_with_hulls, p.hull_error_median, p.hull_error_worst,
+                p.stage[CF_STAGE_CONVEX_DECOMPOSITION],
+                100 * p.stage[CF_STAGE_CONVEX_DECOMPOSITION] / fmax(wall, 1e-300));
     print_memory(sim, out);
-    double staged = p.rigid + p.stress + p.insertion + p.forces + p.pbd + p.bodies + p.handoff +
-                    sim->output_time;
+    double staged = sim->output_time, solver = 0; /* the solver's stages: its step */
+    for (int i = 0; i < CF_STAGE_COUNT; i++)
+        staged += p.stage[i];
+    for (int i = CF_STAGE_ELASTICITY; i <= CF_STAGE_VELOCITY_UPDATE; i++)
+        solver += p.stage[i];
     cf_ledger l;
     cf_world_ledger(w, &l);
     double scale = fmax(fabs(l.initial) + fabs(l.work_gravity) + fabs(l.work_boundary) +
@@ -799,14 +804,14 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
     fprintf(out, "state hash         %016llx (FNV-1a of the final state)\n",
             (unsigned long long)cf_world_state_hash(w));
     fprintf(out, "wall time          %.2f s\n", wall);
-    fprintf(out, "  rigid step %.2f s | stress %.2f s | insertion %.2f s | forces %.2f s | "
-                 "PBD %.2f s | contact between bodies %.2f s | hand-off %.2f s | output %.2f s | "
-                 "other %.2f s\n",
-            p.rigid, p.stress, p.insertion, p.forces, p.pbd, p.bodies, p.handoff,
-            sim->output_time, wall - staged);
+    /* The step's stages (cohfrac/world.h, docs/architecture.md), four to a
+     * line, then what the run loop spent outside the steps. */
+    for (int i = 0; i < CF_STAGE_COUNT; i++)
+        fprintf(out, "%s%s %.2f s", i % 4 == 0 ? (i ? "\n  " : "  ") : " | ",
+                cf_stage_name((cf_stage)i), p.stage[i]);
+    fprintf(out, "\n  output %.2f s | other %.2f s\n", sim->output_time, wall - staged);
     if (p.steps_fracture > 0)
-        fprintf(out, "per fracture step  %.3f ms\n",
-                1e3 * (p.stress + p.insertion + p.forces + p.pbd) / (double)p.steps_fracture);
+        fprintf(out, "per fracture step  %.3f ms\n", 1e3 * solver / (double)p.steps_fracture);
     if (sim->output.file[0])
         fprintf(out, "output             %s\n", sim->output.file);
 }
