@@ -293,6 +293,12 @@ typedef enum {
     CF_STAGE_COUNT
 } cf_stage;
 
+/* The in-house solver's own stages (one step of a fragment,
+ * cf_solver_step) are the range FIRST..LAST of cf_stage: the time per
+ * fracture step of the summary and `cohfrac bench`'s columns. */
+#define CF_STAGE_SOLVER_FIRST CF_STAGE_ELASTICITY
+#define CF_STAGE_SOLVER_LAST CF_STAGE_VELOCITY_UPDATE
+
 /* The stage's name ("elasticity"), or "?" for a value out of range. */
 const char *cf_stage_name(cf_stage s);
 

@@ -192,15 +192,11 @@ static void summarize(sample *s, int n, cf_bench_timing *t)
     t->insertions = s[mid].insertions;
 }
 
-/* The solver's stages, the bench's columns (cohfrac/world.h). */
-#define FIRST_STAGE CF_STAGE_ELASTICITY
-#define LAST_STAGE CF_STAGE_VELOCITY_UPDATE
-
 static void print_row(FILE *f, const char *what, const cf_bench_timing *t, int tets)
 {
     fprintf(f, "  %-10s %8.2f %9.2f %8.2f %9.1f", what, t->ms_min, t->ms_median, t->cpu_ms,
             1e6 * t->ms_min / tets);
-    for (int i = FIRST_STAGE; i <= LAST_STAGE; i++)
+    for (int i = CF_STAGE_SOLVER_FIRST; i <= CF_STAGE_SOLVER_LAST; i++)
         fprintf(f, " %*.2f", (int)strlen(cf_stage_name((cf_stage)i)), t->stage[i]);
     fprintf(f, " %10ld\n", t->insertions);
 }
@@ -278,7 +274,7 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
                 r->colours, r->serial_bars, r->memory_per_tet,
                 r->bytes / 1e6, r->floor_ms, r->bw_nt / 1e9, "threads", "min ms", "median ms",
                 "CPU ms", "ns/tet");
-        for (int i = FIRST_STAGE; i <= LAST_STAGE; i++)
+        for (int i = CF_STAGE_SOLVER_FIRST; i <= CF_STAGE_SOLVER_LAST; i++)
             fprintf(log, " %s", cf_stage_name((cf_stage)i));
         fprintf(log, " %10s\n", "insertions");
         char what[32];

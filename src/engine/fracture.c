@@ -223,7 +223,7 @@ typedef struct {
     cf_world *sim;
     cf_fragment *f;
     double t_next, dt, dv[3];
-    int leapfrog; /* contact_velocities: explicit friction moves the node */
+    int leapfrog; /* collision_friction: explicit friction moves the node */
     int penalty;  /* obstacles act by the penalty force (penalty_chunk) */
 } step_sums;
 
@@ -253,7 +253,7 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
     cf_fragment *f = c->f;
     int shift = c->dv[0] != 0 || c->dv[1] != 0 || c->dv[2] != 0;
     for (int i = i0; i < i1; i++) {
-        if (shift) /* the momentum the speed cap took, given back (project) */
+        if (shift) /* the momentum the speed cap took, given back (velocity_update) */
             acc[2] += shift_node(s, f, i, c->dv);
         int j = f->contact[i];
         if (j < 0)
@@ -296,9 +296,9 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
 }
 
 /* Stage collision, after the velocity update: friction and restitution
- * (contact_chunk), after each node's velocity is
- * shifted by dv (the speed cap's momentum, from project; zero: none); the
- * shift's energy is booked with the projection's. */
+ * (contact_chunk), after each node's velocity is shifted by dv (the speed
+ * cap's momentum, from velocity_update; zero: none); the shift's energy is
+ * booked with the projection's. */
 static double collision_friction(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog,
                                  int penalty, const double dv[3])
 {
@@ -634,10 +634,10 @@ static double collision_sweep(cf_world *sim, cf_fragment *f, double t_next, doub
 
 /* The prescribed nodes' predictions restored (a constraint of the
  * projection); returns the work of their reactions, J. */
-static double prescribed_nodes(cf_world *sim, const cf_fragment *f, double dt, int n_bc)
+static double prescribed_nodes(cf_world *sim, const cf_fragment *f, double dt)
 {
     double w = 0;
-    for (int i = 0; n_bc > 0 && i < f->nodes.n; i++)
+    for (int i = 0; i < f->nodes.n; i++)
         if (sim->solid.bc[f->nodes.v[i]] >= 0)
             w += impose_boundary(sim, f->nodes.v[i], dt, 1);
     return w;
@@ -783,7 +783,7 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
         w_obs += collision_sweep(sim, f, t + dt, dt, penalty);
         cf_profile_lap(prof, CF_STAGE_COLLISION);
         if (n_bc > 0) {
-            w_bc += prescribed_nodes(sim, f, dt, n_bc);
+            w_bc += prescribed_nodes(sim, f, dt);
             cf_profile_lap(prof, CF_STAGE_PBD_PROJECTION);
         }
     }

@@ -780,7 +780,7 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
     double staged = sim->output_time, solver = 0; /* the solver's stages: its step */
     for (int i = 0; i < CF_STAGE_COUNT; i++)
         staged += p.stage[i];
-    for (int i = CF_STAGE_ELASTICITY; i <= CF_STAGE_VELOCITY_UPDATE; i++)
+    for (int i = CF_STAGE_SOLVER_FIRST; i <= CF_STAGE_SOLVER_LAST; i++)
         solver += p.stage[i];
     cf_ledger l;
     cf_world_ledger(w, &l);
