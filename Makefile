@@ -4,7 +4,7 @@
 BUILD     ?= build
 BUNNY_OBJ := /usr/share/glmark2/models/bunny.obj
 # Prepared meshes: the program's default mesh directory (the XDG cache,
-# include/cohfrac/surface.h cf_default_mesh_dir), so that `cohfrac run`
+# src/mesh/include/cohfrac/surface.h cf_default_mesh_dir), so that `cohfrac run`
 # finds them from anywhere without --mesh-dir.
 XDG_CACHE := $(if $(filter /%,$(XDG_CACHE_HOME)),$(XDG_CACHE_HOME),$(HOME)/.cache)
 MESHES    ?= $(or $(COHFRAC_MESH_DIR),$(XDG_CACHE)/cohfrac/meshes)

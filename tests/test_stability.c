@@ -1,4 +1,4 @@
-/* `cohfrac stability --quick` (include/cohfrac/stability.h): the corners of
+/* `cohfrac stability --quick` (src/cli/stability.h): the corners of
  * the map whose outcome is known from the theory of the explicit step and
  * of PBD, with one body on a plane and two bodies of very different mass in
  * contact, and the files it writes. */
@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include "cohfrac/stability.h"
+#include "stability.h"
 #include "fixtures.h"
 
 #include <stdio.h>

@@ -1,4 +1,4 @@
-/* `cohfrac study` (include/cohfrac/study.h): the trajectory error against a
+/* `cohfrac study` (src/cli/study.h): the trajectory error against a
  * closed form (free fall with two time steps), fragment matching through
  * the family tree and mass on written files, the mass-distribution
  * distance, the cache, and the usage and scene errors. */
@@ -9,7 +9,7 @@
 
 #include "check.h"
 #include "cohfrac/h5_output.h"
-#include "cohfrac/study.h"
+#include "study.h"
 #include "fixtures.h"
 
 #include <math.h>

@@ -1,5 +1,5 @@
 /* The rigid backends against closed forms, through cf_compare_run
- * (include/cohfrac/compare.h):
+ * (src/cli/compare.h):
  *
  * scenes/compare/spinning_top.lua: a torque-free symmetric top; its axis
  * precesses about L at Omega_p = |L| / I_1.  Measured (dt_rigid 1e-3 s):
@@ -24,7 +24,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
-#include "cohfrac/compare.h"
+#include "compare.h"
 #include "verify.h"
 
 #define TOP_TOL_BULLET 0.01

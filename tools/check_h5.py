@@ -3,7 +3,7 @@
 
 Usage: tools/check_h5.py RUN.h5 [--quiet]
 
-Reads the layout documented in include/cohfrac/h5_output.h with h5py (Debian
+Reads the layout documented in src/io/include/cohfrac/h5_output.h with h5py (Debian
 package python3-h5py; hence /usr/bin/python3).  Exits 0 when the file is
 consistent, 1 when a check fails, 2 when it cannot be read.  Works on a file
 whose run is still going or was killed: T is taken from the step dataset.

@@ -14,7 +14,7 @@
     world.ledger()["residual"]       # J
 
 The scene dict has the keys and units of a scene script (README "Scenes",
-include/cohfrac/scene.h): SI units, lists for vectors, 1-based body and
+src/io/include/cohfrac/scene.h): SI units, lists for vectors, 1-based body and
 obstacle lists.  It is turned into the same Lua table a script returns and
 checked by the same loader, so a bad key or value raises `CohfracError`
 with the message `cohfrac run` would print.  No output file is written

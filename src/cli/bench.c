@@ -1,6 +1,6 @@
 /* `cohfrac bench`: the fracture-mode step against the memory floor, the
- * thread speed-up and the btSoftBody peer (include/cohfrac/bench.h). */
-#include "cohfrac/bench.h"
+ * thread speed-up and the btSoftBody peer (src/cli/bench.h). */
+#include "bench.h"
 
 #include "clock.h"
 #include "cohfrac/mesh.h"

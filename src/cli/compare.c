@@ -1,6 +1,6 @@
-/* cohfrac — the two rigid backends side by side (see include/cohfrac/compare.h
+/* cohfrac — the two rigid backends side by side (see src/cli/compare.h
  * for the metrics, the reference rules and the files). */
-#include "cohfrac/compare.h"
+#include "compare.h"
 #include "cohfrac/surface.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"

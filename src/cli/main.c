@@ -5,14 +5,14 @@
  * 3 diverged, 4 output not written, 5 external program or memory failure
  * (see include/cohfrac/error.h). */
 #include "cohfrac/version.h"
-#include "cohfrac/bench.h"
-#include "cohfrac/compare.h"
+#include "bench.h"
+#include "compare.h"
 #include "cohfrac/error.h"
 #include "cohfrac/export.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
-#include "cohfrac/stability.h"
-#include "cohfrac/study.h"
+#include "stability.h"
+#include "study.h"
 #include "cohfrac/surface.h"
 
 #include "mpi_cases.h"

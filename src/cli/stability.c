@@ -1,7 +1,7 @@
-/* cohfrac — the stability map (see include/cohfrac/stability.h for the
+/* cohfrac — the stability map (see src/cli/stability.h for the
  * cases, the criteria and the files). */
 #define _GNU_SOURCE
-#include "cohfrac/stability.h"
+#include "stability.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"

@@ -1,8 +1,8 @@
 /* cohfrac study: error against run time over a grid of settings
- * (include/cohfrac/study.h). */
+ * (src/cli/study.h). */
 #define _GNU_SOURCE
 #include "cohfrac/version.h"
-#include "cohfrac/study.h"
+#include "study.h"
 #include "cohfrac/surface.h"
 #include "cohfrac/world.h"
 
@@ -626,7 +626,7 @@ static cf_status write_md(const cf_study_options *o, const cf_study_result *res,
           "*P err*, *L err* the relative difference of the final linear and angular momentum; "
           "*residual* the case's own energy-ledger residual over its initial energy plus work "
           "input; wall time and peak resident memory of the run's process "
-          "(include/cohfrac/study.h gives the exact definitions).\n\n",
+          "(src/cli/study.h gives the exact definitions).\n\n",
           m);
     fputs("| case |", m);
     for (int a = 0; a < n_ax; a++)

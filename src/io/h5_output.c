@@ -1,7 +1,7 @@
 /* cohfrac — HDF5 output in an H5MD-style layout (docs/output.md), plus an XDMF 3
  * sidecar so ParaView can play the fragment centres back over time.
  *
- * The layout is documented in include/cohfrac/h5_output.h.  Choices made
+ * The layout is documented in src/io/include/cohfrac/h5_output.h.  Choices made
  * here, and why:
  *   - Every dataset is chunked and extendable; the per-fragment series are
  *     [T][N](,k) with both T and N unlimited and an HDF5 fill value (NaN, or

@@ -1,4 +1,4 @@
-/* Reading back a run's HDF5 output (layout in include/cohfrac/h5_output.h)
+/* Reading back a run's HDF5 output (layout in src/io/include/cohfrac/h5_output.h)
  * for the studies: fragment trajectories, the family tree, and the first
  * and last sample of the observables a study compares. */
 #ifndef COHFRAC_TRAJECTORY_H
