@@ -152,6 +152,12 @@ static void test_check_names_the_key(void **state)
         {"bodies[1].scale", CF_ERR_SCENE_VALUE},   {"bodies[1].tet_mesh", CF_ERR_SCENE_VALUE},
         {"obstacles[1].normal", CF_ERR_SCENE_VALUE}, {"solver.pbd.iterations", CF_ERR_SCENE_VALUE},
         {"solver.dt_fracture", CF_ERR_SCENE_VALUE}, {"bodies", CF_ERR_SCENE_VALUE},
+        /* each obstacle kind checks its own parameters (obstacle_<type>.c) */
+        {"obstacles[1].radius", CF_ERR_SCENE_VALUE},
+        {"obstacles[1].half_extents", CF_ERR_SCENE_VALUE},
+        {"obstacles[1]", CF_ERR_SCENE_VALUE},
+        {"obstacles[1].type", CF_ERR_SCENE_VALUE},
+        {"obstacles[1].friction", CF_ERR_SCENE_VALUE},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cf_world_def def = api_scene(&box, &body, &ground);
@@ -164,6 +170,11 @@ static void test_check_names_the_key(void **state)
         case 5: def.solver.iterations = 0; break;
         case 6: def.solver.dt_fracture = 1; break;
         case 7: def.n_bodies = 0; break;
+        case 8: ground = cf_default_obstacle(CF_OBSTACLE_SPHERE); break; /* radius 0 */
+        case 9: ground = cf_default_obstacle(CF_OBSTACLE_BOX); break;    /* half-extents 0 */
+        case 10: ground = cf_default_obstacle(CF_OBSTACLE_MESH); break;  /* no triangle */
+        case 11: ground.type = (cf_obstacle_type)CF_OBSTACLE_TYPE_COUNT; break;
+        case 12: ground.friction = -1; break;
         }
         cf_error err = {0};
         cf_world *w = (cf_world *)&err; /* must come back NULL */

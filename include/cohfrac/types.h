@@ -98,12 +98,24 @@ typedef struct cf_boundary {
     double velocity[3];          /* m/s (zero when fixed) */
 } cf_boundary;
 
+/* The obstacle types, X(NAME, name): CF_OBSTACLE_NAME, the scene's
+ * `type = "name"` and the engine's kind cf_obstacle_name
+ * (src/engine/obstacle_name.c).  A new type is a line here, its parameters
+ * in cf_obstacle, its file, and its keys in the scene reader
+ * (docs/architecture.md). */
+#define CF_OBSTACLE_TYPES(X) X(PLANE, plane) X(SPHERE, sphere) X(BOX, box) X(MESH, mesh)
+
 typedef enum {
-    CF_OBSTACLE_PLANE,
-    CF_OBSTACLE_SPHERE,
-    CF_OBSTACLE_BOX,
-    CF_OBSTACLE_MESH
+#define CF_OBSTACLE_ENUM_(NAME, name) CF_OBSTACLE_##NAME,
+    CF_OBSTACLE_TYPES(CF_OBSTACLE_ENUM_)
+#undef CF_OBSTACLE_ENUM_
 } cf_obstacle_type;
+
+/* How many types there are (not a value of cf_obstacle_type, so that a
+ * switch over the types that misses one is still warned about). */
+#define CF_OBSTACLE_ONE_(NAME, name) +1
+enum { CF_OBSTACLE_TYPE_COUNT = 0 CF_OBSTACLE_TYPES(CF_OBSTACLE_ONE_) };
+#undef CF_OBSTACLE_ONE_
 
 typedef struct cf_obstacle {
     cf_obstacle_type type;

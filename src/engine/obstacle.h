@@ -40,12 +40,19 @@ typedef struct cf_obstacle_kind {
      * CF_ERR_NOMEM. */
     cf_status (*prepare)(cf_obstacles *obs, int j, const cf_obstacle *def, cfb_world *bullet,
                          int *body, cf_error *err);
+    /* Check the type's own parameters of obstacle j (cf_world_def_check;
+     * friction and restitution are checked for every type).  Errors:
+     * CF_ERR_SCENE_VALUE naming the key (def_check.h). */
+    cf_status (*check)(int j, const cf_obstacle *o, cf_error *err);
 } cf_obstacle_kind;
 
-extern const cf_obstacle_kind cf_obstacle_plane, cf_obstacle_sphere, cf_obstacle_box,
-    cf_obstacle_mesh;
+/* One kind per line of CF_OBSTACLE_TYPES (cohfrac/types.h). */
+#define CF_OBSTACLE_KIND_(NAME, name) extern const cf_obstacle_kind cf_obstacle_##name;
+CF_OBSTACLE_TYPES(CF_OBSTACLE_KIND_)
+#undef CF_OBSTACLE_KIND_
 
-/* The kind of obstacle type `type` (the table in obstacles.c). */
+/* The kind of obstacle type `type` (the table in obstacles.c), NULL for
+ * a value outside cf_obstacle_type. */
 const cf_obstacle_kind *cf_obstacle_kind_of(cf_obstacle_type type);
 
 /* Set up every obstacle of `def` (obs->o must point at the world's copy of

@@ -2,6 +2,8 @@
  * t = 0, half extents, velocity. */
 #include "obstacle.h"
 
+#include "def_check.h"
+
 #include "linalg.h"
 
 #include <math.h>
@@ -39,5 +41,14 @@ static int bullet_body(cfb_world *w, const cf_obstacle *o)
                        o->restitution);
 }
 
+static cf_status check(int j, const cf_obstacle *o, cf_error *err)
+{
+    char key[96];
+    for (int k = 0; k < 3; k++)
+        CHECK(cf_obstacle_key(key, sizeof key, j, "half_extents"), o->half_extents[k],
+              CF_POSITIVE);
+    return CF_OK;
+}
+
 const cf_obstacle_kind cf_obstacle_box = {
-    distance, cf_obstacle_kinematic_velocity, bullet_body, NULL};
+    distance, cf_obstacle_kinematic_velocity, bullet_body, NULL, check};

@@ -3,6 +3,8 @@
  * of the surface's size behind it (deeper nodes have gone through). */
 #include "obstacle.h"
 
+#include "def_check.h"
+
 #include "linalg.h"
 
 #include <math.h>
@@ -54,5 +56,27 @@ static cf_status prepare(cf_obstacles *obs, int j, const cf_obstacle *o, cfb_wor
     return CF_OK;
 }
 
+/* Besides the placement, the surface must be there and index its own
+ * vertices: the set-up hands it to FCL and Bullet as it is. */
+static cf_status check(int j, const cf_obstacle *o, cf_error *err)
+{
+    char key[96];
+    CHECK(cf_obstacle_key(key, sizeof key, j, "scale"), o->scale, CF_POSITIVE);
+    cf_status st = cf_check_unit(cf_obstacle_key(key, sizeof key, j, "orientation"),
+                                 o->orientation, 4, err);
+    if (st == CF_OK && (!o->vertices || !o->triangles || o->n_triangles < 1))
+        st = cf_error_set(err, CF_ERR_SCENE_VALUE,
+                          "'obstacles[%d]' (mesh %s) has no triangle: give vertices and "
+                          "triangles, or let mesh preparation read `file` "
+                          "(cf_world_meshes_load)",
+                          j + 1, o->file[0] ? o->file : "without a file");
+    for (int i = 0; st == CF_OK && i < 3 * o->n_triangles; i++)
+        if (o->triangles[i] < 0 || o->triangles[i] >= o->n_vertices)
+            st = cf_error_set(err, CF_ERR_SCENE_VALUE,
+                              "obstacles[%d]: triangle %d uses vertex %d, outside [0, %d)",
+                              j + 1, i / 3, o->triangles[i], o->n_vertices);
+    return st;
+}
+
 const cf_obstacle_kind cf_obstacle_mesh = {
-    distance, cf_obstacle_static_velocity, NULL, prepare};
+    distance, cf_obstacle_static_velocity, NULL, prepare, check};

@@ -2,6 +2,8 @@
  * radius, velocity. */
 #include "obstacle.h"
 
+#include "def_check.h"
+
 #include "linalg.h"
 
 static double distance(const cf_obstacles *obs, int j, double t, const double p[3],
@@ -22,5 +24,12 @@ static int bullet_body(cfb_world *w, const cf_obstacle *o)
     return cfb_add_sphere(w, o->center, o->radius, o->velocity, o->friction, o->restitution);
 }
 
+static cf_status check(int j, const cf_obstacle *o, cf_error *err)
+{
+    char key[96];
+    CHECK(cf_obstacle_key(key, sizeof key, j, "radius"), o->radius, CF_POSITIVE);
+    return CF_OK;
+}
+
 const cf_obstacle_kind cf_obstacle_sphere = {
-    distance, cf_obstacle_kinematic_velocity, bullet_body, NULL};
+    distance, cf_obstacle_kinematic_velocity, bullet_body, NULL, check};

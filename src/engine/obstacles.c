@@ -10,11 +10,10 @@
 
 const cf_obstacle_kind *cf_obstacle_kind_of(cf_obstacle_type type)
 {
-    static const cf_obstacle_kind *const kinds[] = {
-        [CF_OBSTACLE_PLANE] = &cf_obstacle_plane,
-        [CF_OBSTACLE_SPHERE] = &cf_obstacle_sphere,
-        [CF_OBSTACLE_BOX] = &cf_obstacle_box,
-        [CF_OBSTACLE_MESH] = &cf_obstacle_mesh,
+    static const cf_obstacle_kind *const kinds[CF_OBSTACLE_TYPE_COUNT] = {
+#define CF_OBSTACLE_ENTRY_(NAME, name) [CF_OBSTACLE_##NAME] = &cf_obstacle_##name,
+        CF_OBSTACLE_TYPES(CF_OBSTACLE_ENTRY_)
+#undef CF_OBSTACLE_ENTRY_
     };
     return (unsigned)type < sizeof kinds / sizeof kinds[0] ? kinds[type] : NULL;
 }

@@ -2,6 +2,8 @@
  * cohfrac/scene.h) and the check cf_world_create runs on what a program or
  * the scene loader filled in. */
 #include "cohfrac/types.h"
+#include "def_check.h"
+#include "obstacle.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -99,54 +101,14 @@ cf_world_def cf_default_world_def(void)
     return d;
 }
 
-/* An allowed interval, worded as the scene loader words it. */
-typedef struct interval {
-    double lo, hi;
-    int lo_closed, hi_closed;
-} interval;
-
-static const interval POSITIVE = {0.0, INFINITY, 0, 0};
-static const interval NON_NEGATIVE = {0.0, INFINITY, 1, 0};
-static const interval FRICTION_ANGLE = {0.0, 60.0, 1, 1}; /* degrees */
-static const interval AT_LEAST_ONE = {1.0, INFINITY, 1, 0};
-static const interval UNIT = {0.0, 1.0, 1, 1};
-static const interval POISSON = {-1.0, 0.5, 0, 0};
-static const interval PPR_SHAPE = {1.0, INFINITY, 0, 0};
-static const interval ITERATIONS = {1.0, CF_MAX_ITERATIONS, 1, 1};
-static const interval PIECE_TETS = {0.0, CF_MAX_PIECE_TETS, 1, 1};
-
-static cf_status in_interval(const char *key, double v, const interval *r, cf_error *err)
-{
-    int ok = (r->lo_closed ? v >= r->lo : v > r->lo) && (r->hi_closed ? v <= r->hi : v < r->hi);
-    if (ok)
-        return CF_OK;
-    char rule[96];
-    if (isinf(r->hi))
-        snprintf(rule, sizeof rule, "%s %g", r->lo_closed ? ">=" : ">", r->lo);
-    else
-        snprintf(rule, sizeof rule, "in %c%g, %g%c", r->lo_closed ? '[' : '(', r->lo, r->hi,
-                 r->hi_closed ? ']' : ')');
-    return cf_error_set(err, CF_ERR_SCENE_VALUE, "'%s' must be %s, got %.17g", key, rule, v);
-}
-
-#define CHECK(key, value, range)                                                             \
-    do {                                                                                     \
-        cf_status st_ = in_interval(key, (double)(value), &(range), err);                    \
-        if (st_ != CF_OK)                                                                    \
-            return st_;                                                                      \
-    } while (0)
-
-static cf_status check_unit(const char *key, const double *v, int n, cf_error *err)
-{
-    double q = 0;
-    for (int i = 0; i < n; i++)
-        q += v[i] * v[i];
-    if (fabs(q - 1.0) > 1e-9)
-        return cf_error_set(err, CF_ERR_SCENE_VALUE,
-                            "'%s' must be a unit %s (length 1), got length %.17g", key,
-                            n == 4 ? "quaternion" : "vector", sqrt(q));
-    return CF_OK;
-}
+/* The allowed intervals of settings beyond def_check.h's. */
+static const cf_interval FRICTION_ANGLE = {0.0, 60.0, 1, 1}; /* degrees */
+static const cf_interval AT_LEAST_ONE = {1.0, INFINITY, 1, 0};
+static const cf_interval UNIT = {0.0, 1.0, 1, 1};
+static const cf_interval POISSON = {-1.0, 0.5, 0, 0};
+static const cf_interval PPR_SHAPE = {1.0, INFINITY, 0, 0};
+static const cf_interval ITERATIONS = {1.0, CF_MAX_ITERATIONS, 1, 1};
+static const cf_interval PIECE_TETS = {0.0, CF_MAX_PIECE_TETS, 1, 1};
 
 static cf_status check_mesh(int b, const cf_mesh *m, cf_error *err)
 {
@@ -169,44 +131,16 @@ static cf_status check_mesh(int b, const cf_mesh *m, cf_error *err)
 
 static cf_status check_obstacle(int j, const cf_obstacle *o, cf_error *err)
 {
-    char key[96];
-#define OKEY(name) (snprintf(key, sizeof key, "obstacles[%d].%s", j + 1, name), key)
-    cf_status st = CF_OK;
-    switch (o->type) {
-    case CF_OBSTACLE_PLANE:
-        st = check_unit(OKEY("normal"), o->normal, 3, err);
-        break;
-    case CF_OBSTACLE_SPHERE:
-        CHECK(OKEY("radius"), o->radius, POSITIVE);
-        break;
-    case CF_OBSTACLE_BOX:
-        for (int k = 0; k < 3; k++)
-            CHECK(OKEY("half_extents"), o->half_extents[k], POSITIVE);
-        break;
-    case CF_OBSTACLE_MESH:
-        CHECK(OKEY("scale"), o->scale, POSITIVE);
-        st = check_unit(OKEY("orientation"), o->orientation, 4, err);
-        if (st == CF_OK && (!o->vertices || !o->triangles || o->n_triangles < 1))
-            st = cf_error_set(err, CF_ERR_SCENE_VALUE,
-                              "'obstacles[%d]' (mesh %s) has no triangle: give vertices and "
-                              "triangles, or let mesh preparation read `file` "
-                              "(cf_world_meshes_load)",
-                              j + 1, o->file[0] ? o->file : "without a file");
-        for (int i = 0; st == CF_OK && i < 3 * o->n_triangles; i++)
-            if (o->triangles[i] < 0 || o->triangles[i] >= o->n_vertices)
-                st = cf_error_set(err, CF_ERR_SCENE_VALUE,
-                                  "obstacles[%d]: triangle %d uses vertex %d, outside [0, %d)",
-                                  j + 1, i / 3, o->triangles[i], o->n_vertices);
-        break;
-    default:
+    const cf_obstacle_kind *kind = cf_obstacle_kind_of(o->type);
+    if (!kind)
         return cf_error_set(err, CF_ERR_SCENE_VALUE, "'obstacles[%d].type' is not a known type",
                             j + 1);
-    }
+    cf_status st = kind->check(j, o, err);
     if (st != CF_OK)
         return st;
-    CHECK(OKEY("friction"), o->friction, NON_NEGATIVE);
-    CHECK(OKEY("restitution"), o->restitution, NON_NEGATIVE);
-#undef OKEY
+    char key[96];
+    CHECK(cf_obstacle_key(key, sizeof key, j, "friction"), o->friction, CF_NON_NEGATIVE);
+    CHECK(cf_obstacle_key(key, sizeof key, j, "restitution"), o->restitution, CF_NON_NEGATIVE);
     return CF_OK;
 }
 
@@ -214,25 +148,25 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
 {
     const cf_material *m = &d->material;
     const cf_solver_settings *s = &d->solver;
-    CHECK("duration", d->duration, POSITIVE);
-    CHECK("material.E", m->E, POSITIVE);
+    CHECK("duration", d->duration, CF_POSITIVE);
+    CHECK("material.E", m->E, CF_POSITIVE);
     CHECK("material.nu", m->nu, POISSON);
-    CHECK("material.rho", m->rho, POSITIVE);
-    CHECK("material.G_I", m->G_I, POSITIVE);
-    CHECK("material.G_II", m->G_II, POSITIVE);
-    CHECK("material.sigma_max", m->sigma_max, POSITIVE);
-    CHECK("material.tau_max", m->tau_max, POSITIVE);
+    CHECK("material.rho", m->rho, CF_POSITIVE);
+    CHECK("material.G_I", m->G_I, CF_POSITIVE);
+    CHECK("material.G_II", m->G_II, CF_POSITIVE);
+    CHECK("material.sigma_max", m->sigma_max, CF_POSITIVE);
+    CHECK("material.tau_max", m->tau_max, CF_POSITIVE);
     CHECK("material.alpha", m->alpha, PPR_SHAPE);
     CHECK("material.beta", m->beta, PPR_SHAPE);
-    CHECK("material.friction", m->friction, NON_NEGATIVE);
+    CHECK("material.friction", m->friction, CF_NON_NEGATIVE);
     CHECK("material.restitution", m->restitution, UNIT);
-    CHECK("material.strength.modulus", m->weibull_modulus, POSITIVE);
-    CHECK("material.strength.area", m->strength_area, NON_NEGATIVE);
-    CHECK("material.nucleation_radius", m->nucleation_radius, NON_NEGATIVE);
+    CHECK("material.strength.modulus", m->weibull_modulus, CF_POSITIVE);
+    CHECK("material.strength.area", m->strength_area, CF_NON_NEGATIVE);
+    CHECK("material.nucleation_radius", m->nucleation_radius, CF_NON_NEGATIVE);
     CHECK("material.internal_friction_angle", m->internal_friction_angle, FRICTION_ANGLE);
-    CHECK("solver.dt_rigid", s->dt_rigid, POSITIVE);
+    CHECK("solver.dt_rigid", s->dt_rigid, CF_POSITIVE);
     CHECK("solver.rigid_substeps", s->rigid_substeps, ITERATIONS);
-    CHECK("solver.dt_fracture", s->dt_fracture, POSITIVE);
+    CHECK("solver.dt_fracture", s->dt_fracture, CF_POSITIVE);
     if (s->dt_rigid > d->duration)
         return cf_error_set(err, CF_ERR_SCENE_VALUE,
                             "'solver.dt_rigid' (%g s) exceeds 'duration' (%g s): the run is "
@@ -248,32 +182,32 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
         return cf_error_set(err, CF_ERR_SCENE_VALUE,
                             "'solver.dt_fracture' must not exceed solver.dt_rigid (%g), got %g",
                             s->dt_rigid, s->dt_fracture);
-    CHECK("solver.cfl_fraction", s->cfl_fraction, NON_NEGATIVE);
+    CHECK("solver.cfl_fraction", s->cfl_fraction, CF_NON_NEGATIVE);
     CHECK("solver.check_interval", s->check_interval, AT_LEAST_ONE);
     CHECK("solver.quiet_steps", s->quiet_steps, AT_LEAST_ONE);
     CHECK("solver.min_piece_tets", s->min_piece_tets, PIECE_TETS);
-    CHECK("solver.min_piece_size", s->min_piece_size, NON_NEGATIVE);
+    CHECK("solver.min_piece_size", s->min_piece_size, CF_NON_NEGATIVE);
     CHECK("solver.debris_tets", s->debris_tets, PIECE_TETS);
-    CHECK("solver.debris_size", s->debris_size, NON_NEGATIVE);
-    CHECK("solver.max_fracture_time", s->max_fracture_time, POSITIVE);
-    CHECK("solver.impact_threshold", s->impact_threshold, NON_NEGATIVE);
-    CHECK("solver.sleeping.linear", s->sleep_linear, NON_NEGATIVE);
-    CHECK("solver.sleeping.angular", s->sleep_angular, NON_NEGATIVE);
+    CHECK("solver.debris_size", s->debris_size, CF_NON_NEGATIVE);
+    CHECK("solver.max_fracture_time", s->max_fracture_time, CF_POSITIVE);
+    CHECK("solver.impact_threshold", s->impact_threshold, CF_NON_NEGATIVE);
+    CHECK("solver.sleeping.linear", s->sleep_linear, CF_NON_NEGATIVE);
+    CHECK("solver.sleeping.angular", s->sleep_angular, CF_NON_NEGATIVE);
     CHECK("solver.pbd.k_stiffness", s->k_stiffness, UNIT);
     CHECK("solver.pbd.iterations", s->iterations, ITERATIONS);
     CHECK("solver.pbd.k_damping", s->k_damping, UNIT);
-    CHECK("solver.xpbd.compliance_scale", s->compliance_scale, POSITIVE);
-    CHECK("solver.contact_stiffness", s->contact_stiffness, NON_NEGATIVE);
+    CHECK("solver.xpbd.compliance_scale", s->compliance_scale, CF_POSITIVE);
+    CHECK("solver.contact_stiffness", s->contact_stiffness, CF_NON_NEGATIVE);
     CHECK("solver.mass_scaling", s->mass_scaling, UNIT);
     CHECK("solver.guard.max_inverted_fraction", s->max_inverted_fraction, UNIT);
-    CHECK("solver.guard.max_energy_growth", s->max_energy_growth, POSITIVE);
-    CHECK("solver.threads", s->threads, NON_NEGATIVE);
-    CHECK("output.frame_interval", d->output.frame_interval, POSITIVE);
+    CHECK("solver.guard.max_energy_growth", s->max_energy_growth, CF_POSITIVE);
+    CHECK("solver.threads", s->threads, CF_NON_NEGATIVE);
+    CHECK("output.frame_interval", d->output.frame_interval, CF_POSITIVE);
     if (s->has_crack_plane) {
-        cf_status st = check_unit("solver.crack_plane.normal", s->crack_plane_normal, 3, err);
+        cf_status st = cf_check_unit("solver.crack_plane.normal", s->crack_plane_normal, 3, err);
         if (st != CF_OK)
             return st;
-        CHECK("solver.crack_plane.tolerance", s->crack_plane_tolerance, POSITIVE);
+        CHECK("solver.crack_plane.tolerance", s->crack_plane_tolerance, CF_POSITIVE);
     }
     if (d->n_bodies < 1 || !d->bodies)
         return cf_error_set(err, CF_ERR_SCENE_VALUE,
@@ -281,9 +215,9 @@ cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
     for (int b = 0; b < d->n_bodies; b++) {
         char key[64];
         snprintf(key, sizeof key, "bodies[%d].scale", b + 1);
-        CHECK(key, d->bodies[b].scale, POSITIVE);
+        CHECK(key, d->bodies[b].scale, CF_POSITIVE);
         snprintf(key, sizeof key, "bodies[%d].orientation", b + 1);
-        cf_status st = check_unit(key, d->bodies[b].orientation, 4, err);
+        cf_status st = cf_check_unit(key, d->bodies[b].orientation, 4, err);
         if (st == CF_OK)
             st = check_mesh(b, d->bodies[b].tet_mesh, err);
         if (st != CF_OK)

@@ -99,7 +99,11 @@ static const char *const output_keys[] = {"file", "frame_interval", "cracks", "f
 static const char *const primitive_names[] = {"box", "sphere", "hollow_sphere", "plate",
                                               "notched_beam"};
 static const char *const region_names[] = {"box", "plane", "group"};
-static const char *const obstacle_names[] = {"plane", "sphere", "box", "mesh"};
+static const char *const obstacle_names[] = {
+#define CF_OBSTACLE_NAME_(NAME, name) #name,
+    CF_OBSTACLE_TYPES(CF_OBSTACLE_NAME_)
+#undef CF_OBSTACLE_NAME_
+};
 static const char *const mode_names[] = {"hybrid", "fracture"};
 static const char *const backend_names[] = {"bullet", "pbd"};
 static const char *const elasticity_names[] = {"corotational", "linear"};
@@ -112,9 +116,6 @@ _Static_assert(CF_PRIM_NONE == 0 && CF_PRIM_BOX == 1 && CF_PRIM_SPHERE == 2 &&
                "primitive_names follows cf_primitive_type");
 _Static_assert(CF_REGION_BOX == 0 && CF_REGION_PLANE == 1 && CF_REGION_GROUP == 2,
                "region_names follows cf_region_type");
-_Static_assert(CF_OBSTACLE_PLANE == 0 && CF_OBSTACLE_SPHERE == 1 && CF_OBSTACLE_BOX == 2 &&
-                   CF_OBSTACLE_MESH == 3,
-               "obstacle_names follows cf_obstacle_type");
 _Static_assert(CF_RUN_HYBRID == 0 && CF_RUN_FRACTURE == 1, "mode_names follows cf_run_mode");
 _Static_assert(CF_RIGID_BULLET == 0 && CF_RIGID_PBD == 1, "backend_names follows cf_rigid_backend");
 _Static_assert(CF_ELASTICITY_COROTATIONAL == 0 && CF_ELASTICITY_LINEAR == 1,
