@@ -18,6 +18,7 @@
 #include "check.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -188,11 +189,59 @@ static void test_check_names_the_key(void **state)
     }
 }
 
+static void record_threads(void *user, double t)
+{
+    (void)t;
+    *(int *)user = omp_get_max_threads();
+}
+
+/* Each world runs its loops on its own thread count, and neither creating
+ * nor stepping one changes the caller's OpenMP setting or another world's. */
+static void test_threads_are_the_worlds(void **state)
+{
+    (void)state;
+    cf_mesh box[2];
+    cf_body_def body[2];
+    cf_obstacle ground[2];
+    cf_world *w[2] = {NULL, NULL};
+    int seen[2] = {0, 0};
+    omp_set_num_threads(3);
+    for (int i = 0; i < 2; i++) {
+        cf_world_def def = api_scene(&box[i], &body[i], &ground[i]);
+        def.solver.mode = CF_RUN_FRACTURE; /* every step ticks from inside */
+        def.solver.constraints = CF_CONSTRAINTS_NONE;
+        def.solver.cfl_fraction = 0.5;
+        def.solver.threads = i == 0 ? 1 : 0; /* 0: the caller's setting, 3 */
+        cf_error err = {0};
+        assert_int_equal(cf_world_create(&def, &w[i], &err), CF_OK);
+        assert_int_equal(omp_get_max_threads(), 3);
+        cf_world_set_tick(w[i], record_threads, &seen[i]);
+    }
+    cf_world_set_threads(w[1], 2);
+    for (int k = 0; k < 2; k++)
+        for (int i = 0; i < 2; i++) {
+            cf_error err = {0};
+            assert_int_equal(cf_world_step(w[i], &err), CF_OK);
+            assert_int_equal(omp_get_max_threads(), 3);
+        }
+    assert_int_equal(seen[0], 1);
+    assert_int_equal(seen[1], 2);
+    cf_world_stats ws;
+    cf_world_stats_get(w[0], &ws);
+    assert_int_equal(ws.threads, 1);
+    assert_true(cf_world_state_hash(w[0]) == cf_world_state_hash(w[1]));
+    for (int i = 0; i < 2; i++) {
+        cf_world_destroy(w[i]);
+        cf_mesh_free(&box[i]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_api_world_equals_lua_scene),
         cmocka_unit_test(test_check_names_the_key),
+        cmocka_unit_test(test_threads_are_the_worlds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

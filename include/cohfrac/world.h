@@ -51,8 +51,10 @@ typedef struct cf_ledger {
  * boundary conditions, obstacles, the initial fragments (one per connected
  * piece of each body, a Bullet body each in hybrid runs with the Bullet
  * backend).  What the world needs of `def` is copied: `def` and the meshes
- * it points to may be freed after the call.  Threads: def->solver.threads
- * (0: all cores; it sets OpenMP's default for the process).
+ * it points to may be freed after the call.  Threads: the world's own,
+ * def->solver.threads (0: the calling thread's OpenMP setting now, all
+ * cores by default); its steps run their loops on them and leave the
+ * caller's OpenMP setting as it was.
  * Errors: those of cf_world_def_check; CF_ERR_SCENE_VALUE for a boundary
  * region that selects no node or a crack plane with no facet on it;
  * CF_ERR_MESH_* for a mesh that fails its checks; CF_ERR_EXTERNAL (Bullet,
@@ -71,9 +73,9 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
 cf_status cf_world_step(cf_world *w, cf_error *err);
 int cf_world_done(const cf_world *w);
 
-/* Threads for the element loops from the next step on (n >= 1; the
- * calling thread's OpenMP setting).  The results do not depend on it: the
- * state hash is the same for any count. */
+/* Threads for this world's element loops from the next step on (n >= 1;
+ * other worlds and the caller's OpenMP setting keep theirs).  The results
+ * do not depend on it: the state hash is the same for any count. */
 void cf_world_set_threads(cf_world *w, int n);
 
 /* A heartbeat inside a long rigid step, for progress displays: fn(user, t)

@@ -506,9 +506,10 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
     const cf_world_def *scene = &sim->def;
     sim->wall_start = cf_wall_time();
     sim->bullet_base = cfb_allocated_bytes();
-    if (scene->solver.threads > 0)
-        omp_set_num_threads(scene->solver.threads);
-    int threads = omp_get_max_threads(), startable = threads_startable(threads);
+    /* The world's own thread count: the process's OpenMP setting is the
+     * caller's, and two worlds may run on different counts. */
+    sim->threads = scene->solver.threads > 0 ? scene->solver.threads : omp_get_max_threads();
+    int threads = sim->threads, startable = threads_startable(threads);
     if (st == CF_OK && startable < threads)
         st = cf_error_set(err, CF_ERR_NOMEM,
                           "cannot start %d threads for the element loops (only %d): the memory "
@@ -1257,9 +1258,8 @@ void cf_world_set_tick(cf_world *sim, cf_world_tick_fn fn, void *user)
 
 void cf_world_set_threads(cf_world *sim, int n)
 {
-    (void)sim;
     if (n >= 1)
-        omp_set_num_threads(n);
+        sim->threads = n;
 }
 
 long cf_world_step_count(const cf_world *sim) { return sim->step; }
@@ -1274,7 +1274,7 @@ double cf_world_dt_fracture(const cf_world *sim) { return sim->dt_fracture; }
 
 double cf_world_dt_cfl(const cf_world *sim) { return sim->solid.dt_cfl; }
 
-cf_status cf_world_step(cf_world *sim, cf_error *err)
+static cf_status world_step(cf_world *sim, cf_error *err)
 {
     cf_profile_start(&sim->prof);
     const cf_world_def *sc = &sim->def;
@@ -1320,6 +1320,17 @@ cf_status cf_world_step(cf_world *sim, cf_error *err)
     return st;
 }
 
+cf_status cf_world_step(cf_world *sim, cf_error *err)
+{
+    /* OpenMP's thread count is the calling thread's setting: the step runs
+     * on the world's and gives the caller back its own. */
+    int caller = omp_get_max_threads();
+    omp_set_num_threads(sim->threads);
+    cf_status st = world_step(sim, err);
+    omp_set_num_threads(caller);
+    return st;
+}
+
 uint64_t cf_world_state_hash(const cf_world *sim)
 {
     const cf_solid *s = &sim->solid;
@@ -1351,7 +1362,7 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     o->mass_total = sim->solid.mass_total;
     o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(sim->solid.mass_scale_max) : 1.0;
     o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
-    o->threads = omp_get_max_threads();
+    o->threads = sim->threads;
     o->alive = alive_fragments(sim, &o->in_fracture);
     o->ever = sim->n_frag;
     o->cohesive = sim->solid.n_coh;

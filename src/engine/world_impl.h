@@ -31,6 +31,7 @@ struct cf_world {
     cfb_world *bullet;       /* NULL for the pbd rigid backend */
     double t;                /* s */
     cf_world_tick_fn tick;   /* heartbeat inside a step (cf_world_set_tick), or NULL */
+    int threads;             /* the element loops' threads (cf_world_set_threads) */
     void *tick_user;
     long step;               /* rigid steps done */
     long n_steps;            /* rigid steps in the scene's duration */
