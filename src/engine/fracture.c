@@ -9,17 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Fragment f's contact cache (contact.h), kept in the world's table, which
- * cf_solver_step makes room in. */
-static cf_contact_cache *cache_of(const cf_world *sim, const cf_fragment *f)
+/* Room for fragment f's scratch and its contact cache *cc. */
+static int ensure_scratch(cf_fragment *f, cf_contact_cache *cc)
 {
-    return &sim->contact.v[f - sim->frag];
-}
-
-static int ensure_scratch(cf_world *sim, cf_fragment *f)
-{
-    if (cf_contact_caches_reserve(&sim->contact, sim->n_frag) ||
-        cf_node_impulses_reserve(&cache_of(sim, f)->push, f->nodes.n))
+    if (cf_node_impulses_reserve(&cc->push, f->nodes.n))
         return -1;
     if (f->pairs_cap < f->coh.n) {
         int cap = f->coh.n + f->coh.n / 2 + 16;
@@ -76,27 +69,27 @@ static int penalty_step(const cf_solver_settings *set, int fracture)
 #define CF_PENALTY_SCALE 0.01 /* k = CF_PENALTY_SCALE m / dt^2 (penalty_chunk) */
 
 /* Half k d^2 over the obstacles node a is under at time t (k from step dt). */
-static double node_springs(const cf_world *sim, int a, double t, double dt)
+static double node_springs(const cf_step_ctx *ctx, int a, double t, double dt)
 {
-    const cf_solid *s = &sim->solid;
+    const cf_solid *s = ctx->solid;
     const double *x = &s->x[3 * a];
-    if (cf_obstacles_clear(&sim->obs, x))
+    if (cf_obstacles_clear(ctx->obs, x))
         return 0;
     double k = CF_PENALTY_SCALE * s->m[a] / (dt * dt), e = 0;
-    for (int o = 0; o < sim->obs.n; o++) {
-        double n[3], d = cf_obstacle_distance(&sim->obs, o, t, x, n);
+    for (int o = 0; o < ctx->obs->n; o++) {
+        double n[3], d = cf_obstacle_distance(ctx->obs, o, t, x, n);
         e += d < 0 ? 0.5 * k * d * d : 0;
     }
     return e;
 }
 
-double cf_fragment_spring_energy(const cf_world *sim, const cf_fragment *f)
+double cf_fragment_spring_energy(const cf_step_ctx *ctx, const cf_fragment *f, double t, double h)
 {
-    if (!penalty_step(&sim->def.solver, 1) || !(sim->h_fracture > 0))
+    if (!penalty_step(&ctx->def->solver, 1) || !(h > 0))
         return 0;
     double e = 0;
     for (int i = 0; i < f->nodes.n; i++)
-        e += node_springs(sim, f->nodes.v[i], sim->t, sim->h_fracture);
+        e += node_springs(ctx, f->nodes.v[i], t, h);
     return e;
 }
 
@@ -110,12 +103,12 @@ double cf_fragment_spring_energy(const cf_world *sim, const cf_fragment *f)
  * the body's load, and would throw a node that now carries only its own
  * share at 0.1 d / dt) are booked as crushing work.  Returns how many tets
  * were crushed, or -1 out of memory. */
-static int crush(cf_world *sim, cf_fragment *f, double t, double dt)
+static int crush(const cf_step_ctx *ctx, cf_fragment *f, double t, double dt)
 {
-    cf_solid *s = &sim->solid;
+    cf_solid *s = ctx->solid;
     double released;
-    sim->crushed.n = 0;
-    int crushed = cf_crush_tets(s, f->tets, f->nt, t, &f->nodes, &sim->touched, &sim->crushed,
+    ctx->crushed->n = 0;
+    int crushed = cf_crush_tets(s, f->tets, f->nt, t, &f->nodes, ctx->touched, ctx->crushed,
                                 &released);
     if (crushed <= 0)
         return crushed;
@@ -130,15 +123,15 @@ static int crush(cf_world *sim, cf_fragment *f, double t, double dt)
     f->coh.n = kept;
     f->separated = -1;
     f->e_strain -= released; /* the tets' part, in this step's sum already */
-    if (!penalty_step(&sim->def.solver, 1))
+    if (!penalty_step(&ctx->def->solver, 1))
         return crushed;
     /* The springs' part was in the last step's sum: it goes to the tet's
      * crushing work. */
-    for (int i = 0; i < sim->crushed.n; i++)
+    for (int i = 0; i < ctx->crushed->n; i++)
         for (int j = 0; j < 4; j++) {
-            int tt = sim->crushed.v[i], a = s->tet[4 * tt + j];
-            s->wp[tt] += node_springs(sim, a, t, dt);
-            cf_obstacles_push_out(&sim->obs, t, &s->x[3 * a]);
+            int tt = ctx->crushed->v[i], a = s->tet[4 * tt + j];
+            s->wp[tt] += node_springs(ctx, a, t, dt);
+            cf_obstacles_push_out(ctx->obs, t, &s->x[3 * a]);
         }
     return crushed;
 }
@@ -146,17 +139,17 @@ static int crush(cf_world *sim, cf_fragment *f, double t, double dt)
 /* Stage insertion_check (source Table 6.2, docs/physics.md §5.1): the
  * facets that meet the criterion at this check (time t, s; n_hot tets
  * above the criterion's bound), then those the growth rule takes, in
- * sim->cand.  Returns how many, or -1 out of memory. */
-static int insertion_check(cf_world *sim, const cf_fragment *f, double t, int n_hot)
+ * ctx->cand.  Returns how many, or -1 out of memory. */
+static int insertion_check(const cf_step_ctx *ctx, const cf_fragment *f, double t, int n_hot)
 {
-    cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->def.solver;
-    int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, &sim->cand);
+    cf_solid *s = ctx->solid;
+    const cf_solver_settings *set = &ctx->def->solver;
+    int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, ctx->cand);
     double d = set->min_piece_size; /* a sphere of diameter d */
     cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets,
                         0.5235987755982988 * d * d * d /* pi d^3 / 6 */, t};
     if (nc > 0)
-        nc = cf_insertion_select(s, &sim->cand, set->criterion, &growth);
+        nc = cf_insertion_select(s, ctx->cand, set->criterion, &growth);
     return nc;
 }
 
@@ -164,19 +157,19 @@ static int insertion_check(cf_world *sim, const cf_fragment *f, double t, int n_
  * cohesive element on each of the nc facets insertion_check chose, with
  * the node duplication that opens them; crushing (crush); the bars of the
  * nodes whose star changed.  *inserted: elements plus crushed tets. */
-static cf_status node_duplication(cf_world *sim, cf_fragment *f, double t, double dt, int nc,
-                                  int *inserted)
+static cf_status node_duplication(const cf_step_ctx *ctx, cf_fragment *f, double t, double dt,
+                                  int nc, int *inserted)
 {
-    cf_solid *s = &sim->solid;
-    sim->touched.n = 0;
+    cf_solid *s = ctx->solid;
+    ctx->touched->n = 0;
     for (int i = 0; i < nc; i++)
-        if (cf_crack_facet(s, sim->cand.v[i], &f->nodes, &sim->touched) ||
+        if (cf_crack_facet(s, ctx->cand->v[i], &f->nodes, ctx->touched) ||
             cf_int_list_push(&f->coh, s->n_coh - 1))
             return CF_ERR_NOMEM;
-    int crushed = crush(sim, f, t, dt);
+    int crushed = crush(ctx, f, t, dt);
     if (crushed < 0)
         return CF_ERR_NOMEM;
-    if (cf_bars_patch(&f->bars, s, sim->touched.v, sim->touched.n, &sim->bar_scratch))
+    if (cf_bars_patch(&f->bars, s, ctx->touched->v, ctx->touched->n, ctx->bar_scratch))
         return CF_ERR_NOMEM;
     *inserted = nc + crushed;
     return CF_OK;
@@ -220,18 +213,19 @@ static double shift_node(cf_solid *s, const cf_fragment *f, int i, const double 
 
 /* What the chunk sums of a step read (chunks.h). */
 typedef struct {
-    cf_world *sim;
+    const cf_step_ctx *ctx;
     cf_fragment *f;
+    cf_contact_cache *cc; /* f's */
     double t_next, dt, dv[3];
     int leapfrog; /* collision_friction: explicit friction moves the node */
     int penalty;  /* obstacles act by the penalty force (penalty_chunk) */
 } step_sums;
 
 /* Whether an obstacle is a triangle mesh: its FCL queries run on one thread. */
-static int mesh_obstacles(const cf_world *sim)
+static int mesh_obstacles(const cf_step_ctx *ctx)
 {
-    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
-        if (sim->obs.mesh[j])
+    for (int j = 0; ctx->obs->mesh && j < ctx->obs->n; j++)
+        if (ctx->obs->mesh[j])
             return 1;
     return 0;
 }
@@ -249,7 +243,7 @@ static int mesh_obstacles(const cf_world *sim)
 static void contact_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const step_sums *c = ctx;
-    cf_solid *s = &c->sim->solid;
+    cf_solid *s = c->ctx->solid;
     cf_fragment *f = c->f;
     int shift = c->dv[0] != 0 || c->dv[1] != 0 || c->dv[2] != 0;
     for (int i = i0; i < i1; i++) {
@@ -258,11 +252,11 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
         int j = f->contact[i];
         if (j < 0)
             continue;
-        const cf_obstacle *o = &c->sim->obs.o[j];
+        const cf_obstacle *o = &c->ctx->obs->o[j];
         double mu = s->mat.friction * o->friction, e = s->mat.restitution * o->restitution;
         int a = f->nodes.v[i];
         double n[3], u[3], vr[3], *va = &s->v[3 * a];
-        cf_obstacle_distance(&c->sim->obs, j, c->t_next, &s->x[3 * a], n);
+        cf_obstacle_distance(c->ctx->obs, j, c->t_next, &s->x[3 * a], n);
         cf_obstacle_velocity(o, u);
         v3_sub(va, u, vr);
         double vn = v3_dot(vr, n), vt[3];
@@ -299,12 +293,14 @@ static void contact_chunk(void *ctx, int i0, int i1, double *acc)
  * (contact_chunk), after each node's velocity is shifted by dv (the speed
  * cap's momentum, from velocity_update; zero: none); the shift's energy is
  * booked with the projection's. */
-static double collision_friction(cf_world *sim, cf_fragment *f, double t, double dt, int leapfrog,
-                                 int penalty, const double dv[3])
+static double collision_friction(const cf_step_ctx *ctx, cf_fragment *f, cf_contact_cache *cc,
+                                 double t, double dt, int leapfrog, int penalty,
+                                 const double dv[3])
 {
-    step_sums c = {sim, f, t, dt, {dv[0], dv[1], dv[2]}, leapfrog, penalty};
+    step_sums c = {.ctx = ctx, .f = f, .cc = cc, .t_next = t, .dt = dt,
+                   .dv = {dv[0], dv[1], dv[2]}, .leapfrog = leapfrog, .penalty = penalty};
     double sums[3]; /* removed, of which the obstacles' work; the shift's */
-    cf_sum_chunks(f->nodes.n, 3, !mesh_obstacles(sim), contact_chunk, &c, sums);
+    cf_sum_chunks(f->nodes.n, 3, !mesh_obstacles(ctx), contact_chunk, &c, sums);
     f->pending.obstacles += sums[1];
     f->pending.pbd += sums[2];
     return sums[0];
@@ -314,10 +310,10 @@ static double collision_friction(cf_world *sim, cf_fragment *f, double t, double
  * into the prediction p = x + dt v when `on_p` is set.  Returns the work of
  * the reaction that restores p (J): the impulse m dp/dt times the node's
  * prescribed velocity. */
-static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
+static double impose_boundary(const cf_step_ctx *ctx, int a, double dt, int on_p)
 {
-    cf_solid *s = &sim->solid;
-    const cf_boundary *bc = &sim->def.boundaries[s->bc[a]];
+    cf_solid *s = ctx->solid;
+    const cf_boundary *bc = &ctx->def->boundaries[s->bc[a]];
     double work = 0;
     for (int k = 0; k < 3; k++)
         if (bc->axes & (1 << k)) {
@@ -348,9 +344,9 @@ static double impose_boundary(cf_world *sim, int a, double dt, int on_p)
 static void penalty_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const step_sums *c = ctx;
-    cf_solid *s = &c->sim->solid;
+    cf_solid *s = c->ctx->solid;
     cf_fragment *f = c->f;
-    const cf_obstacles *obs = &c->sim->obs;
+    const cf_obstacles *obs = c->ctx->obs;
     for (int i = i0; i < i1; i++) {
         int a = f->nodes.v[i];
         const double *x = &s->x[3 * a];
@@ -378,10 +374,10 @@ static void penalty_chunk(void *ctx, int i0, int i1, double *acc)
  * x_n (corotational or Neo-Hookean forces per tet, rotation, inverted
  * tets; the stress too when `check`), and the strain energy.  Returns how
  * many tets are above the criterion's bound (cf_tet4_forces). */
-static int elasticity(cf_world *sim, cf_fragment *f, int check)
+static int elasticity(const cf_step_ctx *ctx, cf_fragment *f, int check)
 {
-    cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->def.solver;
+    cf_solid *s = ctx->solid;
+    const cf_solver_settings *set = &ctx->def->solver;
     cf_stress_check bound = cf_insertion_bound(s, set->criterion);
     int n_hot = 0;
     f->n_inverted = cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check ? &bound : NULL,
@@ -392,31 +388,31 @@ static int elasticity(cf_world *sim, cf_fragment *f, int check)
 
 /* Stage elasticity, its second part: the tets' forces gathered at the
  * nodes, with gravity: f = m g - f_int. */
-static void elasticity_scatter(cf_world *sim, cf_fragment *f)
+static void elasticity_scatter(const cf_step_ctx *ctx, cf_fragment *f)
 {
-    cf_tet4_scatter(&sim->solid, f->tets, f->nt, f->nodes.v, f->nodes.n, sim->def.gravity);
+    cf_tet4_scatter(ctx->solid, f->tets, f->nt, f->nodes.v, f->nodes.n, ctx->def->gravity);
 }
 
 /* Stage cohesive_forces (docs/physics.md §6): the PPR tractions of f's
  * cohesive elements and, in explicit runs, the crack faces' compression
  * penalty, added to the node forces (with PBD the faces are kept apart by
  * a constraint in pbd_projection instead). */
-static void cohesive_forces(cf_world *sim, cf_fragment *f, double dt)
+static void cohesive_forces(const cf_step_ctx *ctx, cf_fragment *f, double dt)
 {
-    const cf_solver_settings *set = &sim->def.solver;
+    const cf_solver_settings *set = &ctx->def->solver;
     double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;
-    cf_cohesive_forces(&sim->solid, sim->law, sim->law_params, f->coh.v, f->coh.n, dt, kp,
+    cf_cohesive_forces(ctx->solid, ctx->law, ctx->law_params, f->coh.v, f->coh.n, dt, kp,
                        f->pairs);
 }
 
 /* Stage collision, as a force (explicit runs with the penalty contact,
  * docs/physics.md §7.1): penalty_chunk on every node; the springs' energy
  * goes with the strain energy. */
-static void collision_forces(cf_world *sim, cf_fragment *f, double t, double dt)
+static void collision_forces(const cf_step_ctx *ctx, cf_fragment *f, double t, double dt)
 {
-    step_sums c = {sim, f, t, dt, {0, 0, 0}, 1, 1};
+    step_sums c = {.ctx = ctx, .f = f, .t_next = t, .dt = dt, .leapfrog = 1, .penalty = 1};
     double e[2]; /* the springs' energy; moving obstacles' work */
-    cf_sum_chunks(f->nodes.n, 2, !mesh_obstacles(sim), penalty_chunk, &c, e);
+    cf_sum_chunks(f->nodes.n, 2, !mesh_obstacles(ctx), penalty_chunk, &c, e);
     f->e_strain += e[0];
     f->pending.obstacles += e[1];
 }
@@ -426,7 +422,7 @@ static void collision_forces(cf_world *sim, cf_fragment *f, double t, double dt)
 static void kinetic_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const step_sums *c = ctx;
-    const cf_solid *s = &c->sim->solid;
+    const cf_solid *s = c->ctx->solid;
     const cf_fragment *f = c->f;
     for (int i = i0; i < i1; i++) {
         int a = f->nodes.v[i];
@@ -442,7 +438,7 @@ static void kinetic_chunk(void *ctx, int i0, int i1, double *acc)
 static void kick_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const step_sums *c = ctx;
-    cf_solid *s = &c->sim->solid;
+    cf_solid *s = c->ctx->solid;
     const cf_fragment *f = c->f;
     for (int i = i0; i < i1; i++) {
         int a = f->nodes.v[i];
@@ -456,12 +452,12 @@ static void kick_chunk(void *ctx, int i0, int i1, double *acc)
 /* v <- v + dt M^-1 f, prescribed velocities, global damping (pbd rigid
  * mode); the ledger's kinetic energy and the boundary and damping work.
  * Returns the number of prescribed nodes. */
-static int update_velocities(cf_world *sim, cf_fragment *f, double dt, int fracture)
+static int update_velocities(const cf_step_ctx *ctx, cf_fragment *f, double dt, int fracture)
 {
-    cf_solid *s = &sim->solid;
+    cf_solid *s = ctx->solid;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n;
-    step_sums c = {sim, f, 0, dt, {0, 0, 0}, 0, 0};
+    step_sums c = {.ctx = ctx, .f = f, .dt = dt};
     double sums[5];
     cf_sum_chunks(nn, 5, 1, kick_chunk, &c, sums);
     int n_bc = (int)sums[4]; /* prescribed nodes: most fragments have none */
@@ -474,11 +470,11 @@ static int update_velocities(cf_world *sim, cf_fragment *f, double dt, int fract
             continue;
         double vfree[3], *vo = &f->v_old[3 * i];
         memcpy(vfree, &s->v[3 * a], sizeof vfree);
-        impose_boundary(sim, a, dt, 0);
+        impose_boundary(ctx, a, dt, 0);
         for (int k = 0; k < 3; k++)
             w_bc += s->m[a] * (s->v[3 * a + k] - vfree[k]) * 0.5 * (vo[k] + s->v[3 * a + k]);
     }
-    sim->flow.boundary += w_bc;
+    ctx->flow->boundary += w_bc;
     if (!fracture) {
         /* Global damping D is linear, keeps momentum, and leaves the uniform
          * kick dt g as it is, so D(v_old + dt g) = D(v_old) + dt g: it acts
@@ -488,10 +484,10 @@ static int update_velocities(cf_world *sim, cf_fragment *f, double dt, int fract
          * free until the prediction.) */
         for (int i = 0; i < nn; i++)
             memcpy(&s->p[4 * nodes[i]], &s->v[3 * nodes[i]], 3 * sizeof(double));
-        cf_global_damping(s, nodes, nn, sim->def.solver.k_damping);
+        cf_global_damping(s, nodes, nn, ctx->def->solver.k_damping);
         for (int i = 0; i < nn; i++) {
             int a = nodes[i];
-            sim->flow.damping += impulse_removes(s, f, i, &s->p[4 * a], &s->v[3 * a], 0);
+            ctx->flow->damping += impulse_removes(s, f, i, &s->p[4 * a], &s->v[3 * a], 0);
             for (int k = 0; k < 3; k++)
                 f->v_old[3 * i + k] = s->v[3 * a + k] - dt * s->f[3 * a + k] / s->m[a];
         }
@@ -506,30 +502,29 @@ static int update_velocities(cf_world *sim, cf_fragment *f, double dt, int fract
 /* The obstacles and rigid neighbours' hulls on node i's prediction at
  * t_next; records its contact and approach speed.  Returns the work of
  * moving obstacles on it in this pass, J. */
-static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next, double dt,
-                            int penalty)
+static double obstacle_node(const cf_step_ctx *ctx, cf_fragment *f, cf_contact_cache *cc, int i,
+                            double t_next, double dt, int penalty)
 {
-    cf_solid *s = &sim->solid;
+    cf_solid *s = ctx->solid;
     int a = f->nodes.v[i];
     double n[3], before[3], w = 0;
     memcpy(before, &s->p[4 * a], sizeof before);
     int hit = penalty ? -1
-                      : cf_obstacles_project(&sim->obs, t_next - dt, &s->x[3 * a], t_next,
+                      : cf_obstacles_project(ctx->obs, t_next - dt, &s->x[3 * a], t_next,
                                              &s->p[4 * a], n);
     if (hit >= 0 && f->contact[i] < 0) {
         double u[3], vr[3];
-        cf_obstacle_velocity(&sim->obs.o[hit], u);
+        cf_obstacle_velocity(&ctx->obs->o[hit], u);
         v3_sub(&s->v[3 * a], u, vr);
         f->vn_pre[i] = v3_dot(vr, n);
     }
     if (hit >= 0) {
         double u[3], dp[3];
         f->contact[i] = hit;
-        cf_obstacle_velocity(&sim->obs.o[hit], u);
+        cf_obstacle_velocity(&ctx->obs->o[hit], u);
         v3_sub(&s->p[4 * a], before, dp);
         w = s->m[a] * v3_dot(dp, u) / dt;
     }
-    cf_contact_cache *cc = cache_of(sim, f);
     if (cc->near.n > 0) { /* rigid fragments: the push is an impulse on the body */
         double *pa = &s->p[4 * a], dJ[3];
         memcpy(before, pa, sizeof before);
@@ -548,14 +543,14 @@ static double obstacle_node(cf_world *sim, cf_fragment *f, int i, double t_next,
 static void obstacle_chunk(void *ctx, int i0, int i1, double *acc)
 {
     const step_sums *c = ctx;
-    const cf_solid *s = &c->sim->solid;
-    int alone = cache_of(c->sim, c->f)->near.n == 0; /* no rigid neighbour's hull to test */
+    const cf_solid *s = c->ctx->solid;
+    int alone = c->cc->near.n == 0; /* no rigid neighbour's hull to test */
     if (alone && c->penalty)
         return; /* the obstacles acted as forces (penalty_chunk) */
     for (int i = i0; i < i1; i++) {
-        if (alone && cf_obstacles_clear(&c->sim->obs, &s->p[4 * c->f->nodes.v[i]]))
+        if (alone && cf_obstacles_clear(c->ctx->obs, &s->p[4 * c->f->nodes.v[i]]))
             continue; /* nothing to move, record or add */
-        acc[0] += obstacle_node(c->sim, c->f, i, c->t_next, c->dt, c->penalty);
+        acc[0] += obstacle_node(c->ctx, c->f, c->cc, i, c->t_next, c->dt, c->penalty);
     }
 }
 
@@ -573,11 +568,11 @@ static void term_chunk(void *ctx, int i0, int i1, double *acc)
  * (unless the penalty force made them) and, with bars, notes each node's
  * predicted speed for the cap in velocity_update.  Returns the number of
  * prescribed nodes. */
-static int integration(cf_world *sim, cf_fragment *f, double dt, int fracture)
+static int integration(const cf_step_ctx *ctx, cf_fragment *f, double dt, int fracture)
 {
-    cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->def.solver;
-    int n_bc = update_velocities(sim, f, dt, fracture);
+    cf_solid *s = ctx->solid;
+    const cf_solver_settings *set = &ctx->def->solver;
+    int n_bc = update_velocities(ctx, f, dt, fracture);
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
     int bars = !explicit_step(set, fracture), penalty = penalty_step(set, fracture);
@@ -600,10 +595,11 @@ static int integration(cf_world *sim, cf_fragment *f, double dt, int fracture)
 /* Stage pbd_projection, one sweep: the bars (PBD, or XPBD in fracture
  * mode) and the crack faces' contact constraint.  *caps: whether the
  * neighbours' speeds for the cap were taken (in the first PBD sweep). */
-static void pbd_projection(cf_world *sim, cf_fragment *f, double dt, int fracture, int *caps)
+static void pbd_projection(const cf_step_ctx *ctx, cf_fragment *f, double dt, int fracture,
+                           int *caps)
 {
-    cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->def.solver;
+    cf_solid *s = ctx->solid;
+    const cf_solver_settings *set = &ctx->def->solver;
     if (set->constraints == CF_CONSTRAINTS_XPBD && fracture) {
         cf_bars_project_xpbd(&f->bars, s, dt, set->compliance_scale);
     } else {
@@ -619,14 +615,14 @@ static void pbd_projection(cf_world *sim, cf_fragment *f, double dt, int fractur
 /* Stage collision, one sweep of the projection: obstacles and rigid
  * neighbours' hulls node by node, each writing its own p (obstacle_chunk).
  * Returns the moving obstacles' work, J. */
-static double collision_sweep(cf_world *sim, cf_fragment *f, double t_next, double dt,
-                              int penalty)
+static double collision_sweep(const cf_step_ctx *ctx, cf_fragment *f, cf_contact_cache *cc,
+                              double t_next, double dt, int penalty)
 {
     int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
     /* On the threads unless hull pushes of rigid neighbours (one list) or
      * FCL queries need one thread. */
-    int obstacles_par = par && cache_of(sim, f)->near.n == 0 && !mesh_obstacles(sim);
-    step_sums sums = {sim, f, t_next, dt, {0, 0, 0}, 0, penalty};
+    int obstacles_par = par && cc->near.n == 0 && !mesh_obstacles(ctx);
+    step_sums sums = {.ctx = ctx, .f = f, .cc = cc, .t_next = t_next, .dt = dt, .penalty = penalty};
     double w;
     cf_sum_chunks(nn, 1, obstacles_par, obstacle_chunk, &sums, &w);
     return w;
@@ -634,12 +630,12 @@ static double collision_sweep(cf_world *sim, cf_fragment *f, double t_next, doub
 
 /* The prescribed nodes' predictions restored (a constraint of the
  * projection); returns the work of their reactions, J. */
-static double prescribed_nodes(cf_world *sim, const cf_fragment *f, double dt)
+static double prescribed_nodes(const cf_step_ctx *ctx, const cf_fragment *f, double dt)
 {
     double w = 0;
     for (int i = 0; i < f->nodes.n; i++)
-        if (sim->solid.bc[f->nodes.v[i]] >= 0)
-            w += impose_boundary(sim, f->nodes.v[i], dt, 1);
+        if (ctx->solid->bc[f->nodes.v[i]] >= 0)
+            w += impose_boundary(ctx, f->nodes.v[i], dt, 1);
     return w;
 }
 
@@ -659,14 +655,14 @@ static double prescribed_nodes(cf_world *sim, const cf_fragment *f, double dt)
  * the velocity every node must gain to give back the momentum the speed
  * cap took (zero when it took none): collision_friction adds it in its
  * pass over the nodes. */
-static void velocity_update(cf_world *sim, cf_fragment *f, double dt, int fracture, int caps,
-                            double w_obs, double w_bc, double dv[3])
+static void velocity_update(const cf_step_ctx *ctx, cf_fragment *f, const cf_contact_cache *cc,
+                            double dt, int fracture, int caps, double w_obs, double w_bc,
+                            double dv[3])
 {
-    cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->def.solver;
+    cf_solid *s = ctx->solid;
+    const cf_solver_settings *set = &ctx->def->solver;
     const int *nodes = f->nodes.v;
     int nn = f->nodes.n, par = nn >= CF_NODES_PARALLEL_MIN;
-    const cf_contact_cache *cc = cache_of(sim, f);
     int bars = !explicit_step(set, fracture);
     if (bars && !caps)
         cf_bars_neighbour_speed(&f->bars, s->speed, s->vcap);
@@ -680,7 +676,7 @@ static void velocity_update(cf_world *sim, cf_fragment *f, double dt, int fractu
             double cap = s->vcap[a];
             if (f->contact[i] >= 0) { /* a moving wall: |v' - u| <= |v - u| */
                 double u[3], vr[3];
-                cf_obstacle_velocity(&sim->obs.o[f->contact[i]], u);
+                cf_obstacle_velocity(&ctx->obs->o[f->contact[i]], u);
                 v3_sub(va, u, vr);
                 cap = fmax(cap, v3_norm(vr) + v3_norm(u));
             }
@@ -699,7 +695,7 @@ static void velocity_update(cf_world *sim, cf_fragment *f, double dt, int fractu
     /* The momentum the cap took goes back to the whole fragment, so that the
      * projection keeps linear momentum (bars act in equal and opposite pairs;
      * the cap does not). */
-    step_sums sums = {sim, f, 0, dt, {0, 0, 0}, 0, 0};
+    step_sums sums = {.ctx = ctx, .f = f, .dt = dt};
     double removed;
     cf_sum_chunks(nn, 1, par, term_chunk, &sums, &removed);
     double dP[3] = {0, 0, 0}; /* zero unless the cap took some (then in node order) */
@@ -727,49 +723,53 @@ static void velocity_update(cf_world *sim, cf_fragment *f, double dt, int fractu
 
 /* One step of the in-house solver on fragment fi (fracture.h), stage by
  * stage, each stage's time charged to its timer as it ends. */
-cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture)
+cf_status cf_solver_step(const cf_step_ctx *ctx, cf_fragment *f, int fi, double t, double dt,
+                         int fracture)
 {
-    cf_fragment *f = &sim->frag[fi];
-    cf_profile *prof = &sim->prof;
-    const cf_solver_settings *set = &sim->def.solver;
+    cf_profile *prof = ctx->prof;
+    const cf_solver_settings *set = &ctx->def->solver;
     int penalty = penalty_step(set, fracture), bars = !explicit_step(set, fracture);
-    cf_fragment_book_pending(f, &sim->flow);
+    cf_fragment_book_pending(f, ctx->flow);
     f->e_strain = 0;
     if (fracture) {
         /* Stresses only when the criterion is checked at this step. */
         int check = set->criterion != CF_CRITERION_NONE && (f->steps % set->check_interval) == 0;
-        int n_hot = elasticity(sim, f, check), inserted = 0;
+        int n_hot = elasticity(ctx, f, check), inserted = 0;
         cf_profile_lap(prof, CF_STAGE_ELASTICITY);
         if (check) {
-            int nc = insertion_check(sim, f, t, n_hot);
+            int nc = insertion_check(ctx, f, t, n_hot);
             cf_profile_lap(prof, CF_STAGE_INSERTION_CHECK);
-            cf_status st = nc < 0 ? CF_ERR_NOMEM : node_duplication(sim, f, t, dt, nc, &inserted);
+            cf_status st = nc < 0 ? CF_ERR_NOMEM : node_duplication(ctx, f, t, dt, nc, &inserted);
             cf_profile_lap(prof, CF_STAGE_NODE_DUPLICATION);
             if (st != CF_OK)
                 return st;
         }
         f->quiet = inserted ? 0 : f->quiet + 1;
     }
-    if (ensure_scratch(sim, f))
+    /* Fragment fi's contact cache (contact.h), in the world's table. */
+    if (cf_contact_caches_reserve(ctx->contact, ctx->n_frag))
+        return CF_ERR_NOMEM;
+    cf_contact_cache *cc = &ctx->contact->v[fi];
+    if (ensure_scratch(f, cc))
         return CF_ERR_NOMEM;
     if (fracture) {
-        elasticity_scatter(sim, f);
+        elasticity_scatter(ctx, f);
         cf_profile_lap(prof, CF_STAGE_ELASTICITY);
-        cohesive_forces(sim, f, dt);
+        cohesive_forces(ctx, f, dt);
         cf_profile_lap(prof, CF_STAGE_COHESIVE_FORCES);
         if (penalty) {
-            collision_forces(sim, f, t, dt);
+            collision_forces(ctx, f, t, dt);
             cf_profile_lap(prof, CF_STAGE_COLLISION);
         }
     } else {
-        cf_solid *s = &sim->solid;
+        cf_solid *s = ctx->solid;
         for (int i = 0; i < f->nodes.n; i++) { /* pbd rigid mode: gravity alone */
             int a = f->nodes.v[i];
             for (int k = 0; k < 3; k++)
-                s->f[3 * a + k] = s->m[a] * sim->def.gravity[k];
+                s->f[3 * a + k] = s->m[a] * ctx->def->gravity[k];
         }
     }
-    int n_bc = integration(sim, f, dt, fracture);
+    int n_bc = integration(ctx, f, dt, fracture);
     cf_profile_lap(prof, CF_STAGE_INTEGRATION);
     if (set->constraints == CF_CONSTRAINTS_XPBD)
         cf_bars_reset_lambda(&f->bars);
@@ -777,30 +777,29 @@ cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fractur
     int caps = 0, iterations = bars ? set->iterations : 1;
     for (int it = 0; it < iterations; it++) {
         if (bars) {
-            pbd_projection(sim, f, dt, fracture, &caps);
+            pbd_projection(ctx, f, dt, fracture, &caps);
             cf_profile_lap(prof, CF_STAGE_PBD_PROJECTION);
         }
-        w_obs += collision_sweep(sim, f, t + dt, dt, penalty);
+        w_obs += collision_sweep(ctx, f, cc, t + dt, dt, penalty);
         cf_profile_lap(prof, CF_STAGE_COLLISION);
         if (n_bc > 0) {
-            w_bc += prescribed_nodes(sim, f, dt);
+            w_bc += prescribed_nodes(ctx, f, dt);
             cf_profile_lap(prof, CF_STAGE_PBD_PROJECTION);
         }
     }
     double dv[3];
-    velocity_update(sim, f, dt, fracture, caps, w_obs, w_bc, dv);
+    velocity_update(ctx, f, cc, dt, fracture, caps, w_obs, w_bc, dv);
     cf_profile_lap(prof, CF_STAGE_VELOCITY_UPDATE);
-    f->pending.contact += collision_friction(sim, f, t + dt, dt, !bars, penalty, dv);
+    f->pending.contact += collision_friction(ctx, f, cc, t + dt, dt, !bars, penalty, dv);
     cf_profile_lap(prof, CF_STAGE_COLLISION);
     f->steps++;
     return CF_OK;
 }
 
-int cf_pbd_impact(const cf_world *sim, int fi, double dt)
+int cf_pbd_impact(const cf_step_ctx *ctx, const cf_fragment *f, double t, double dt)
 {
-    const cf_fragment *f = &sim->frag[fi];
-    const cf_solid *s = &sim->solid;
-    const double *g = sim->def.gravity;
+    const cf_solid *s = ctx->solid;
+    const double *g = ctx->def->gravity;
     for (int i = 0; i < f->nodes.n; i++) {
         int a = f->nodes.v[i];
         double v[3], p[3];
@@ -808,14 +807,14 @@ int cf_pbd_impact(const cf_world *sim, int fi, double dt)
             v[k] = s->v[3 * a + k] + dt * g[k];
             p[k] = s->x[3 * a + k] + dt * v[k];
         }
-        for (int j = 0; j < sim->obs.n; j++) {
+        for (int j = 0; j < ctx->obs->n; j++) {
             double n[3];
-            if (cf_obstacle_distance(&sim->obs, j, sim->t + dt, p, n) >= 0)
+            if (cf_obstacle_distance(ctx->obs, j, t + dt, p, n) >= 0)
                 continue;
             double u[3], vr[3];
-            cf_obstacle_velocity(&sim->obs.o[j], u);
+            cf_obstacle_velocity(&ctx->obs->o[j], u);
             v3_sub(v, u, vr);
-            if (-v3_dot(vr, n) > sim->def.solver.impact_threshold)
+            if (-v3_dot(vr, n) > ctx->def->solver.impact_threshold)
                 return 1;
         }
     }

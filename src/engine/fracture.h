@@ -1,27 +1,57 @@
 /* The in-house solver step (source Table 6.2, docs/physics.md §4), per
- * fragment, and what it shares with the hand-offs. */
+ * fragment, and what it shares with the hand-offs.  The step sees the
+ * world through a narrow context (cf_step_ctx), never the whole world. */
 #ifndef COHFRAC_FRACTURE_H
 #define COHFRAC_FRACTURE_H
 
-#include "world_impl.h"
+#include "cohesive_law.h"
+#include "contact.h"
+#include "fragment.h"
+#include "insertion.h"
+#include "obstacle.h"
+#include "pbd.h"
+#include "profile.h"
+#include "solid.h"
 
-/* One step of the in-house solver on fragment f (source Table 6.2): with
- * `fracture` set, stresses every check_interval steps, cohesive insertion,
- * internal and cohesive forces; otherwise (pbd rigid mode) global damping
- * instead.  Then prediction, PBD bars + collision constraints, velocity
- * update, friction and restitution.  t: time at the start of the step (s).
- * Returns CF_OK or CF_ERR_NOMEM. */
-cf_status cf_solver_step(cf_world *sim, int fi, double t, double dt, int fracture);
+/* What the solver step reads and writes beyond its fragment
+ * (docs/architecture.md, "The step, stage by stage"): the solid, the
+ * settings, the obstacles, the cohesive law, the fragments' contact caches
+ * (indexed by fragment, n_frag of them), the world's energy flows and
+ * profile, and the step's scratch lists.  The world makes one for each
+ * call (cf_world_step_ctx, world_impl.h). */
+typedef struct cf_step_ctx {
+    cf_solid *solid;
+    const cf_world_def *def;
+    const cf_obstacles *obs;
+    const cf_cohesive_law *law;
+    const double *law_params;
+    cf_contact_caches *contact;
+    int n_frag;
+    cf_energy_flows *flow;
+    cf_profile *prof;
+    cf_int_list *cand, *touched, *crushed; /* facets, nodes, tets of a check */
+    cf_bars_scratch *bar_scratch;
+} cf_step_ctx;
 
-/* Whether rigid fragment fi (nodes in the in-house solver) would hit an
- * obstacle during the next step of length dt faster than the impact
- * threshold (normal approach speed). */
-int cf_pbd_impact(const cf_world *sim, int fi, double dt);
+/* One step of the in-house solver on fragment f, number fi of the world's
+ * (its contact cache's index): with `fracture` set, stresses every
+ * check_interval steps, cohesive insertion, internal and cohesive forces;
+ * otherwise (pbd rigid mode) global damping instead.  Then prediction, PBD
+ * bars + collision constraints, velocity update, friction and restitution.
+ * t: time at the start of the step (s).  Returns CF_OK or CF_ERR_NOMEM. */
+cf_status cf_solver_step(const cf_step_ctx *c, cf_fragment *f, int fi, double t, double dt,
+                         int fracture);
+
+/* Whether rigid fragment f (nodes in the in-house solver) would hit an
+ * obstacle during the next step of length dt from time t faster than the
+ * impact threshold (normal approach speed). */
+int cf_pbd_impact(const cf_step_ctx *c, const cf_fragment *f, double t, double dt);
 
 /* The energy (J) of the penalty contact's springs (docs/physics.md §7.1)
- * under fragment f's nodes at their positions now (time sim->t, the
- * stiffness of the last fracture step): the part of a fracture-mode
- * fragment's e_strain beyond its tets'.  0 without the penalty contact. */
-double cf_fragment_spring_energy(const cf_world *sim, const cf_fragment *f);
+ * under fragment f's nodes at their positions at time t, with the
+ * stiffness of fracture step h (the last one taken; 0: none yet): the part
+ * of a fracture-mode fragment's e_strain beyond its tets'.  0 without the
+ * penalty contact. */
+double cf_fragment_spring_energy(const cf_step_ctx *c, const cf_fragment *f, double t, double h);
 
 #endif

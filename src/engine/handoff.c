@@ -424,7 +424,9 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         g->steps = p->steps, g->quiet = p->quiet, g->t_enter = p->t_enter;
         g->e_enter = p->e_enter;
         memcpy(g->q_match, p->q_match, sizeof g->q_match);
-        g->e_strain = cf_tet4_strain_energy(s, g->tets, g->nt) + cf_fragment_spring_energy(sim, g);
+        cf_step_ctx ctx = cf_world_step_ctx(sim);
+        g->e_strain = cf_tet4_strain_energy(s, g->tets, g->nt) +
+                      cf_fragment_spring_energy(&ctx, g, sim->t, sim->h_fracture);
         for (int i = 0; i < g->nodes.n; i++) {
             int a = g->nodes.v[i];
             g->e_kin += 0.5 * s->m[a] * v3_dot(&p->v_old[3 * index[a]], &s->v[3 * a]);

@@ -937,7 +937,8 @@ static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
     for (int fi = 0; fi < sim->n_frag; fi++) {
         if (sim->frag[fi].mode != CF_MODE_RIGID)
             continue;
-        int hit = cf_pbd_impact(sim, fi, dt) && can_break(sim, &sim->frag[fi]);
+        cf_step_ctx ctx = cf_world_step_ctx(sim);
+        int hit = cf_pbd_impact(&ctx, &sim->frag[fi], sim->t, dt) && can_break(sim, &sim->frag[fi]);
         cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
         if (hit) {
             cf_status st = to_fracture(sim, fi, NULL, err);
@@ -947,7 +948,7 @@ static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
             continue;
         }
         /* The damped step's own stages are timed as the solver's. */
-        if (cf_solver_step(sim, fi, sim->t, dt, 0) != CF_OK)
+        if (cf_solver_step(&ctx, &sim->frag[fi], fi, sim->t, dt, 0) != CF_OK)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory in the pbd rigid step");
     }
     sim->steps_rigid++;
@@ -1044,11 +1045,12 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
     if (gather_hulls(sim, &cx, dt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
     cf_profile_lap(&sim->prof, CF_STAGE_COLLISION);
+    cf_step_ctx ctx = cf_world_step_ctx(sim);
     for (long k = 0; k < n_sub; k++) {
         for (int fi = 0; fi < n; fi++) {
             if (sim->frag[fi].mode != CF_MODE_FRACTURE)
                 continue;
-            if (cf_solver_step(sim, fi, sim->t + (double)k * h, h, 1) != CF_OK)
+            if (cf_solver_step(&ctx, &sim->frag[fi], fi, sim->t + (double)k * h, h, 1) != CF_OK)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
             sim->steps_fracture++;
             sim->tet_steps_fracture += sim->frag[fi].nt;

@@ -11,6 +11,7 @@
 #include "cohesive.h"
 #include "contact.h"
 #include "decompose.h"
+#include "fracture.h"
 #include "fragment.h"
 #include "cohfrac/world.h"
 #include "insertion.h"
@@ -64,5 +65,16 @@ struct cf_world {
     cf_event *ev;            /* events since the caller last drained them */
     int n_ev, cap_ev;
 };
+
+/* The narrow view of world w that the solver step gets (fracture.h); made
+ * for each use, as the fragment count changes. */
+static inline cf_step_ctx cf_world_step_ctx(cf_world *w)
+{
+    return (cf_step_ctx){.solid = &w->solid, .def = &w->def, .obs = &w->obs, .law = w->law,
+                         .law_params = w->law_params, .contact = &w->contact,
+                         .n_frag = w->n_frag, .flow = &w->flow, .prof = &w->prof,
+                         .cand = &w->cand, .touched = &w->touched, .crushed = &w->crushed,
+                         .bar_scratch = &w->bar_scratch};
+}
 
 #endif
