@@ -13,7 +13,7 @@ for bad in '#include <lua.h>' '#include <hdf5.h>' '#include "cohfrac/mesh.h"' \
            '#include "cohfrac/scene.h"' '#include "cohfrac/h5_output.h"' \
            'static void f(void) { fopen("x", "w"); }'; do
     rm -rf "$tmp/src" && cp -r "$root/src" "$tmp/src"
-    printf '%s\n' "$bad" >> "$tmp/src/engine/world.c"
+    printf '%s\n' "$bad" >> "$tmp/src/engine/world_step.c"
     if sh "$root/tools/check_layering.sh" "$tmp/src" 2>/dev/null; then
         echo "FAIL: not caught in the engine: $bad"; fails=$((fails + 1))
     else

@@ -1,4 +1,5 @@
-/* The world record: what the step (world.c) owns and the stages that take
+/* The world record: what a world (world_create.c, world_step.c,
+ * world_query.c) owns and the stages that take
  * the whole world read, the solver step (fracture.h) and the mode
  * hand-offs (handoff.h).  Data only: the functions are in those headers,
  * so that this one includes no stage above it. */

@@ -1,0 +1,360 @@
+/* What a world tells its caller: events, fragments, tets, cracks, the
+ * state hash, statistics and memory, and its few settings (threads, the
+ * heartbeat). */
+#include "world_events.h"
+
+#include "hash.h"
+#include "linalg.h"
+#include "sort.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const cf_event *cf_world_events(const cf_world *sim, int *n)
+{
+    *n = sim->n_ev;
+    return sim->ev;
+}
+
+void cf_world_clear_events(cf_world *sim) { sim->n_ev = 0; }
+
+int cf_world_fragments_ever(const cf_world *sim) { return sim->n_frag; }
+
+int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
+{
+    if (id < 0 || id >= sim->n_frag)
+        return -1;
+    const cf_fragment *f = &sim->frag[id];
+    memset(o, 0, sizeof *o);
+    o->id = id;
+    o->parent = f->parent;
+    o->birth_time = f->birth_time;
+    o->mass = f->mass;
+    o->n_tets = f->nt;
+    memcpy(o->inertia_principal, f->principal, sizeof f->principal);
+    o->n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
+    o->debris = cf_fragment_is_debris(f, &sim->def.solver);
+    o->hull_volume_error = cf_hulls_error(&f->hulls);
+    o->decomposition_time = f->decompose_time;
+    memcpy(o->com_rest, f->com_rest, sizeof o->com_rest);
+    return 0;
+}
+
+void cf_world_initial_bounds(const cf_world *sim, cf_initial_bounds *out) { *out = sim->bounds; }
+
+int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
+{
+    int n = 0;
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        cf_fragment *f = &sim->frag[fi];
+        if (f->mode == CF_MODE_DEAD)
+            continue;
+        if (n < cap) {
+            cf_fragment_state *o = &out[n];
+            double R[9];
+            memset(o, 0, sizeof *o);
+            o->id = fi, o->parent = f->parent, o->birth_time = f->birth_time;
+            o->mode = f->mode, o->n_tets = f->nt, o->mass = f->mass;
+            memcpy(o->principal, f->principal, sizeof o->principal);
+            memcpy(o->axes, f->Q, sizeof o->axes);
+            cf_fragment_pose_peek(f, &sim->solid, sim->bullet, o->com, R, o->v, o->w);
+            mat_to_quat(R, o->quat);
+            for (int k = 0; k < 3; k++)
+                o->momentum[k] = f->mass * o->v[k];
+            if (f->body >= 0) {
+                cfb_state st;
+                cfb_get_state(sim->bullet, f->body, &st);
+                cf_body_spin(f, &st, o->angular_momentum);
+                o->kinetic = cf_body_kinetic_energy(f, &st);
+            } else {
+                cf_node_state ns;
+                cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
+                memcpy(o->angular_momentum, ns.L, sizeof ns.L);
+                for (int k = 0; k < 3; k++)
+                    o->momentum[k] = ns.M * ns.v[k];
+                o->kinetic = ns.ke;
+            }
+        }
+        n++;
+    }
+    return n;
+}
+
+double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
+{
+    if (id < 0 || id >= sim->n_frag || sim->frag[id].mode == CF_MODE_DEAD)
+        return 0;
+    const cf_fragment *f = &sim->frag[id];
+    double com[3], R[9], v[3], w[3], Rd[3], best = -INFINITY;
+    cf_fragment_pose_peek(f, &sim->solid, sim->bullet, com, R, v, w);
+    m3_tmulv(R, d, Rd); /* (R r).d = r.(R^T d), r from the rest centre of mass */
+    for (int i = 0; i < f->nodes.n; i++) {
+        double r[3];
+        v3_sub(&sim->solid.X[3 * f->nodes.v[i]], f->com_rest, r);
+        best = fmax(best, v3_dot(r, Rd));
+    }
+    return f->nodes.n ? best : 0;
+}
+
+int cf_world_tet_count(const cf_world *sim) { return sim->solid.n_tets; }
+
+int cf_world_rest_node_count(const cf_world *sim) { return sim->solid.n_verts0; }
+
+void cf_world_rest_nodes(const cf_world *sim, double *X)
+{
+    memcpy(X, sim->solid.X, (size_t)sim->solid.n_verts0 * 3 * sizeof(double));
+}
+
+int cf_world_rest_tet(const cf_world *sim, int t, int nodes[4])
+{
+    if (t < 0 || t >= sim->solid.n_tets)
+        return -1;
+    memcpy(nodes, &sim->solid.tet0[4 * sim->tet_of_user[t]], 4 * sizeof(int));
+    return 0;
+}
+
+int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
+{
+    if (t < 0 || t >= sim->solid.n_tets)
+        return -1;
+    const cf_solid *s = &sim->solid;
+    int st = sim->tet_of_user[t], fi = s->tet_frag[st];
+    const cf_fragment *f = &sim->frag[fi];
+    double com[3], R[9], v[3], w[3];
+    if (f->body >= 0) /* rigid in Bullet: the nodes are not moved, the pose is */
+        cf_fragment_pose_peek(f, &sim->solid, sim->bullet, com, R, v, w);
+    for (int j = 0; j < 4; j++) {
+        int a = s->tet[4 * st + j];
+        if (f->body < 0) {
+            memcpy(&x[3 * j], &s->x[3 * a], 3 * sizeof(double));
+            continue;
+        }
+        double r[3], y[3];
+        v3_sub(&s->X[3 * a], f->com_rest, r);
+        m3_mulv(R, r, y);
+        for (int k = 0; k < 3; k++)
+            x[3 * j + k] = com[k] + y[k];
+    }
+    return 0;
+}
+
+int cf_world_fracture_tets(const cf_world *sim, int *tets, double *stress, double *damage)
+{
+    const cf_solid *s = &sim->solid;
+    int nt = s->n_tets, n = 0;
+    /* damage by the solid's tets: each element's to both its sides */
+    double *d = calloc((size_t)(nt > 0 ? nt : 1), sizeof *d);
+    if (!d)
+        return -1;
+    for (int e = 0; e < s->n_coh; e++) {
+        double de = cf_cohesive_damage(s, e);
+        for (int side = 0; side < 2; side++)
+            d[s->coh[e].tet[side]] = fmax(d[s->coh[e].tet[side]], de);
+    }
+    static const int voigt[6] = {0, 4, 8, 5, 2, 1}; /* xx yy zz yz xz xy of [3][3] */
+    for (int t = 0; t < nt; t++) {
+        int st = sim->tet_of_user[t];
+        if (sim->frag[s->tet_frag[st]].mode != CF_MODE_FRACTURE)
+            continue;
+        tets[n] = t;
+        damage[n] = d[st];
+        for (int k = 0; k < 6; k++)
+            stress[6 * n + k] = s->sigma ? s->sigma[9 * st + voigt[k]] : 0.0;
+        n++;
+    }
+    free(d);
+    return n;
+}
+
+int cf_world_tet_fragment(const cf_world *sim, int t)
+{
+    return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[sim->tet_of_user[t]] : -1;
+}
+
+int cf_world_cohesive_count(const cf_world *sim) { return sim->solid.n_coh; }
+
+int cf_world_crack(const cf_world *sim, int e, cf_crack_row *r)
+{
+    memset(r, 0, sizeof *r);
+    if (e < 0 || e >= sim->solid.n_coh)
+        return -1;
+    r->time = sim->t;
+    r->element = e;
+    cf_cohesive_state(&sim->solid, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
+                      &r->failed);
+    return 0;
+}
+
+double cf_world_crack_area(const cf_world *sim) { return cf_solid_crack_area(&sim->solid); }
+
+const char *cf_stage_name(cf_stage s)
+{
+#define CF_STAGE_NAME(id, name) #name,
+    static const char *const names[] = {CF_STAGES(CF_STAGE_NAME)};
+#undef CF_STAGE_NAME
+    return s >= 0 && s < CF_STAGE_COUNT ? names[s] : "?";
+}
+
+const cf_world_def *cf_world_definition(const cf_world *sim) { return &sim->def; }
+
+int cf_world_done(const cf_world *sim) { return sim->step >= sim->n_steps; }
+
+void cf_world_set_tick(cf_world *sim, cf_world_tick_fn fn, void *user)
+{
+    sim->tick = fn, sim->tick_user = user;
+}
+
+void cf_world_set_threads(cf_world *sim, int n)
+{
+    if (n >= 1)
+        sim->threads = n;
+}
+
+long cf_world_step_count(const cf_world *sim) { return sim->step; }
+
+long cf_world_steps_total(const cf_world *sim) { return sim->n_steps; }
+
+double cf_world_dt_outer(const cf_world *sim) { return sim->dt_outer; }
+
+double cf_world_time(const cf_world *sim) { return sim->t; }
+
+double cf_world_dt_fracture(const cf_world *sim) { return sim->dt_fracture; }
+
+double cf_world_dt_cfl(const cf_world *sim) { return sim->solid.dt_cfl; }
+
+uint64_t cf_world_state_hash(const cf_world *sim)
+{
+    const cf_solid *s = &sim->solid;
+    uint64_t h = CF_FNV1A_SEED;
+    h = cf_fnv1a(h, s->x, (size_t)s->n_nodes * 3 * sizeof(double));
+    h = cf_fnv1a(h, s->v, (size_t)s->n_nodes * 3 * sizeof(double));
+    h = cf_fnv1a(h, s->tet_frag, (size_t)s->n_tets * sizeof(int));
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        const cf_fragment *f = &sim->frag[fi];
+        int mode = f->mode;
+        h = cf_fnv1a(h, &mode, sizeof mode);
+        if (f->body >= 0) {
+            cfb_state st;
+            cfb_get_state(sim->bullet, f->body, &st);
+            h = cf_fnv1a(h, &st, sizeof st);
+        }
+    }
+    return h;
+}
+
+void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
+{
+    const cf_profile *p = &sim->prof;
+    memset(o, 0, sizeof *o);
+    o->tets = sim->solid.n_tets, o->nodes_input = sim->solid.n_verts0;
+    o->nodes = sim->solid.n_nodes;
+    o->dt_fracture = sim->dt_fracture, o->dt_cfl = sim->solid.dt_cfl, o->dt_outer = sim->dt_outer;
+    o->mass_scaled = sim->solid.n_mass_scaled, o->mass_added = sim->solid.mass_added;
+    o->mass_total = sim->solid.mass_total;
+    o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(sim->solid.mass_scale_max) : 1.0;
+    o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
+    o->threads = sim->threads;
+    o->alive = cf_world_alive_fragments(sim, &o->in_fracture);
+    o->ever = sim->n_frag;
+    o->cohesive = sim->solid.n_coh;
+    o->handoffs = sim->n_handoffs;
+    o->max_momentum_error = sim->max_momentum_error, o->handoff_loss = sim->total_handoff_loss;
+    memcpy(o->stage, p->stage, sizeof o->stage);
+    /* Convex decomposition of the rigid fragments alive now: median and worst
+     * error (NaN when there is no memory to sort them: unknown, not 0). */
+    double *e = malloc((size_t)(sim->n_frag + 1) * sizeof(double));
+    int n = 0;
+    for (int fi = 0; fi < sim->n_frag; fi++) {
+        const cf_fragment *f = &sim->frag[fi];
+        if (f->mode != CF_MODE_DEAD)
+            o->mass_alive += f->mass;
+        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(f, &sim->def.solver)) {
+            o->debris++;
+            o->debris_mass += f->mass;
+            continue;
+        }
+        if (f->mode == CF_MODE_RIGID && f->body >= 0) {
+            if (e)
+                e[n] = cf_hulls_error(&f->hulls);
+            n++;
+            o->hulls += f->hulls.n_hulls;
+        }
+    }
+    if (n > 0 && !e) {
+        o->hull_error_median = o->hull_error_worst = NAN;
+    } else if (n > 0) {
+        cf_doubles_sort(e, n);
+        o->hull_error_median = n % 2 ? e[n / 2] : 0.5 * (e[n / 2 - 1] + e[n / 2]);
+        o->hull_error_worst = e[n - 1];
+    }
+    o->rigid_with_hulls = n;
+    free(e);
+}
+
+void cf_world_memory(const cf_world *sim, cf_memory *m)
+{
+    const cf_solid *s = &sim->solid;
+    const unsigned long long D = sizeof(double), I = sizeof(int);
+    unsigned long long cn = (unsigned long long)s->cap_nodes, nt = (unsigned long long)s->n_tets;
+    memset(m, 0, sizeof *m);
+    /* per node: X x v f, the row p, m vcap speed; origin bc */
+    m->solid = cn * (19 * D + 2 * I) + nt * (27 * D + 9 * I) +
+               ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I + (s->ep ? nt * 7 * D : 0);
+    if (s->facet)
+        m->fracture = nt * (9 * D + 2 + 20 * I) + cn * (1 + D) +
+                      (unsigned long long)s->n_facets * (1 + (s->candidate != NULL));
+    m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
+    m->fragments = (unsigned long long)sim->cap_frag * sizeof(cf_fragment);
+    for (int i = 0; i < sim->n_frag; i++) {
+        const cf_fragment *f = &sim->frag[i];
+        m->fragments += (unsigned long long)f->nt * I + (unsigned long long)f->nodes.cap * I +
+                        (unsigned long long)f->coh.cap * I +
+                        (unsigned long long)f->bars.n * (2 * I + 3 * D) +
+                        (unsigned long long)f->scratch_cap * (I + 5 * D + I + 6 * D) +
+                        (unsigned long long)f->pairs_cap * 3 * sizeof(cf_pair_force);
+        if (f->hulls.n_hulls)
+            m->fragments += (unsigned long long)f->hulls.start[f->hulls.n_hulls] * 3 * D +
+                            ((unsigned long long)f->hulls.n_hulls + 1) * I;
+    }
+    unsigned long long b = cfb_allocated_bytes();
+    m->bullet = b > sim->bullet_base ? b - sim->bullet_base : 0;
+    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
+        m->collision += cff_mesh_bytes(sim->obs.mesh[j]);
+    for (int i = 0; i < sim->contact.cap; i++) {
+        const cf_frag_surface *fs = &sim->contact.v[i].surface;
+        m->collision += cff_mesh_bytes(fs->mesh) +
+                        (unsigned long long)fs->nv * (I + 3 * D) + 3ull * fs->ntri * I;
+    }
+}
+
+void cf_world_step_stats(const cf_world *sim, cf_step_stats *o)
+{
+    const cf_solver_settings *set = &sim->def.solver;
+    memset(o, 0, sizeof *o);
+    o->fracture_steps = sim->steps_fracture;
+    o->tet_steps = sim->tet_steps_fracture, o->fracture_time = sim->t_fracture;
+    memcpy(o->stage, sim->prof.stage, sizeof o->stage);
+    for (int i = 0; i < sim->n_frag; i++) {
+        const cf_fragment *f = &sim->frag[i];
+        if (f->mode != CF_MODE_FRACTURE)
+            continue;
+        o->tets += f->nt, o->nodes += f->nodes.n, o->bars += f->bars.n, o->cohesive += f->coh.n;
+        if (f->bars.color_start) {
+            o->colours = f->bars.n_colors > o->colours ? f->bars.n_colors : o->colours;
+            o->serial_bars += f->bars.n - f->bars.color_start[CF_BARS_COLORS];
+        }
+    }
+    o->iterations = set->constraints == CF_CONSTRAINTS_NONE ? 0 : set->iterations;
+    o->check = set->criterion != CF_CRITERION_NONE;
+    o->xpbd = set->constraints == CF_CONSTRAINTS_XPBD;
+}
+
+double cf_step_traffic(const cf_step_stats *st)
+{
+    double tet = 168 + (st->check ? 144 : 0);
+    double node = 104 + 48.0 * st->iterations;
+    double bar = (st->xpbd ? 40.0 : 16.0) * st->iterations;
+    return tet * st->tets + node * st->nodes + bar * st->bars +
+           2.0 * sizeof(cf_cohesive) * st->cohesive;
+}
