@@ -16,6 +16,7 @@
 #define _XOPEN_SOURCE 700 /* realpath (XSI), stat */
 
 #include "cohfrac/scene.h"
+#include "cohfrac/settings.h"
 #include "cohfrac/surface.h"
 
 #include <lauxlib.h>
@@ -48,13 +49,6 @@
  * "allowed:" lists in messages; resolved_text() writes keys in this order. */
 static const char *const top_keys[] = {"name",     "duration", "gravity",   "material", "bodies",
                                        "boundary", "obstacles", "solver",   "output"};
-static const char *const material_keys[] = {"E",     "nu",   "rho",     "G_I",
-                                            "sigma_max", "alpha", "G_II", "tau_max",
-                                            "beta",  "friction", "restitution", "compressive_strength",
-                                            "internal_friction_angle", "strength", "nucleation_radius",
-                                            "crushing_strain"};
-static const char *const strength_keys[] = {"distribution", "modulus", "seed", "area"};
-static const char *const distribution_names[] = {"uniform", "weibull"};
 static const char *const body_keys[] = {"mesh",     "scale",   "position", "orientation",
                                         "velocity", "angular_velocity", "expansion_rate",
                                         "expansion_center", "hollow_layers", "visual"};
@@ -75,23 +69,7 @@ static const char *const box_keys[] = {"type",     "center",   "half_extents",
                                        "velocity", "friction", "restitution"};
 static const char *const mesh_obstacle_keys[] = {"type",     "file",     "scale",      "orientation",
                                                  "position", "friction", "restitution"};
-static const char *const solver_keys[] = {
-    "mode",              "rigid_backend",    "dt_rigid",       "rigid_substeps",
-    "ccd",               "sleeping",
-    "dt_fracture",       "cfl_fraction",     "check_interval", "quiet_steps",
-    "max_fracture_time",
-    "impact_threshold",  "elasticity",       "criterion",      "crack_plane",
-    "crack_growth",      "min_piece_tets",   "min_piece_size", "debris_tets",
-    "debris_size",
-    "constraints",       "pbd",              "xpbd",           "contact_stiffness",
-    "obstacle_contact",  "mass_scaling",
-    "guard",             "threads"};
-static const char *const sleeping_keys[] = {"linear", "angular"};
 static const char *const crack_plane_keys[] = {"point", "normal", "tolerance"};
-static const char *const pbd_keys[] = {"k_stiffness", "iterations", "k_damping",
-                                       "iteration_independent"};
-static const char *const xpbd_keys[] = {"compliance_scale"};
-static const char *const guard_keys[] = {"max_inverted_fraction", "max_energy_growth"};
 static const char *const output_keys[] = {"file", "frame_interval", "cracks", "fields"};
 
 /* Enum spellings, indexed by the enum values of scene.h (primitive_names by
@@ -104,27 +82,11 @@ static const char *const obstacle_names[] = {
     CF_OBSTACLE_TYPES(CF_OBSTACLE_NAME_)
 #undef CF_OBSTACLE_NAME_
 };
-static const char *const mode_names[] = {"hybrid", "fracture"};
-static const char *const backend_names[] = {"bullet", "pbd"};
-static const char *const elasticity_names[] = {"corotational", "linear"};
-static const char *const criterion_names[] = {"traction", "source", "none"};
-static const char *const constraints_names[] = {"pbd", "xpbd", "none"};
-static const char *const growth_names[] = {"fronts", "all"};
-static const char *const obstacle_contact_names[] = {"kinematic", "penalty"};
 _Static_assert(CF_PRIM_NONE == 0 && CF_PRIM_BOX == 1 && CF_PRIM_SPHERE == 2 &&
                    CF_PRIM_HOLLOW_SPHERE == 3 && CF_PRIM_PLATE == 4 && CF_PRIM_NOTCHED_BEAM == 5,
                "primitive_names follows cf_primitive_type");
 _Static_assert(CF_REGION_BOX == 0 && CF_REGION_PLANE == 1 && CF_REGION_GROUP == 2,
                "region_names follows cf_region_type");
-_Static_assert(CF_RUN_HYBRID == 0 && CF_RUN_FRACTURE == 1, "mode_names follows cf_run_mode");
-_Static_assert(CF_RIGID_BULLET == 0 && CF_RIGID_PBD == 1, "backend_names follows cf_rigid_backend");
-_Static_assert(CF_ELASTICITY_COROTATIONAL == 0 && CF_ELASTICITY_LINEAR == 1,
-               "elasticity_names follows cf_elasticity");
-_Static_assert(CF_CRITERION_TRACTION == 0 && CF_CRITERION_SOURCE == 1 && CF_CRITERION_NONE == 2,
-               "criterion_names follows cf_criterion");
-_Static_assert(CF_GROWTH_FRONTS == 0 && CF_GROWTH_ALL == 1, "growth_names follows cf_crack_growth");
-_Static_assert(CF_OBSTACLE_CONTACT_KINEMATIC == 0 && CF_OBSTACLE_CONTACT_PENALTY == 1,
-               "obstacle_contact_names follows cf_obstacle_contact");
 _Static_assert(CF_CONSTRAINTS_PBD == 0 && CF_CONSTRAINTS_XPBD == 1 && CF_CONSTRAINTS_NONE == 2,
                "constraints_names follows cf_constraints");
 
@@ -136,17 +98,8 @@ typedef struct range {
 } range;
 
 static const range POSITIVE = {0.0, INFINITY, 0, 0, NULL};
-static const range ANY_INTEGER = {-INFINITY, INFINITY, 1, 1, NULL};
 static const range NON_NEGATIVE = {0.0, INFINITY, 1, 0, NULL};
-static const range AT_LEAST_ONE = {1.0, INFINITY, 1, 0, NULL};
-static const range PIECE_TETS = {0.0, CF_MAX_PIECE_TETS, 1, 1, NULL};
-static const range UNIT = {0.0, 1.0, 1, 1, NULL};
-static const range FRICTION_ANGLE = {0.0, 60.0, 1, 1, NULL};
-static const range POISSON = {-1.0, 0.5, 0, 0,
-                              "(Poisson's ratio of a stable isotropic solid)"};
 static const range ANY = {-INFINITY, INFINITY, 0, 0, NULL};
-static const range PPR_SHAPE = {1.0, INFINITY, 0, 0,
-                                "(the PPR cohesive law needs shape parameters alpha, beta > 1)"};
 
 static const double ZERO3[3] = {0.0, 0.0, 0.0};
 static const double GRAVITY[3] = {0.0, 0.0, -9.81};
@@ -811,42 +764,67 @@ static cf_status resolve_surface(loader *ld, const char *key, const char *name, 
     } while (0)
 
 
-static cf_status read_strength(loader *ld, int t, cf_material *m)
-{
-    static const double modulus = 10.0, area = 0.0;
-    TRY(check_keys(ld, t, strength_keys, COUNT(strength_keys)));
-    TRY(get_enum(ld, t, "distribution", distribution_names, COUNT(distribution_names), 0,
-                 &m->weibull));
-    TRY(get_num(ld, t, "modulus", &modulus, &POSITIVE, &m->weibull_modulus));
-    TRY(get_int(ld, t, "seed", 1, &ANY_INTEGER, &m->strength_seed));
-    TRY(get_num(ld, t, "area", &area, &NON_NEGATIVE, &m->strength_area));
-    return CF_OK;
-}
+static cf_status read_crack_plane(loader *ld, int t, cf_solver_settings *s);
 
-static cf_status read_material(loader *ld, int t, cf_material *m)
+/* The settings of schema table `table` (cohfrac/settings.h) at t into the
+ * definition: each key with its kind, default and range, in the schema's
+ * order; tables within it in turn. */
+static cf_status read_settings(loader *ld, int t, const char *table)
 {
-    static const double E = 1e6, nu = 0.3, rho = 2400.0, G_I = 22.0, sigma = 1e4, alpha = 2.0,
-                        friction = 0.5, restitution = 0.0, none = 0.0;
-    static const range restitution_range = {0.0, 1.0, 1, 1, NULL};
-    TRY(check_keys(ld, t, material_keys, COUNT(material_keys)));
-    TRY(get_num(ld, t, "E", &E, &POSITIVE, &m->E));
-    TRY(get_num(ld, t, "nu", &nu, &POISSON, &m->nu));
-    TRY(get_num(ld, t, "rho", &rho, &POSITIVE, &m->rho));
-    TRY(get_num(ld, t, "G_I", &G_I, &POSITIVE, &m->G_I));
-    TRY(get_num(ld, t, "sigma_max", &sigma, &POSITIVE, &m->sigma_max));
-    TRY(get_num(ld, t, "alpha", &alpha, &PPR_SHAPE, &m->alpha));
-    /* Mode II defaults to mode I (docs/physics.md §6). */
-    TRY(get_num(ld, t, "G_II", &m->G_I, &POSITIVE, &m->G_II));
-    TRY(get_num(ld, t, "tau_max", &m->sigma_max, &POSITIVE, &m->tau_max));
-    TRY(get_num(ld, t, "beta", &m->alpha, &PPR_SHAPE, &m->beta));
-    TRY(get_num(ld, t, "friction", &friction, &NON_NEGATIVE, &m->friction));
-    TRY(get_num(ld, t, "restitution", &restitution, &restitution_range, &m->restitution));
-    TRY(get_num(ld, t, "compressive_strength", &none, &NON_NEGATIVE, &m->compressive_strength));
-    TRY(get_num(ld, t, "internal_friction_angle", &none, &FRICTION_ANGLE,
-                &m->internal_friction_angle));
-    TRY(get_num(ld, t, "nucleation_radius", &none, &NON_NEGATIVE, &m->nucleation_radius));
-    TRY(get_num(ld, t, "crushing_strain", &none, &NON_NEGATIVE, &m->crushing_strain));
-    WITH_TABLE(ld, t, "strength", read_strength(ld, lua_gettop(ld->L), m));
+    int n, nk = 0;
+    const cf_setting *e = cf_settings(&n);
+    const char *keys[64];
+    for (int i = 0; i < n && nk < COUNT(keys); i++)
+        if (strcmp(e[i].table, table) == 0)
+            keys[nk++] = e[i].key;
+    TRY(check_keys(ld, t, keys, nk));
+    for (int i = 0; i < n; i++) {
+        const cf_setting *x = &e[i];
+        if (strcmp(x->table, table) != 0)
+            continue;
+        double def = x->def, v = 0;
+        if (x->def_from) /* read before it, in the schema's order */
+            def = cf_setting_get(cf_setting_find(table, x->def_from), ld->s);
+        const range r = {x->lo, x->hi, x->lo_closed, x->hi_closed, x->why};
+        int k = 0;
+        switch (x->kind) {
+        case CF_SET_NUM:
+            TRY(get_num(ld, t, x->key, &def, &r, &v));
+            break;
+        case CF_SET_INT:
+            TRY(get_int(ld, t, x->key, (int)def, &r, &k));
+            v = k;
+            break;
+        case CF_SET_BOOL:
+            TRY(get_bool(ld, t, x->key, (int)def, &k));
+            v = k;
+            break;
+        case CF_SET_ENUM: {
+            int count = 0;
+            while (x->names[count])
+                count++;
+            TRY(get_enum(ld, t, x->key, x->names, count, (int)def, &k));
+            v = k;
+            break;
+        }
+        case CF_SET_TABLE: {
+            char sub[64];
+            snprintf(sub, sizeof sub, "%s.%s", table, x->key);
+            WITH_TABLE(ld, t, x->key, read_settings(ld, lua_gettop(ld->L), sub));
+            continue;
+        }
+        case CF_SET_CUSTOM: /* solver.crack_plane, the one optional table */
+            ld->s->solver.has_crack_plane = 0;
+            if (raw_get(ld->L, t, x->key) != LUA_TNIL) {
+                lua_pop(ld->L, 1);
+                WITH_TABLE(ld, t, x->key, read_crack_plane(ld, lua_gettop(ld->L), &ld->s->solver));
+            } else {
+                lua_pop(ld->L, 1);
+            }
+            continue;
+        }
+        cf_setting_set(x, ld->s, v);
+    }
     return CF_OK;
 }
 
@@ -1003,7 +981,7 @@ static cf_status read_body(loader *ld, int t, cf_body_def *b)
 static cf_status read_region(loader *ld, int t, cf_boundary *b)
 {
     static const double tolerance = 1e-6;
-    int type;
+    int type = 0;
     TRY(get_enum(ld, t, "type", region_names, COUNT(region_names), -1, &type));
     b->type = (cf_region_type)type;
     switch (b->type) {
@@ -1151,116 +1129,6 @@ static cf_status read_crack_plane(loader *ld, int t, cf_solver_settings *s)
     return CF_OK;
 }
 
-static cf_status read_sleeping(loader *ld, int t, cf_solver_settings *s)
-{
-    static const double zero = 0.0;
-    TRY(check_keys(ld, t, sleeping_keys, COUNT(sleeping_keys)));
-    TRY(get_num(ld, t, "linear", &zero, &NON_NEGATIVE, &s->sleep_linear));
-    TRY(get_num(ld, t, "angular", &zero, &NON_NEGATIVE, &s->sleep_angular));
-    /* Bullet compares both speeds: a 0 in one would keep every body awake. */
-    if ((s->sleep_linear > 0.0) != (s->sleep_angular > 0.0)) {
-        char a[40], b[40];
-        return fail(ld, CF_ERR_SCENE_VALUE,
-                    "'%s' needs linear and angular both > 0 (or both 0: no sleeping), got "
-                    "linear = %s m/s, angular = %s rad/s",
-                    ld->path, shortest(a, s->sleep_linear), shortest(b, s->sleep_angular));
-    }
-    return CF_OK;
-}
-
-static cf_status read_pbd(loader *ld, int t, cf_solver_settings *s)
-{
-    static const double k_stiffness = 0.9, k_damping = 1.0;
-    TRY(check_keys(ld, t, pbd_keys, COUNT(pbd_keys)));
-    TRY(get_num(ld, t, "k_stiffness", &k_stiffness, &UNIT, &s->k_stiffness));
-    TRY(get_int(ld, t, "iterations", 3, &AT_LEAST_ONE, &s->iterations));
-    TRY(get_num(ld, t, "k_damping", &k_damping, &UNIT, &s->k_damping));
-    TRY(get_bool(ld, t, "iteration_independent", 0, &s->iteration_independent));
-    return CF_OK;
-}
-
-static cf_status read_xpbd(loader *ld, int t, cf_solver_settings *s)
-{
-    static const double one = 1.0;
-    TRY(check_keys(ld, t, xpbd_keys, COUNT(xpbd_keys)));
-    TRY(get_num(ld, t, "compliance_scale", &one, &POSITIVE, &s->compliance_scale));
-    return CF_OK;
-}
-
-static cf_status read_guard(loader *ld, int t, cf_solver_settings *s)
-{
-    static const double inverted = 0.01, growth = 0.5;
-    TRY(check_keys(ld, t, guard_keys, COUNT(guard_keys)));
-    TRY(get_num(ld, t, "max_inverted_fraction", &inverted, &UNIT, &s->max_inverted_fraction));
-    TRY(get_num(ld, t, "max_energy_growth", &growth, &POSITIVE, &s->max_energy_growth));
-    return CF_OK;
-}
-
-static cf_status read_solver(loader *ld, int t, cf_solver_settings *s)
-{
-    static const double dt_rigid = 1e-3, dt_fracture = 5e-6, max_fracture_time = 0.05,
-                        impact_threshold = 0.2, contact_stiffness = 0.0, cfl_fraction = 0.0,
-                        mass_scaling = 0.0, debris_size = 0.0, min_piece_size = 0.0;
-    lua_State *L = ld->L;
-    int mode, backend, elasticity, criterion, growth, constraints, obstacle_contact;
-    TRY(check_keys(ld, t, solver_keys, COUNT(solver_keys)));
-    TRY(get_enum(ld, t, "mode", mode_names, COUNT(mode_names), CF_RUN_HYBRID, &mode));
-    s->mode = (cf_run_mode)mode;
-    TRY(get_enum(ld, t, "rigid_backend", backend_names, COUNT(backend_names), CF_RIGID_BULLET,
-                 &backend));
-    s->rigid_backend = (cf_rigid_backend)backend;
-    TRY(get_num(ld, t, "dt_rigid", &dt_rigid, &POSITIVE, &s->dt_rigid));
-    TRY(get_int(ld, t, "rigid_substeps", 5, &AT_LEAST_ONE, &s->rigid_substeps));
-    TRY(get_bool(ld, t, "ccd", 1, &s->ccd));
-    WITH_TABLE(ld, t, "sleeping", read_sleeping(ld, lua_gettop(L), s));
-    TRY(get_num(ld, t, "dt_fracture", &dt_fracture, &POSITIVE, &s->dt_fracture));
-    if (s->dt_fracture > s->dt_rigid)
-        return fail(ld, CF_ERR_SCENE_VALUE,
-                    "'%s' must not exceed solver.dt_rigid (%g), got %g", kp(ld, "dt_fracture"),
-                    s->dt_rigid, s->dt_fracture);
-    TRY(get_num(ld, t, "cfl_fraction", &cfl_fraction, &NON_NEGATIVE, &s->cfl_fraction));
-    TRY(get_int(ld, t, "check_interval", 1, &AT_LEAST_ONE, &s->check_interval));
-    TRY(get_int(ld, t, "quiet_steps", 400, &AT_LEAST_ONE, &s->quiet_steps));
-    TRY(get_num(ld, t, "max_fracture_time", &max_fracture_time, &POSITIVE,
-                &s->max_fracture_time));
-    TRY(get_num(ld, t, "impact_threshold", &impact_threshold, &NON_NEGATIVE,
-                &s->impact_threshold));
-    TRY(get_enum(ld, t, "elasticity", elasticity_names, COUNT(elasticity_names),
-                 CF_ELASTICITY_COROTATIONAL, &elasticity));
-    s->elasticity = (cf_elasticity)elasticity;
-    TRY(get_enum(ld, t, "criterion", criterion_names, COUNT(criterion_names),
-                 CF_CRITERION_TRACTION, &criterion));
-    s->criterion = (cf_criterion)criterion;
-    TRY(get_enum(ld, t, "crack_growth", growth_names, COUNT(growth_names), CF_GROWTH_FRONTS,
-                 &growth));
-    s->crack_growth = (cf_crack_growth)growth;
-    TRY(get_enum(ld, t, "obstacle_contact", obstacle_contact_names, COUNT(obstacle_contact_names),
-                 CF_OBSTACLE_CONTACT_KINEMATIC, &obstacle_contact));
-    s->obstacle_contact = (cf_obstacle_contact)obstacle_contact;
-    TRY(get_num(ld, t, "mass_scaling", &mass_scaling, &UNIT, &s->mass_scaling));
-    TRY(get_int(ld, t, "min_piece_tets", 4, &PIECE_TETS, &s->min_piece_tets));
-    TRY(get_num(ld, t, "min_piece_size", &min_piece_size, &NON_NEGATIVE, &s->min_piece_size));
-    TRY(get_int(ld, t, "debris_tets", 4, &PIECE_TETS, &s->debris_tets));
-    TRY(get_num(ld, t, "debris_size", &debris_size, &NON_NEGATIVE, &s->debris_size));
-    s->has_crack_plane = 0;
-    if (raw_get(L, t, "crack_plane") != LUA_TNIL) {
-        lua_pop(L, 1);
-        WITH_TABLE(ld, t, "crack_plane", read_crack_plane(ld, lua_gettop(L), s));
-    } else {
-        lua_pop(L, 1);
-    }
-    TRY(get_enum(ld, t, "constraints", constraints_names, COUNT(constraints_names),
-                 CF_CONSTRAINTS_PBD, &constraints));
-    s->constraints = (cf_constraints)constraints;
-    WITH_TABLE(ld, t, "pbd", read_pbd(ld, lua_gettop(L), s));
-    WITH_TABLE(ld, t, "xpbd", read_xpbd(ld, lua_gettop(L), s));
-    TRY(get_num(ld, t, "contact_stiffness", &contact_stiffness, &NON_NEGATIVE,
-                &s->contact_stiffness));
-    WITH_TABLE(ld, t, "guard", read_guard(ld, lua_gettop(L), s));
-    TRY(get_int(ld, t, "threads", 0, &NON_NEGATIVE, &s->threads));
-    return CF_OK;
-}
-
 static cf_status read_output(loader *ld, int t, const char *name, int fracture_only,
                              cf_output_settings *o)
 {
@@ -1312,7 +1180,7 @@ static cf_status read_scene(loader *ld, int t)
     TRY(get_str(ld, t, "name", "scene", s->name, sizeof s->name));
     TRY(get_num(ld, t, "duration", &duration, &POSITIVE, &s->duration));
     TRY(get_vec(ld, t, "gravity", 3, GRAVITY, s->gravity));
-    WITH_TABLE(ld, t, "material", read_material(ld, lua_gettop(L), &s->material));
+    WITH_TABLE(ld, t, "material", read_settings(ld, lua_gettop(L), "material"));
 
     if (raw_get(L, t, "bodies") == LUA_TNIL)
         return fail(ld, CF_ERR_SCENE_KEY, "missing required key 'bodies' (a list of solids)");
@@ -1371,13 +1239,16 @@ static cf_status read_scene(loader *ld, int t)
     }
     lua_pop(L, 1);
 
-    WITH_TABLE(ld, t, "solver", read_solver(ld, lua_gettop(L), &s->solver));
+    WITH_TABLE(ld, t, "solver", read_settings(ld, lua_gettop(L), "solver"));
+    cf_error rule;
+    if (cf_solver_check_rules(&s->solver, &rule) != CF_OK)
+        return fail(ld, rule.code, "%s", rule.msg);
     if (s->n_boundaries > 0 && s->solver.mode != CF_RUN_FRACTURE)
         return fail(ld, CF_ERR_SCENE_VALUE,
                     "'boundary' has %d entr%s but solver.mode is \"%s\": boundary conditions "
                     "need solver.mode = \"fracture\"",
                     s->n_boundaries, s->n_boundaries == 1 ? "y" : "ies",
-                    mode_names[s->solver.mode]);
+                    cf_setting_find("solver", "mode")->names[s->solver.mode]);
     WITH_TABLE(ld, t, "output",
                read_output(ld, lua_gettop(L), s->name, s->solver.mode == CF_RUN_FRACTURE,
                            &s->output));
@@ -1742,38 +1613,54 @@ static void put_boundary(text *b, const cf_boundary *d)
     put(b, "    },\n");
 }
 
+/* The settings of schema table `table` in d, as read_settings reads them. */
+static void put_settings(text *b, int ind, const cf_world_def *d, const char *table)
+{
+    int n;
+    const cf_setting *e = cf_settings(&n);
+    for (int i = 0; i < n; i++) {
+        const cf_setting *x = &e[i];
+        if (strcmp(x->table, table) != 0)
+            continue;
+        double v = cf_setting_get(x, d);
+        const cf_solver_settings *sv = &d->solver;
+        char sub[64];
+        switch (x->kind) {
+        case CF_SET_NUM: put_num(b, ind, x->key, v); break;
+        case CF_SET_INT: put(b, "%*s%s = %d,\n", ind, "", x->key, (int)v); break;
+        case CF_SET_BOOL: put(b, "%*s%s = %s,\n", ind, "", x->key, v ? "true" : "false"); break;
+        case CF_SET_ENUM: put_str(b, ind, x->key, x->names[(int)v]); break;
+        case CF_SET_TABLE:
+            snprintf(sub, sizeof sub, "%s.%s", table, x->key);
+            put(b, "%*s%s = {\n", ind, "", x->key);
+            put_settings(b, ind + 2, d, sub);
+            put(b, "%*s},\n", ind, "");
+            break;
+        case CF_SET_CUSTOM: /* solver.crack_plane */
+            if (!sv->has_crack_plane) {
+                put(b, "%*s-- %s: none\n", ind, "", x->key);
+                break;
+            }
+            put(b, "%*s%s = {\n", ind, "", x->key);
+            put_vec(b, ind + 2, "point", sv->crack_plane_point, 3);
+            put_vec(b, ind + 2, "normal", sv->crack_plane_normal, 3);
+            put_num(b, ind + 2, "tolerance", sv->crack_plane_tolerance);
+            put(b, "%*s},\n", ind, "");
+            break;
+        }
+    }
+}
+
 /* The whole scene as Lua text in schema order; NULL when out of memory. */
 static char *resolved_text(const cf_world_def *s)
 {
     text b = {0};
-    const cf_material *m = &s->material;
-    const cf_solver_settings *v = &s->solver;
     put(&b, "return {\n");
     put_str(&b, 2, "name", s->name);
     put_num(&b, 2, "duration", s->duration);
     put_vec(&b, 2, "gravity", s->gravity, 3);
     put(&b, "  material = {\n");
-    put_num(&b, 4, "E", m->E);
-    put_num(&b, 4, "nu", m->nu);
-    put_num(&b, 4, "rho", m->rho);
-    put_num(&b, 4, "G_I", m->G_I);
-    put_num(&b, 4, "sigma_max", m->sigma_max);
-    put_num(&b, 4, "alpha", m->alpha);
-    put_num(&b, 4, "G_II", m->G_II);
-    put_num(&b, 4, "tau_max", m->tau_max);
-    put_num(&b, 4, "beta", m->beta);
-    put_num(&b, 4, "friction", m->friction);
-    put_num(&b, 4, "restitution", m->restitution);
-    put_num(&b, 4, "compressive_strength", m->compressive_strength);
-    put_num(&b, 4, "internal_friction_angle", m->internal_friction_angle);
-    put_num(&b, 4, "nucleation_radius", m->nucleation_radius);
-    put_num(&b, 4, "crushing_strain", m->crushing_strain);
-    put(&b, "    strength = {\n");
-    put_str(&b, 6, "distribution", distribution_names[m->weibull]);
-    put_num(&b, 6, "modulus", m->weibull_modulus);
-    put_num(&b, 6, "seed", m->strength_seed);
-    put_num(&b, 6, "area", m->strength_area);
-    put(&b, "    },\n");
+    put_settings(&b, 4, s, "material");
     put(&b, "  },\n  bodies = {\n");
     for (int i = 0; i < s->n_bodies; i++) {
         const cf_body_def *d = &s->bodies[i];
@@ -1831,54 +1718,7 @@ static char *resolved_text(const cf_world_def *s)
         put(&b, "    },\n");
     }
     put(&b, "  },\n  solver = {\n");
-    put_str(&b, 4, "mode", mode_names[v->mode]);
-    put_str(&b, 4, "rigid_backend", backend_names[v->rigid_backend]);
-    put_num(&b, 4, "dt_rigid", v->dt_rigid);
-    put(&b, "    rigid_substeps = %d,\n", v->rigid_substeps);
-    put(&b, "    ccd = %s,\n", v->ccd ? "true" : "false");
-    put(&b, "    sleeping = {\n");
-    put_num(&b, 6, "linear", v->sleep_linear);
-    put_num(&b, 6, "angular", v->sleep_angular);
-    put(&b, "    },\n");
-    put_num(&b, 4, "dt_fracture", v->dt_fracture);
-    put_num(&b, 4, "cfl_fraction", v->cfl_fraction);
-    put(&b, "    check_interval = %d,\n", v->check_interval);
-    put(&b, "    quiet_steps = %d,\n", v->quiet_steps);
-    put_num(&b, 4, "max_fracture_time", v->max_fracture_time);
-    put_num(&b, 4, "impact_threshold", v->impact_threshold);
-    put_str(&b, 4, "elasticity", elasticity_names[v->elasticity]);
-    put_str(&b, 4, "criterion", criterion_names[v->criterion]);
-    put_str(&b, 4, "crack_growth", growth_names[v->crack_growth]);
-    put(&b, "    min_piece_tets = %d,\n", v->min_piece_tets);
-    put_num(&b, 4, "min_piece_size", v->min_piece_size);
-    put(&b, "    debris_tets = %d,\n", v->debris_tets);
-    put_num(&b, 4, "debris_size", v->debris_size);
-    put_str(&b, 4, "obstacle_contact", obstacle_contact_names[v->obstacle_contact]);
-    put_num(&b, 4, "mass_scaling", v->mass_scaling);
-    if (v->has_crack_plane) {
-        put(&b, "    crack_plane = {\n");
-        put_vec(&b, 6, "point", v->crack_plane_point, 3);
-        put_vec(&b, 6, "normal", v->crack_plane_normal, 3);
-        put_num(&b, 6, "tolerance", v->crack_plane_tolerance);
-        put(&b, "    },\n");
-    } else {
-        put(&b, "    -- crack_plane: none\n");
-    }
-    put_str(&b, 4, "constraints", constraints_names[v->constraints]);
-    put(&b, "    pbd = {\n");
-    put_num(&b, 6, "k_stiffness", v->k_stiffness);
-    put(&b, "      iterations = %d,\n", v->iterations);
-    put_num(&b, 6, "k_damping", v->k_damping);
-    put(&b, "      iteration_independent = %s,\n", v->iteration_independent ? "true" : "false");
-    put(&b, "    },\n    xpbd = {\n");
-    put_num(&b, 6, "compliance_scale", v->compliance_scale);
-    put(&b, "    },\n");
-    put_num(&b, 4, "contact_stiffness", v->contact_stiffness);
-    put(&b, "    guard = {\n");
-    put_num(&b, 6, "max_inverted_fraction", v->max_inverted_fraction);
-    put_num(&b, 6, "max_energy_growth", v->max_energy_growth);
-    put(&b, "    },\n");
-    put(&b, "    threads = %d,\n", v->threads);
+    put_settings(&b, 4, s, "solver");
     put(&b, "  },\n  output = {\n");
     put_str(&b, 4, "file", s->output.file);
     put_num(&b, 4, "frame_interval", s->output.frame_interval);

@@ -18,6 +18,7 @@
 #include "cohfrac/h5_output.h"
 #include "cohfrac/mesh.h"
 #include "cohfrac/scene.h"
+#include "cohfrac/settings.h"
 #include "cohfrac/sim.h"
 #include "cohfrac/surface.h"
 #include "cohfrac/tetmesh.h"

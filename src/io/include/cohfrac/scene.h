@@ -8,7 +8,10 @@
  * key has a default; `--set key.path=value` overrides anything (the value is
  * a Lua expression: 1e-6, "pbd", {0,0,1}; list items as bodies[1].scale).
  *
- * Schema (SI units; defaults in brackets):
+ * Schema (SI units; defaults in brackets).  The keys of `material` and
+ * `solver` are the settings schema's (cohfrac/settings.h): its table
+ * docs/settings.md gives each one's kind, default, allowed values and unit;
+ * below they are explained at length:
  *   name            string   ["scene"]
  *   duration        s        [1.0]        simulated time
  *   gravity         {x,y,z}  [{0,0,-9.81}] m/s^2
