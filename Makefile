@@ -43,9 +43,11 @@ figures: meshes
 	    --md docs/scenes.md --sheet docs/images/figures.png
 
 # The fracture-mode step on the 203k-tet bunny against the memory floor, 1
-# against 2 threads and against btSoftBody (docs/performance.md).
+# against 2 threads and against btSoftBody (docs/performance.md); its last
+# line goes to bench/results/<machine>.csv (bench/record.sh).
 bench: meshes
-	$(BUILD)/cohfrac bench --peer -m $(MESHES)
+	@{ $(BUILD)/cohfrac bench --peer -m $(MESHES); echo $$? > $(BUILD)/bench.rc; } | tee $(BUILD)/bench.txt
+	@[ "$$(cat $(BUILD)/bench.rc)" = 0 ] && sh bench/record.sh $(BUILD)/bench.txt
 
 # Step time and memory per tet from 15k to 800k tets.
 bench-scaling: meshes
