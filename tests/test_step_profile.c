@@ -160,7 +160,7 @@ static cf_world *make_world(scene_kind kind, int threads, int n, cf_mesh *box)
 static void step(cf_world *w)
 {
     cf_error err = {0};
-    if (cf_world_step(w, &err) != CF_OK)
+    if (cf_world_step(w, cf_world_dt_outer(w), &err) != CF_OK)
         fail_msg("step: %s", err.msg);
 }
 

@@ -70,8 +70,11 @@ static void test_api_world_equals_lua_scene(void **state)
     cf_mesh_free(&box);
     memset(&ground, 0xff, sizeof ground);
     int handoffs = 0, born = 0, inserted = 0;
-    while (!cf_world_done(w)) {
-        assert_int_equal(cf_world_step(w, &err), CF_OK);
+    /* As the run loop steps it: ceil(duration / dt) regular steps. */
+    double dt = cf_world_dt_outer(w);
+    long n_steps = lround(ceil(def.duration / dt - 1e-9));
+    while (cf_world_step_count(w) < n_steps) {
+        assert_int_equal(cf_world_step(w, dt, &err), CF_OK);
         int n;
         const cf_event *ev = cf_world_events(w, &n);
         for (int i = 0; i < n; i++) {
@@ -221,7 +224,7 @@ static void test_threads_are_the_worlds(void **state)
     for (int k = 0; k < 2; k++)
         for (int i = 0; i < 2; i++) {
             cf_error err = {0};
-            assert_int_equal(cf_world_step(w[i], &err), CF_OK);
+            assert_int_equal(cf_world_step(w[i], cf_world_dt_outer(w[i]), &err), CF_OK);
             assert_int_equal(omp_get_max_threads(), 3);
         }
     assert_int_equal(seen[0], 1);

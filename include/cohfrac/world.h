@@ -3,7 +3,9 @@
  *
  * cf_world_create builds what a world definition (cohfrac/types.h) asks
  * for and nothing else (no Bullet world for the `pbd` rigid backend);
- * cf_world_step advances it by one rigid step.  The world does no file
+ * cf_world_step advances it by the step its caller gives: the caller owns
+ * time (the run loop of cohfrac/sim.h steps to the scene's duration).
+ * The world does no file
  * I/O and prints nothing: what happened in a step (hand-offs, new
  * fragments, cohesive insertions) is pushed as events the caller drains
  * (cf_world_events), and everything else is read through the queries below.
@@ -61,17 +63,19 @@ typedef struct cf_ledger {
  * FCL); CF_ERR_NOMEM.  On error *out is NULL. */
 cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err);
 
-/* One rigid step (dt_rigid, sub-cycled in fracture mode), with hand-offs
- * and the divergence guard.  Errors: CF_ERR_DIVERGED (a non-finite or
- * faster than 1e5 m/s node, more inverted tets than
- * solver.guard.max_inverted_fraction, or kinetic + strain + cohesive energy
- * above (1 + solver.guard.max_energy_growth) times the initial energy plus
- * all work input; the message names dt/dt_cfl and what to change),
- * CF_ERR_NOMEM.  cf_world_done tells when the duration is reached: the
- * step count is ceil(duration / dt_rigid), so the last step ends at or just
- * past it (cf_world_dt_outer). */
-cf_status cf_world_step(cf_world *w, cf_error *err);
-int cf_world_done(const cf_world *w);
+/* One rigid step of dt seconds (sub-cycled in fracture mode), with
+ * hand-offs and the divergence guard.  dt is the regular step
+ * cf_world_dt_outer(w) (dt_rigid; fracture-only runs: a whole number of
+ * fracture steps), or less to end a run between two regular steps; a
+ * fracture-only run then takes the fewest whole fracture steps that cover
+ * dt, so cf_world_time may lie less than one fracture step past t + dt.
+ * A dt outside (0, cf_world_dt_outer] is a programming error (assert).
+ * Errors: CF_ERR_DIVERGED (a non-finite or faster than 1e5 m/s node, more
+ * inverted tets than solver.guard.max_inverted_fraction, or kinetic +
+ * strain + cohesive energy above (1 + solver.guard.max_energy_growth)
+ * times the initial energy plus all work input; the message names
+ * dt/dt_cfl and what to change), CF_ERR_NOMEM. */
+cf_status cf_world_step(cf_world *w, double dt, cf_error *err);
 
 /* Threads for this world's element loops from the next step on (n >= 1;
  * other worlds and the caller's OpenMP setting keep theirs).  The results
@@ -87,10 +91,9 @@ void cf_world_set_threads(cf_world *w, int n);
 typedef void (*cf_world_tick_fn)(void *user, double t);
 void cf_world_set_tick(cf_world *w, cf_world_tick_fn fn, void *user);
 
-/* Rigid steps taken and the number the duration needs; the rigid step, s
- * (fracture-only runs: a whole number of fracture steps). */
+/* Rigid steps taken; the regular rigid step, s (fracture-only runs: a
+ * whole number of fracture steps). */
 long cf_world_step_count(const cf_world *w);
-long cf_world_steps_total(const cf_world *w);
 double cf_world_dt_outer(const cf_world *w);
 
 /* One fragment's record (an initial body or a product of a split). */

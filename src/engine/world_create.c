@@ -451,7 +451,6 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
     if (scene->solver.mode == CF_RUN_FRACTURE)
         sim->dt_outer = fmax(1.0, floor(scene->solver.dt_rigid / sim->dt_fracture + 1e-9)) *
                         sim->dt_fracture;
-    sim->n_steps = lround(ceil(scene->duration / sim->dt_outer - 1e-9));
     if (st == CF_OK && scene->solver.rigid_backend == CF_RIGID_BULLET &&
         scene->solver.mode == CF_RUN_HYBRID) {
         sim->bullet = cfb_world_create(scene->gravity);

@@ -36,7 +36,6 @@ struct cf_world {
     int threads;             /* the element loops' threads (cf_world_set_threads) */
     void *tick_user;
     long step;               /* rigid steps done */
-    long n_steps;            /* rigid steps in the scene's duration */
     double dt_fracture;      /* s: solver.dt_fracture, or cfl_fraction dt_cfl */
     double h_fracture;       /* s: the last fracture step taken (the penalty's stiffness) */
     double dt_outer;         /* s: dt_rigid (fracture-only runs: a whole number of

@@ -198,8 +198,6 @@ const char *cf_stage_name(cf_stage s)
 
 const cf_world_def *cf_world_definition(const cf_world *sim) { return &sim->def; }
 
-int cf_world_done(const cf_world *sim) { return sim->step >= sim->n_steps; }
-
 void cf_world_set_tick(cf_world *sim, cf_world_tick_fn fn, void *user)
 {
     sim->tick = fn, sim->tick_user = user;
@@ -212,8 +210,6 @@ void cf_world_set_threads(cf_world *sim, int n)
 }
 
 long cf_world_step_count(const cf_world *sim) { return sim->step; }
-
-long cf_world_steps_total(const cf_world *sim) { return sim->n_steps; }
 
 double cf_world_dt_outer(const cf_world *sim) { return sim->dt_outer; }
 

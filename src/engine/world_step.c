@@ -12,6 +12,7 @@
 #include "linalg.h"
 #include "parallel.h"
 
+#include <assert.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -456,23 +457,22 @@ static cf_status split_fragments(cf_world *sim, cf_error *err)
     return CF_OK;
 }
 
-static cf_status world_step(cf_world *sim, cf_error *err)
+static cf_status world_step(cf_world *sim, double want, cf_error *err)
 {
     cf_profile_start(&sim->prof);
     const cf_world_def *sc = &sim->def;
     double dt = sim->dt_outer, h, t0 = sim->t;
     long n_sub = sub_steps(sim, dt, &h);
-    /* The last step is cut short so that the run ends at the duration: in
-     * rigid mode exactly; a fracture-only run in whole fracture steps of the
-     * same h (the leapfrog energy estimate needs a constant step), so it
-     * ends less than one fracture step past it. */
-    double rest = sc->duration - (double)sim->step * sim->dt_outer;
-    int cut = sim->step == sim->n_steps - 1 && rest < (1 - 1e-9) * dt;
+    /* A step shorter than the regular one (a run that ends between two):
+     * in rigid mode exactly `want`; a fracture-only run in whole fracture
+     * steps of the same h (the leapfrog energy estimate needs a constant
+     * step), so it ends less than one fracture step past t0 + want. */
+    int cut = want < (1 - 1e-9) * dt;
     if (cut && sc->solver.mode == CF_RUN_FRACTURE) {
-        n_sub = lround(fmax(1.0, ceil(rest / h - 1e-9)));
+        n_sub = lround(fmax(1.0, ceil(want / h - 1e-9)));
         dt = (double)n_sub * h;
     } else if (cut) {
-        dt = rest;
+        dt = want;
         n_sub = sub_steps(sim, dt, &h);
     }
     int n_coh = sim->solid.n_coh;
@@ -483,8 +483,8 @@ static cf_status world_step(cf_world *sim, cf_error *err)
     if (sim->steps_fracture > stepped)
         sim->t_fracture += dt;
     sim->step++;
-    sim->t = !cut ? (double)sim->step * sim->dt_outer
-                  : sc->solver.mode == CF_RUN_FRACTURE ? t0 + dt : sc->duration;
+    /* Regular steps count from zero, so that no rounding builds up. */
+    sim->t = !cut ? (double)sim->step * sim->dt_outer : t0 + dt;
     if (st == CF_OK && sim->solid.n_coh > n_coh) {
         cf_event e = {.type = CF_EVENT_INSERTIONS, .time = sim->t, .first = n_coh,
                       .count = sim->solid.n_coh - n_coh, .alive = cf_world_alive_fragments(sim, NULL)};
@@ -502,13 +502,14 @@ static cf_status world_step(cf_world *sim, cf_error *err)
     return st;
 }
 
-cf_status cf_world_step(cf_world *sim, cf_error *err)
+cf_status cf_world_step(cf_world *sim, double dt, cf_error *err)
 {
+    assert(dt > 0 && dt <= sim->dt_outer * (1 + 1e-9)); /* the caller's step (world.h) */
     /* OpenMP's thread count is the calling thread's setting: the step runs
      * on the world's and gives the caller back its own. */
     int caller = omp_get_max_threads();
     omp_set_num_threads(sim->threads);
-    cf_status st = world_step(sim, err);
+    cf_status st = world_step(sim, dt, err);
     omp_set_num_threads(caller);
     return st;
 }

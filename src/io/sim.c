@@ -48,6 +48,7 @@ struct cf_sim {
     cf_run_options opt;
     char name[128];
     double duration;            /* s */
+    long n_steps;               /* rigid steps the duration needs (the last may be cut) */
     cf_output_settings output;
     cf_h5 *h5;                  /* NULL when no output is asked for */
     double next_frame;          /* s */
@@ -79,7 +80,7 @@ struct cf_sim {
 
 cf_world *cf_sim_world(const cf_sim *sim) { return sim->world; }
 
-int cf_sim_done(const cf_sim *sim) { return cf_world_done(sim->world); }
+int cf_sim_done(const cf_sim *sim) { return cf_world_step_count(sim->world) >= sim->n_steps; }
 
 static int tty(void) { return isatty(STDERR_FILENO); }
 
@@ -340,8 +341,10 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
         st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
     if (st == CF_OK)
         st = cf_world_create(&w, &sim->world, err);
-    if (st == CF_OK)
+    if (st == CF_OK) {
         cf_world_set_tick(sim->world, tick, sim);
+        sim->n_steps = lround(ceil(sim->duration / cf_world_dt_outer(sim->world) - 1e-9));
+    }
     if (st == CF_OK && w.solver.threads == 0) { /* the default: adapts to the host */
         cf_world_stats ws;
         cf_world_stats_get(sim->world, &ws);
@@ -550,7 +553,7 @@ static void progress(cf_sim *sim, int final)
         return;
     sim->last_progress = now;
     cf_world *w = sim->world;
-    long done = cf_world_step_count(w), total = cf_world_steps_total(w);
+    long done = cf_world_step_count(w), total = sim->n_steps;
     double frac = total > 0 ? fmin(1.0, (double)done / (double)total) : 1.0;
     cf_world_stats ws;
     cf_world_stats_get(w, &ws);
@@ -647,12 +650,18 @@ cf_status cf_sim_advance(cf_sim *sim, cf_error *err)
     if (sim->loop_start == 0)
         sim->loop_start = cf_wall_time();
     cf_world *w = sim->world;
-    cf_status st = cf_world_step(w, err);
+    /* The run owns time: regular steps, the last one cut short so that the
+     * run ends at the duration (ceil(duration / dt) steps in all). */
+    long step = cf_world_step_count(w);
+    double dt_step = cf_world_dt_outer(w), rest = sim->duration - (double)step * dt_step;
+    if (step == sim->n_steps - 1 && rest < (1 - 1e-9) * dt_step)
+        dt_step = rest;
+    cf_status st = cf_world_step(w, dt_step, err);
     cf_status st2 = drain_events(sim, st == CF_OK ? err : NULL);
     if (st == CF_OK)
         st = st2;
     double t = cf_world_time(w), dt = cf_world_dt_outer(w);
-    if (st == CF_OK && (t >= sim->next_frame - 1e-9 * dt || cf_world_done(w))) {
+    if (st == CF_OK && (t >= sim->next_frame - 1e-9 * dt || cf_sim_done(sim))) {
         st = write_frame(sim, err);
         while (sim->next_frame <= t + 1e-9 * dt)
             sim->next_frame += sim->output.frame_interval;
