@@ -1,6 +1,7 @@
 /* cohfrac — the two rigid backends side by side (see src/cli/compare.h
  * for the metrics, the reference rules and the files). */
 #include "compare.h"
+#include "compare_metrics.h"
 #include "cohfrac/surface.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
@@ -20,67 +21,6 @@
 #include <unistd.h>
 
 static const char *const backend_name[2] = {"bullet", "pbd"};
-
-/* Two principal moments agreeing within this (relative) make a symmetric top. */
-#define TOP_TOLERANCE 1e-3
-#define TWO_PI 6.283185307179586
-
-/* The alive fragments of one run at one sample, with an id -> index map. */
-typedef struct snap {
-    cf_fragment_state *f;
-    int n, cap;
-    int *index; /* [max id + 1]: position in f, -1 when not alive */
-    int index_cap;
-} snap;
-
-typedef struct sample {
-    double t;                    /* s */
-    double com_dist, orient;     /* m, rad: mass-weighted over matched fragments */
-    int nfrag[2];
-    double com[2][3];            /* m, whole-body centre of mass per backend */
-    double ref[3];               /* m, analytic centre of mass (NaN: none) */
-    double ref_err[2];           /* m */
-    double ke[2], p[2], l[2];    /* drifts (see compare.h) */
-    double axis_angle[2];        /* rad, top's symmetry axis about L, wrapped */
-} sample;
-
-/* Everything the reference needs, fixed at t = 0. */
-typedef struct reference {
-    cf_compare_ref kind;
-    double x0[3], v0[3], g[3];   /* m, m/s, m/s^2 */
-    /* bounce */
-    double n[3], e, t1, t2, x1[3], v1[3]; /* plane normal; restitution; contacts, s;
-                                             state just after the first contact */
-    /* symmetric top */
-    int top;
-    double omega_p;              /* rad/s */
-    double Lhat[3], u1[3], u2[3];/* L direction and a basis of the plane normal to it */
-    double e_sym[3];             /* rest frame */
-} reference;
-
-typedef struct totals {
-    double M, E, P[3], L[3], com[3];
-} totals;
-
-/* ---- small helpers ---- */
-
-static double v3_dist(const double a[3], const double b[3])
-{
-    double d[3];
-    v3_sub(a, b, d);
-    return v3_norm(d);
-}
-
-/* Angle of q_a^-1 q_b, rad, in [0, pi]. */
-static double quat_angle(const double a[4], const double b[4])
-{
-    /* conj(a) b: scalar part and the norm of the vector part */
-    double w = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
-    double x = a[0] * b[1] - a[1] * b[0] - a[2] * b[3] + a[3] * b[2];
-    double y = a[0] * b[2] + a[1] * b[3] - a[2] * b[0] - a[3] * b[1];
-    double z = a[0] * b[3] - a[1] * b[2] + a[2] * b[1] - a[3] * b[0];
-    return 2.0 * atan2(sqrt(x * x + y * y + z * z), fabs(w));
-}
 
 static cf_status snap_take(cf_sim *sim, snap *s, cf_error *err)
 {
@@ -115,183 +55,6 @@ static void snap_free(snap *s)
 {
     free(s->f), free(s->index);
     memset(s, 0, sizeof *s);
-}
-
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
-/* partner[i]: index in sb of the fragment of run b holding the most tets of
- * sa's fragment i (-1: none); shared[i]: how many.  keys: scratch [tets]. */
-static void match_fragments(const cf_sim *a, const cf_sim *b, const snap *sa, const snap *sb,
-                            uint64_t *keys, int *partner, int *shared)
-{
-    int nt = cf_world_tet_count(cf_sim_world(a)), nk = 0;
-    for (int t = 0; t < nt; t++) {
-        int fa = cf_world_tet_fragment(cf_sim_world(a), t), fb = cf_world_tet_fragment(cf_sim_world(b), t);
-        if (fa >= 0 && fb >= 0)
-            keys[nk++] = (uint64_t)fa << 32 | (uint64_t)(uint32_t)fb;
-    }
-    qsort(keys, (size_t)nk, sizeof *keys, cmp_u64);
-    for (int i = 0; i < sa->n; i++)
-        partner[i] = -1, shared[i] = 0;
-    for (int k = 0; k < nk;) {
-        int run = k;
-        while (run < nk && keys[run] == keys[k])
-            run++;
-        int fa = (int)(keys[k] >> 32), fb = (int)(keys[k] & 0xffffffffu);
-        int ia = fa < sa->index_cap ? sa->index[fa] : -1;
-        int ib = fb < sb->index_cap ? sb->index[fb] : -1;
-        if (ia >= 0 && ib >= 0 && run - k > shared[ia])
-            partner[ia] = ib, shared[ia] = run - k;
-        k = run;
-    }
-}
-
-static void sum_totals(const snap *s, const double g[3], totals *o)
-{
-    memset(o, 0, sizeof *o);
-    for (int i = 0; i < s->n; i++) {
-        const cf_fragment_state *f = &s->f[i];
-        o->M += f->mass;
-        o->E += f->kinetic - f->mass * v3_dot(g, f->com);
-        v3_axpy(1.0, f->momentum, o->P);
-        v3_axpy(1.0, f->angular_momentum, o->L);
-        v3_axpy(f->mass, f->com, o->com);
-    }
-    if (o->M > 0)
-        for (int k = 0; k < 3; k++)
-            o->com[k] /= o->M;
-}
-
-static int heaviest(const snap *s)
-{
-    int best = -1;
-    for (int i = 0; i < s->n; i++)
-        if (best < 0 || s->f[i].mass > s->f[best].mass)
-            best = i;
-    return best;
-}
-
-/* ---- the analytic reference ---- */
-
-static void ballistic(const double x0[3], const double v0[3], const double g[3], double t,
-                      double x[3])
-{
-    for (int k = 0; k < 3; k++)
-        x[k] = x0[k] + v0[k] * t + 0.5 * g[k] * t * t;
-}
-
-/* Centre of mass of the reference at t; returns 0 (x NaN) past its validity. */
-static int reference_at(const reference *r, double t, double x[3])
-{
-    if (r->kind == CF_CMP_REF_NONE || (r->kind == CF_CMP_REF_BOUNCE && t > r->t2 + 1e-12)) {
-        x[0] = x[1] = x[2] = NAN;
-        return 0;
-    }
-    if (r->kind == CF_CMP_REF_BOUNCE && t > r->t1)
-        ballistic(r->x1, r->v1, r->g, t - r->t1, x);
-    else
-        ballistic(r->x0, r->v0, r->g, t, x);
-    return 1;
-}
-
-/* Decide the reference from the scene and the state at t = 0 (Bullet run). */
-static void reference_setup(const cf_world_def *sc, cf_sim *sim, const snap *first, reference *r)
-{
-    memset(r, 0, sizeof *r);
-    r->kind = CF_CMP_REF_NONE;
-    r->t2 = INFINITY;
-    if (sc->n_bodies != 1 || sc->n_boundaries != 0 || first->n != 1)
-        return;
-    const cf_body_def *b = &sc->bodies[0];
-    const cf_fragment_state *f = &first->f[0];
-    memcpy(r->x0, f->com, sizeof r->x0);
-    memcpy(r->g, sc->gravity, sizeof r->g);
-    /* v0 from the scene's velocity field at the centre of mass (the spin
-     * term vanishes there), not from either backend */
-    for (int k = 0; k < 3; k++) {
-        double c = b->has_expansion_center ? b->expansion_center[k] : f->com[k];
-        r->v0[k] = b->velocity[k] + b->expansion_rate[k] * (f->com[k] - c);
-    }
-    double w0n = v3_norm(b->angular_velocity);
-    if (sc->n_obstacles == 0) {
-        r->kind = v3_norm(r->v0) == 0 ? CF_CMP_REF_FREE_FALL : CF_CMP_REF_PROJECTILE;
-        /* symmetric top: which moment is the distinct one */
-        const double *p = f->principal;
-        int k_sym = -1;
-        for (int k = 0; k < 3; k++) {
-            int i = (k + 1) % 3, j = (k + 2) % 3;
-            double pij = fmax(p[i], p[j]);
-            if (pij > 0 && fabs(p[i] - p[j]) <= TOP_TOLERANCE * pij &&
-                fabs(p[k] - 0.5 * (p[i] + p[j])) > TOP_TOLERANCE * pij)
-                k_sym = k;
-        }
-        if (w0n == 0 || k_sym < 0)
-            return;
-        double I1 = 0.5 * (p[(k_sym + 1) % 3] + p[(k_sym + 2) % 3]);
-        /* L = R0 A diag(p) A^T R0^T w0, A the rest principal axes */
-        double R0[9], RA[9], tmp[3], L[3];
-        quat_to_mat(f->quat, R0);
-        m3_mul(R0, f->axes, RA);
-        m3_tmulv(RA, b->angular_velocity, tmp);
-        for (int k = 0; k < 3; k++)
-            tmp[k] *= p[k];
-        m3_mulv(RA, tmp, L);
-        double Ln = v3_norm(L);
-        for (int k = 0; k < 3; k++) {
-            r->e_sym[k] = f->axes[3 * k + k_sym];
-            r->Lhat[k] = L[k] / Ln;
-        }
-        double a0[3];
-        m3_mulv(R0, r->e_sym, a0);
-        double along = v3_dot(a0, r->Lhat);
-        for (int k = 0; k < 3; k++)
-            r->u1[k] = a0[k] - along * r->Lhat[k];
-        double u1n = v3_norm(r->u1);
-        if (!(u1n > 1e-6)) /* spinning about the symmetry axis: nothing precesses */
-            return;
-        for (int k = 0; k < 3; k++)
-            r->u1[k] /= u1n;
-        v3_cross(r->Lhat, r->u1, r->u2);
-        r->top = 1;
-        r->omega_p = Ln / I1;
-        return;
-    }
-    if (sc->n_obstacles != 1 || sc->obstacles[0].type != CF_OBSTACLE_PLANE ||
-        sc->solver.criterion != CF_CRITERION_NONE || w0n != 0)
-        return;
-    const cf_obstacle *o = &sc->obstacles[0];
-    memcpy(r->n, o->normal, sizeof r->n);
-    double mn[3] = {-r->n[0], -r->n[1], -r->n[2]}, d[3];
-    double h = cf_world_fragment_support(cf_sim_world(sim), f->id, mn);
-    v3_sub(r->x0, o->point, d);
-    double s0 = v3_dot(d, r->n), vn0 = v3_dot(r->v0, r->n), gn = v3_dot(r->g, r->n);
-    if (!(gn < 0) || !(s0 > h))
-        return;
-    r->kind = CF_CMP_REF_BOUNCE;
-    r->e = sc->material.restitution * o->restitution;
-    double disc = vn0 * vn0 - 2.0 * gn * (s0 - h);
-    r->t1 = (vn0 + sqrt(disc)) / -gn;
-    double vt1[3];
-    ballistic(r->x0, r->v0, r->g, r->t1, r->x1);
-    for (int k = 0; k < 3; k++)
-        vt1[k] = r->v0[k] + r->g[k] * r->t1;
-    double vn1 = v3_dot(vt1, r->n); /* < 0: approaching */
-    for (int k = 0; k < 3; k++)
-        r->v1[k] = vt1[k] - (1.0 + r->e) * vn1 * r->n[k];
-    r->t2 = r->t1 + 2.0 * (-r->e * vn1) / -gn;
-}
-
-/* Wrapped angle (rad) of the top's symmetry axis about L. */
-static double axis_angle(const reference *r, const cf_fragment_state *f)
-{
-    double R[9], a[3];
-    quat_to_mat(f->quat, R);
-    m3_mulv(R, r->e_sym, a);
-    return atan2(v3_dot(a, r->u2), v3_dot(a, r->u1));
 }
 
 /* ---- sampling ---- */
@@ -334,7 +97,7 @@ static cf_status take_sample(state *st, cf_error *err)
         st->shared = q, st->match_cap = cap;
     }
     const snap *sa = &st->s[0], *sb = &st->s[1];
-    match_fragments(st->sim[0], st->sim[1], sa, sb, st->keys, st->partner, st->shared);
+    cf_cmp_match_fragments(st->sim[0], st->sim[1], sa, sb, st->keys, st->partner, st->shared);
 
     sample *o = &st->smp[st->n_smp];
     memset(o, 0, sizeof *o);
@@ -345,16 +108,16 @@ static cf_status take_sample(state *st, cf_error *err)
         if (j < 0)
             continue;
         wsum += sa->f[i].mass;
-        dsum += sa->f[i].mass * v3_dist(sa->f[i].com, sb->f[j].com);
-        asum += sa->f[i].mass * quat_angle(sa->f[i].quat, sb->f[j].quat);
+        dsum += sa->f[i].mass * cf_cmp_dist(sa->f[i].com, sb->f[j].com);
+        asum += sa->f[i].mass * cf_cmp_quat_angle(sa->f[i].quat, sb->f[j].quat);
     }
     o->com_dist = wsum > 0 ? dsum / wsum : NAN;
     o->orient = wsum > 0 ? asum / wsum : NAN;
-    int has_ref = reference_at(&st->ref, o->t, o->ref);
+    int has_ref = cf_cmp_reference_at(&st->ref, o->t, o->ref);
     const double *g = st->scene->gravity;
     for (int b = 0; b < 2; b++) {
         totals tt;
-        sum_totals(&st->s[b], g, &tt);
+        cf_cmp_sum_totals(&st->s[b], g, &tt);
         if (st->n_smp == 0) {
             st->t0[b] = tt;
             if (b == 0)
@@ -363,7 +126,7 @@ static cf_status take_sample(state *st, cf_error *err)
         const totals *z = &st->t0[b];
         o->nfrag[b] = st->s[b].n;
         memcpy(o->com[b], tt.com, sizeof tt.com);
-        o->ref_err[b] = has_ref ? v3_dist(tt.com, o->ref) : NAN;
+        o->ref_err[b] = has_ref ? cf_cmp_dist(tt.com, o->ref) : NAN;
         o->ke[b] = (tt.E - z->E) / (z->E != 0 ? fabs(z->E) : 1.0);
         double dP[3], dL[3];
         for (int k = 0; k < 3; k++) {
@@ -373,28 +136,11 @@ static cf_status take_sample(state *st, cf_error *err)
         o->p[b] = v3_norm(dP) / (st->p_scale > 0 ? st->p_scale : 1.0);
         double l0 = v3_norm(z->L);
         o->l[b] = v3_norm(dL) / (l0 > 0 ? l0 : 1.0);
-        int h = heaviest(&st->s[b]);
-        o->axis_angle[b] = st->ref.top && h >= 0 ? axis_angle(&st->ref, &st->s[b].f[h]) : NAN;
+        int h = cf_cmp_heaviest(&st->s[b]);
+        o->axis_angle[b] = st->ref.top && h >= 0 ? cf_cmp_axis_angle(&st->ref, &st->s[b].f[h]) : NAN;
     }
     st->n_smp++;
     return CF_OK;
-}
-
-/* Least-squares slope of the unwrapped angle series a[0..n) over t; unwraps in place. */
-static double unwrap_slope(const sample *s, int n, double *a)
-{
-    for (int i = 1; i < n; i++) {
-        double d = a[i] - a[i - 1];
-        a[i] -= TWO_PI * floor((d + 0.5 * TWO_PI) / TWO_PI);
-    }
-    double tm = 0, am = 0;
-    for (int i = 0; i < n; i++)
-        tm += s[i].t, am += a[i];
-    tm /= n, am /= n;
-    double num = 0, den = 0;
-    for (int i = 0; i < n; i++)
-        num += (s[i].t - tm) * (a[i] - am), den += (s[i].t - tm) * (s[i].t - tm);
-    return den > 0 ? num / den : NAN;
 }
 
 /* ---- files ---- */
@@ -553,8 +299,8 @@ static cf_status write_md(const char *dir, const char *headline, const state *st
             continue;
         }
         fprintf(o.f, "| %d | %d | %.4g | %d of %d | %.4g | %.4g |\n", f->id, sb->f[j].id,
-                f->mass, st->shared[order[i]], f->n_tets, v3_dist(f->com, sb->f[j].com),
-                quat_angle(f->quat, sb->f[j].quat));
+                f->mass, st->shared[order[i]], f->n_tets, cf_cmp_dist(f->com, sb->f[j].com),
+                cf_cmp_quat_angle(f->quat, sb->f[j].quat));
     }
     fprintf(o.f, "\nFiles: `compare.csv` (time series), `fragments.csv` (every fragment at "
                  "the end), `compare.png` (plots by tools/compare_plot.py, when "
@@ -616,8 +362,8 @@ static cf_status write_fragments_csv(const char *dir, const state *st, cf_error 
         fprintf(o.f, "%d,%d,%.10g", f->id, g ? g->id : -1, f->mass);
         csv_num(o.f, g ? g->mass : NAN);
         fprintf(o.f, ",%d,%d", f->n_tets, st->shared[i]);
-        csv_num(o.f, g ? v3_dist(f->com, g->com) : NAN);
-        csv_num(o.f, g ? quat_angle(f->quat, g->quat) : NAN);
+        csv_num(o.f, g ? cf_cmp_dist(f->com, g->com) : NAN);
+        csv_num(o.f, g ? cf_cmp_quat_angle(f->quat, g->quat) : NAN);
         csv_num(o.f, v3_norm(f->v));
         csv_num(o.f, g ? v3_norm(g->v) : NAN);
         csv_num(o.f, f->kinetic);
@@ -697,7 +443,7 @@ static void summarise(const state *st, cf_compare_result *r)
         for (int b = 0; a && b < 2; b++) {
             for (int i = 0; i < n; i++)
                 a[i] = s[i].axis_angle[b];
-            r->omega_measured[b] = unwrap_slope(s, n, a);
+            r->omega_measured[b] = cf_cmp_unwrap_slope(s, n, a);
             r->omega_rel_err[b] = fabs(r->omega_measured[b] - r->omega_p) / r->omega_p;
         }
         free(a);
@@ -756,7 +502,7 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
 
     if ((rc = snap_take(st.sim[0], &st.s[0], err)) != CF_OK)
         goto done;
-    reference_setup(&sc[0], st.sim[0], &st.s[0], &st.ref);
+    cf_cmp_reference_setup(&sc[0], st.sim[0], &st.s[0], &st.ref);
     if ((rc = take_sample(&st, err)) != CF_OK)
         goto done;
     double dt = sc[0].solver.dt_rigid, every = sc[0].output.frame_interval;
