@@ -19,7 +19,9 @@ static void print_value(const cf_setting *e, double v)
 
 static void print_range(const cf_setting *e)
 {
-    if (e->kind == CF_SET_ENUM) {
+    if (e->names == cf_cohesive_law_names) { /* as many as the engine has files for */
+        printf("`\"%s\"` and one per `src/engine/cohesive_<law>.c`", e->names[0]);
+    } else if (e->kind == CF_SET_ENUM) {
         for (int k = 0; e->names[k]; k++)
             printf("%s`\"%s\"`", k ? ", " : "", e->names[k]);
     } else if (e->kind == CF_SET_BOOL) {

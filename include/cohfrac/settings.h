@@ -92,6 +92,8 @@ typedef enum {
       CF_R_NON_NEGATIVE, "m", "R_n: no crack nucleates within R_n / ratio^2 of a crack; 0 l_ch") \
     X("material", "crushing_strain", NUM, material.crushing_strain, 0, NULL, NULL,            \
       CF_R_NON_NEGATIVE, "", "plastic strain at which a crushing tet leaves as debris; 0 never") \
+    X("material", "cohesive_law", ENUM, material.cohesive_law, 0, NULL, cf_cohesive_law_names,\
+      CF_R_NONE, "", "the cohesive law, one per src/engine/cohesive_<law>.c (docs/physics.md 6)") \
     X("solver", "mode", ENUM, solver.mode, 0, NULL, cf_names_mode, CF_R_NONE, "",             \
       "hybrid: rigid mode with fracture mode on impact; fracture: fracture mode throughout")   \
     X("solver", "rigid_backend", ENUM, solver.rigid_backend, 0, NULL, cf_names_backend,       \
@@ -165,6 +167,10 @@ typedef enum {
       CF_R_POSITIVE, "", "stop when the energy exceeds input and work by this fraction")      \
     X("solver", "threads", INT, solver.threads, 0, NULL, NULL, CF_R_NON_NEGATIVE, "",         \
       "threads of the element loops; 0 all cores")
+
+/* The spellings of material.cohesive_law: the laws the engine was built
+ * with, PPR first, NULL after the last. */
+extern const char *const cf_cohesive_law_names[];
 
 /* One entry of CF_SETTINGS. */
 typedef struct cf_setting {

@@ -59,6 +59,8 @@ typedef struct cf_material {
                                       as debris (docs/physics.md §2.2); 0 never */
     double internal_friction_angle; /* phi, degrees, [0, 60]: the crushing strength grows
                                       with pressure (Drucker-Prager); 0 von Mises */
+    int cohesive_law;              /* index of the cohesive law (material.cohesive_law,
+                                      docs/settings.md); 0 PPR */
 } cf_material;
 
 typedef struct cf_body_def {

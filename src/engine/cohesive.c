@@ -224,3 +224,19 @@ void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double norm
         *sliding += v3_norm(d) / 3.0;
     }
 }
+
+const char *const cf_cohesive_law_names[] = {
+#define CF_LAW_NAME_(law) #law,
+    CF_COHESIVE_LAWS(CF_LAW_NAME_)
+#undef CF_LAW_NAME_
+    NULL};
+
+const cf_cohesive_law *cf_cohesive_law_of(int i)
+{
+    static const cf_cohesive_law *const laws[] = {
+#define CF_LAW_ENTRY_(law) &cf_law_##law,
+        CF_COHESIVE_LAWS(CF_LAW_ENTRY_)
+#undef CF_LAW_ENTRY_
+    };
+    return i >= 0 && i < (int)(sizeof laws / sizeof laws[0]) ? laws[i] : NULL;
+}

@@ -29,7 +29,17 @@ typedef struct cf_cohesive_law {
                      unsigned char *failed, double *Tn, double *Tt);
 } cf_cohesive_law;
 
-/* The laws there are. */
-extern const cf_cohesive_law cf_law_ppr;
+/* The laws there are: one per file src/engine/cohesive_<law>.c, which
+ * defines cf_law_<law>; CMake lists the files in CF_COHESIVE_LAWS, PPR
+ * first.  material.cohesive_law picks one by its index in that list. */
+#include "cohesive_laws.h"
+#define CF_LAW_DECLARE_(law) extern const cf_cohesive_law cf_law_##law;
+CF_COHESIVE_LAWS(CF_LAW_DECLARE_)
+#undef CF_LAW_DECLARE_
+
+/* The law of index i in CF_COHESIVE_LAWS (material.cohesive_law), NULL
+ * outside it; its names in order, NULL after the last. */
+const cf_cohesive_law *cf_cohesive_law_of(int i);
+extern const char *const cf_cohesive_law_names[];
 
 #endif

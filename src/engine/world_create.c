@@ -415,7 +415,7 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
                           "or process limits (ulimit -v, ulimit -u) leave no room for their "
                           "stacks; run with fewer threads (-t %d, solver.threads)",
                           threads, startable, startable > 0 ? startable : 1);
-    sim->law = &cf_law_ppr;
+    sim->law = cf_cohesive_law_of(scene->material.cohesive_law);
     sim->law->init(sim->law_params, &scene->material);
 
     cf_mesh all = {0};
