@@ -172,10 +172,10 @@ static int node_body(const cf_solid *s, const int *body, int a)
 
 /* With a crack plane, only the interior facets on it may crack: mark the
  * others as not candidates. */
-static cf_status select_crack_plane(cf_world *sim, cf_error *err)
+static cf_status select_crack_plane(cf_world *w, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->def.solver;
-    cf_solid *s = &sim->solid;
+    const cf_solver_settings *set = &w->def.solver;
+    cf_solid *s = &w->solid;
     if (!set->has_crack_plane || !s->facet)
         return CF_OK;
     s->candidate = malloc((size_t)s->n_facets);
@@ -202,10 +202,10 @@ static cf_status select_crack_plane(cf_world *sim, cf_error *err)
 }
 
 /* Initial fragments: the connected components of each body. */
-static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, const int *body,
+static cf_status make_initial_fragments(cf_world *w, const cf_world_def *def, const int *body,
                                         cf_error *err)
 {
-    cf_solid *s = &sim->solid;
+    cf_solid *s = &w->solid;
     int nt = s->n_tets;
     int *all = malloc((size_t)nt * sizeof(int)), *comp = malloc((size_t)nt * sizeof(int));
     unsigned char *seen = calloc((size_t)s->n_nodes, 1);
@@ -218,9 +218,9 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
     int k = cf_label_components(s, all, nt, comp);
     int ok = k >= 0;
     for (int c = 0; ok && c < k; c++)
-        ok = cf_fragment_new(&sim->frag, &sim->n_frag, &sim->cap_frag, -1, 0.0) >= 0;
+        ok = cf_fragment_new(&w->frag, &w->n_frag, &w->cap_frag, -1, 0.0) >= 0;
     for (int t = 0; ok && t < nt; t++) {
-        cf_fragment *f = &sim->frag[comp[t]];
+        cf_fragment *f = &w->frag[comp[t]];
         if (!f->tets && !(f->tets = malloc((size_t)nt * sizeof(int)))) { /* trimmed below */
             ok = 0;
             break;
@@ -261,24 +261,24 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
                                        bd->expansion_rate[k2] * (s->x[3 * a + k2] - xe[k2]);
             }
     }
-    int fracture = sim->def.solver.mode == CF_RUN_FRACTURE;
-    for (int fi = 0; fi < sim->n_frag; fi++) {
-        cf_fragment *f = &sim->frag[fi];
+    int fracture = w->def.solver.mode == CF_RUN_FRACTURE;
+    for (int fi = 0; fi < w->n_frag; fi++) {
+        cf_fragment *f = &w->frag[fi];
         int *tt = realloc(f->tets, (size_t)f->nt * sizeof(int));
         if (tt)
             f->tets = tt;
-        cf_fragment_rest_props(f, &sim->solid);
-        cf_fragment_ledger_reset(f, &sim->solid, &sim->flow);
+        cf_fragment_rest_props(f, &w->solid);
+        cf_fragment_ledger_reset(f, &w->solid, &w->flow);
         if (fracture) {
             f->mode = CF_MODE_FRACTURE;
             f->t_enter = 0;
         }
-        if (sim->bullet) {
+        if (w->bullet) {
             const cf_body_def *bd = &def->bodies[body[f->tets[0]]];
             cf_node_state ns;
             cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &ns);
             double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-            cf_status st = cf_fragment_add_body(sim, fi, f->com_rest, I3, ns.v,
+            cf_status st = cf_fragment_add_body(w, fi, f->com_rest, I3, ns.v,
                                                 bd->angular_velocity, err);
             if (st != CF_OK)
                 return st;
@@ -291,30 +291,30 @@ static cf_status make_initial_fragments(cf_world *sim, const cf_world_def *def, 
 
 /* Every obstacle for the in-house solver and, when there is a Bullet
  * world, as Bullet bodies; which of them move (kinematic). */
-static cf_status add_obstacles(cf_world *sim, const cf_world_def *def, cf_error *err)
+static cf_status add_obstacles(cf_world *w, const cf_world_def *def, cf_error *err)
 {
     int n = def->n_obstacles;
-    sim->obs.o = sim->def.obstacles;
-    sim->obstacle_body = malloc(((size_t)n + 1) * sizeof(int));
-    sim->obstacle_moving = calloc((size_t)n + 1, 1);
-    if (!sim->obstacle_body || !sim->obstacle_moving)
+    w->obs.o = w->def.obstacles;
+    w->obstacle_body = malloc(((size_t)n + 1) * sizeof(int));
+    w->obstacle_moving = calloc((size_t)n + 1, 1);
+    if (!w->obstacle_body || !w->obstacle_moving)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for obstacles");
     for (int j = 0; j < n; j++) {
         double u[3];
         cf_obstacle_velocity(&def->obstacles[j], u);
-        sim->obstacle_moving[j] = v3_dot(u, u) > 0;
+        w->obstacle_moving[j] = v3_dot(u, u) > 0;
     }
-    return cf_obstacles_create(&sim->obs, def, sim->bullet, sim->obstacle_body, err);
+    return cf_obstacles_create(&w->obs, def, w->bullet, w->obstacle_body, err);
 }
 
 /* What a reader needs to bound a run's outcome (tools/check_physics.py):
  * the box around the nodes, mass, energy and fastest node at t = 0, and the
  * fastest kinematic obstacle or prescribed node; taken at create. */
-static void initial_bounds(cf_world *sim)
+static void initial_bounds(cf_world *w)
 {
-    const cf_solid *s = &sim->solid;
-    const cf_world_def *sc = &sim->def;
-    cf_initial_bounds *b = &sim->bounds;
+    const cf_solid *s = &w->solid;
+    const cf_world_def *sc = &w->def;
+    cf_initial_bounds *b = &w->bounds;
     double v2 = 0;
     for (int k = 0; k < 3; k++)
         b->lower[k] = INFINITY, b->upper[k] = -INFINITY;
@@ -335,7 +335,7 @@ static void initial_bounds(cf_world *sim)
     for (int j = 0; j < sc->n_boundaries; j++)
         b->max_obstacle_speed = fmax(b->max_obstacle_speed, v3_norm(sc->boundaries[j].velocity));
     b->max_speed = sqrt(v2);
-    b->energy = sim->e0;
+    b->energy = w->e0;
     const cf_material *m = &s->mat;
     b->release_speed = 0;
     if (s->facet) /* an insertion criterion: facets can be held up to their strength */
@@ -360,17 +360,17 @@ static void *copy_array(const void *src, int n, size_t size, int *fail)
 /* The world's own copy of the definition: settings, obstacles and
  * boundary conditions (the bodies and meshes are used up at create; the
  * world never reads the caller's definition after create). */
-static cf_status copy_def(cf_world *sim, const cf_world_def *def, cf_error *err)
+static cf_status copy_def(cf_world *w, const cf_world_def *def, cf_error *err)
 {
     int fail = 0;
-    sim->def = *def;
-    sim->def.bodies = NULL, sim->def.n_bodies = 0;
-    sim->def.resolved = NULL;
-    sim->def.obstacles = copy_array(def->obstacles, def->n_obstacles, sizeof *def->obstacles, &fail);
-    sim->def.boundaries = copy_array(def->boundaries, def->n_boundaries, sizeof *def->boundaries,
+    w->def = *def;
+    w->def.bodies = NULL, w->def.n_bodies = 0;
+    w->def.resolved = NULL;
+    w->def.obstacles = copy_array(def->obstacles, def->n_obstacles, sizeof *def->obstacles, &fail);
+    w->def.boundaries = copy_array(def->boundaries, def->n_boundaries, sizeof *def->boundaries,
                                      &fail);
-    for (int j = 0; sim->def.obstacles && j < def->n_obstacles; j++) /* FCL and Bullet copy them */
-        sim->def.obstacles[j].vertices = NULL, sim->def.obstacles[j].triangles = NULL;
+    for (int j = 0; w->def.obstacles && j < def->n_obstacles; j++) /* FCL and Bullet copy them */
+        w->def.obstacles[j].vertices = NULL, w->def.obstacles[j].triangles = NULL;
     return fail ? cf_error_set(err, CF_ERR_NOMEM, "out of memory copying the world definition")
                 : CF_OK;
 }
@@ -398,25 +398,25 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
     cf_status st = cf_world_def_check(def, err);
     if (st != CF_OK)
         return st;
-    cf_world *sim = calloc(1, sizeof *sim);
-    if (!sim)
+    cf_world *w = calloc(1, sizeof *w);
+    if (!w)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-    st = copy_def(sim, def, err);
-    const cf_world_def *scene = &sim->def;
-    sim->wall_start = cf_wall_time();
-    sim->bullet_base = cfb_allocated_bytes();
+    st = copy_def(w, def, err);
+    const cf_world_def *scene = &w->def;
+    w->wall_start = cf_wall_time();
+    w->bullet_base = cfb_allocated_bytes();
     /* The world's own thread count: the process's OpenMP setting is the
      * caller's, and two worlds may run on different counts. */
-    sim->threads = scene->solver.threads > 0 ? scene->solver.threads : omp_get_max_threads();
-    int threads = sim->threads, startable = threads_startable(threads);
+    w->threads = scene->solver.threads > 0 ? scene->solver.threads : omp_get_max_threads();
+    int threads = w->threads, startable = threads_startable(threads);
     if (st == CF_OK && startable < threads)
         st = cf_error_set(err, CF_ERR_NOMEM,
                           "cannot start %d threads for the element loops (only %d): the memory "
                           "or process limits (ulimit -v, ulimit -u) leave no room for their "
                           "stacks; run with fewer threads (-t %d, solver.threads)",
                           threads, startable, startable > 0 ? startable : 1);
-    sim->law = cf_cohesive_law_of(scene->material.cohesive_law);
-    sim->law->init(sim->law_params, &scene->material);
+    w->law = cf_cohesive_law_of(scene->material.cohesive_law);
+    w->law->init(w->law_params, &scene->material);
 
     cf_mesh all = {0};
     int *body = NULL, *bc = NULL;
@@ -424,92 +424,92 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
         st = load_bodies(def, &all, &body, &bc, err);
     if (st == CF_OK) {
         int *user = malloc((size_t)all.n_tets * sizeof(int));
-        sim->tet_of_user = malloc((size_t)all.n_tets * sizeof(int));
-        if (!user || !sim->tet_of_user || cf_renumber_locality(&all, bc, body, user))
+        w->tet_of_user = malloc((size_t)all.n_tets * sizeof(int));
+        if (!user || !w->tet_of_user || cf_renumber_locality(&all, bc, body, user))
             st = cf_error_set(err, CF_ERR_NOMEM, "out of memory renumbering %d tets", all.n_tets);
         for (int t = 0; st == CF_OK && t < all.n_tets; t++)
-            sim->tet_of_user[user[t]] = t;
+            w->tet_of_user[user[t]] = t;
         free(user);
     }
     if (st == CF_OK) {
-        st = cf_solid_init(&sim->solid, &all, &scene->material, body, err);
+        st = cf_solid_init(&w->solid, &all, &scene->material, body, err);
         if (st == CF_OK)
-            memcpy(sim->solid.bc, bc, (size_t)all.n_nodes * sizeof(int));
+            memcpy(w->solid.bc, bc, (size_t)all.n_nodes * sizeof(int));
         if (st == CF_OK)
-            st = cf_solid_scale_mass(&sim->solid, scene->solver.mass_scaling, err);
+            st = cf_solid_scale_mass(&w->solid, scene->solver.mass_scaling, err);
         if (st == CF_OK && scene->solver.criterion != CF_CRITERION_NONE)
-            st = cf_solid_init_facets(&sim->solid, err);
+            st = cf_solid_init_facets(&w->solid, err);
         cf_mesh_free(&all);
     }
     free(bc);
-    sim->dt_fracture = scene->solver.cfl_fraction > 0
-                           ? scene->solver.cfl_fraction * sim->solid.dt_cfl
+    w->dt_fracture = scene->solver.cfl_fraction > 0
+                           ? scene->solver.cfl_fraction * w->solid.dt_cfl
                            : scene->solver.dt_fracture;
     /* With no rigid mode the outer step only paces output and checks: a
      * whole number of fracture steps, so that every step is dt_fracture. */
-    sim->dt_outer = scene->solver.dt_rigid;
+    w->dt_outer = scene->solver.dt_rigid;
     if (scene->solver.mode == CF_RUN_FRACTURE)
-        sim->dt_outer = fmax(1.0, floor(scene->solver.dt_rigid / sim->dt_fracture + 1e-9)) *
-                        sim->dt_fracture;
+        w->dt_outer = fmax(1.0, floor(scene->solver.dt_rigid / w->dt_fracture + 1e-9)) *
+                        w->dt_fracture;
     if (st == CF_OK && scene->solver.rigid_backend == CF_RIGID_BULLET &&
         scene->solver.mode == CF_RUN_HYBRID) {
-        sim->bullet = cfb_world_create(scene->gravity);
-        if (!sim->bullet)
+        w->bullet = cfb_world_create(scene->gravity);
+        if (!w->bullet)
             st = cf_world_bullet_error(err, "creating the world");
         else
-            cfb_set_sleeping(sim->bullet, scene->solver.sleep_linear, scene->solver.sleep_angular);
+            cfb_set_sleeping(w->bullet, scene->solver.sleep_linear, scene->solver.sleep_angular);
     }
     if (st == CF_OK)
-        st = add_obstacles(sim, def, err);
+        st = add_obstacles(w, def, err);
     if (st == CF_OK)
-        st = select_crack_plane(sim, err);
-    cf_profile_start(&sim->prof);
+        st = select_crack_plane(w, err);
+    cf_profile_start(&w->prof);
     if (st == CF_OK)
-        st = make_initial_fragments(sim, def, body, err);
+        st = make_initial_fragments(w, def, body, err);
     free(body);
     /* The initial bodies' convex decompositions are the run's; the rest of
      * creation is no stage of a step. */
-    double hulls = sim->prof.stage[CF_STAGE_CONVEX_DECOMPOSITION];
-    memset(&sim->prof, 0, sizeof sim->prof);
-    sim->prof.stage[CF_STAGE_CONVEX_DECOMPOSITION] = hulls;
+    double hulls = w->prof.stage[CF_STAGE_CONVEX_DECOMPOSITION];
+    memset(&w->prof, 0, sizeof w->prof);
+    w->prof.stage[CF_STAGE_CONVEX_DECOMPOSITION] = hulls;
     if (st == CF_OK) { /* the ledger's reference state */
         cf_ledger l;
-        cf_world_ledger(sim, &l);
-        sim->e0 = l.kinetic + l.strain;
-        memcpy(sim->mx0, l.mass_moment, sizeof sim->mx0);
-        initial_bounds(sim);
-        st = cf_world_fragments_born(sim, 0, err);
+        cf_world_ledger(w, &l);
+        w->e0 = l.kinetic + l.strain;
+        memcpy(w->mx0, l.mass_moment, sizeof w->mx0);
+        initial_bounds(w);
+        st = cf_world_fragments_born(w, 0, err);
     }
     if (st != CF_OK) {
-        cf_world_destroy(sim);
+        cf_world_destroy(w);
         return st;
     }
-    *out = sim;
+    *out = w;
     return CF_OK;
 }
 
-void cf_world_destroy(cf_world *sim)
+void cf_world_destroy(cf_world *w)
 {
-    if (!sim)
+    if (!w)
         return;
-    for (int i = 0; i < sim->n_frag; i++) {
-        cf_fragment *f = &sim->frag[i];
+    for (int i = 0; i < w->n_frag; i++) {
+        cf_fragment *f = &w->frag[i];
         free(f->tets), free(f->nodes.v), free(f->coh.v), free(f->contact), free(f->vn_pre);
         free(f->v_old), free(f->term), free(f->pairs);
         cf_bars_free(&f->bars);
         cf_hulls_free(&f->hulls);
     }
-    free(sim->frag);
-    cf_contact_caches_free(&sim->contact);
-    cf_arena_free(&sim->arena);
-    cf_obstacles_free(&sim->obs);
-    free(sim->obstacle_body), free(sim->obstacle_moving);
-    free(sim->cand.v), free(sim->tet_of_user), free(sim->ev);
-    free(sim->touched.v), free(sim->crushed.v);
-    cf_bars_scratch_free(&sim->bar_scratch);
-    free(sim->def.obstacles), free(sim->def.boundaries);
-    if (sim->bullet)
-        cfb_world_destroy(sim->bullet);
-    cf_solid_free(&sim->solid);
-    free(sim);
+    free(w->frag);
+    cf_contact_caches_free(&w->contact);
+    cf_arena_free(&w->arena);
+    cf_obstacles_free(&w->obs);
+    free(w->obstacle_body), free(w->obstacle_moving);
+    free(w->cand.v), free(w->tet_of_user), free(w->ev);
+    free(w->touched.v), free(w->crushed.v);
+    cf_bars_scratch_free(&w->bar_scratch);
+    free(w->def.obstacles), free(w->def.boundaries);
+    if (w->bullet)
+        cfb_world_destroy(w->bullet);
+    cf_solid_free(&w->solid);
+    free(w);
 }

@@ -14,25 +14,25 @@ cf_status cf_world_bullet_error(cf_error *err, const char *what)
 }
 
 /* Append an event (the array grows; out of memory drops it and says so). */
-cf_status cf_world_push_event(cf_world *sim, const cf_event *e, cf_error *err)
+cf_status cf_world_push_event(cf_world *w, const cf_event *e, cf_error *err)
 {
-    if (sim->n_ev == sim->cap_ev) {
-        int cap = sim->cap_ev ? 2 * sim->cap_ev : 16;
-        cf_event *ev = realloc(sim->ev, (size_t)cap * sizeof *ev);
+    if (w->n_ev == w->cap_ev) {
+        int cap = w->cap_ev ? 2 * w->cap_ev : 16;
+        cf_event *ev = realloc(w->ev, (size_t)cap * sizeof *ev);
         if (!ev)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory recording an event");
-        sim->ev = ev, sim->cap_ev = cap;
+        w->ev = ev, w->cap_ev = cap;
     }
-    sim->ev[sim->n_ev++] = *e;
+    w->ev[w->n_ev++] = *e;
     return CF_OK;
 }
 
-int cf_world_alive_fragments(const cf_world *sim, int *in_fracture)
+int cf_world_alive_fragments(const cf_world *w, int *in_fracture)
 {
     int n = 0, nf = 0;
-    for (int i = 0; i < sim->n_frag; i++) {
-        n += sim->frag[i].mode != CF_MODE_DEAD;
-        nf += sim->frag[i].mode == CF_MODE_FRACTURE;
+    for (int i = 0; i < w->n_frag; i++) {
+        n += w->frag[i].mode != CF_MODE_DEAD;
+        nf += w->frag[i].mode == CF_MODE_FRACTURE;
     }
     if (in_fracture)
         *in_fracture = nf;
@@ -40,11 +40,11 @@ int cf_world_alive_fragments(const cf_world *sim, int *in_fracture)
 }
 
 /* Fragments first .. n_frag - 1 were born. */
-cf_status cf_world_fragments_born(cf_world *sim, int first, cf_error *err)
+cf_status cf_world_fragments_born(cf_world *w, int first, cf_error *err)
 {
-    if (first >= sim->n_frag)
+    if (first >= w->n_frag)
         return CF_OK;
-    cf_event e = {.type = CF_EVENT_FRAGMENTS, .time = sim->t, .first = first,
-                  .count = sim->n_frag - first, .alive = cf_world_alive_fragments(sim, NULL)};
-    return cf_world_push_event(sim, &e, err);
+    cf_event e = {.type = CF_EVENT_FRAGMENTS, .time = w->t, .first = first,
+                  .count = w->n_frag - first, .alive = cf_world_alive_fragments(w, NULL)};
+    return cf_world_push_event(w, &e, err);
 }

@@ -11,21 +11,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-const cf_event *cf_world_events(const cf_world *sim, int *n)
+const cf_event *cf_world_events(const cf_world *w, int *n)
 {
-    *n = sim->n_ev;
-    return sim->ev;
+    *n = w->n_ev;
+    return w->ev;
 }
 
-void cf_world_clear_events(cf_world *sim) { sim->n_ev = 0; }
+void cf_world_clear_events(cf_world *w) { w->n_ev = 0; }
 
-int cf_world_fragments_ever(const cf_world *sim) { return sim->n_frag; }
+int cf_world_fragments_ever(const cf_world *w) { return w->n_frag; }
 
-int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
+int cf_world_fragment_info(const cf_world *w, int id, cf_frag_info *o)
 {
-    if (id < 0 || id >= sim->n_frag)
+    if (id < 0 || id >= w->n_frag)
         return -1;
-    const cf_fragment *f = &sim->frag[id];
+    const cf_fragment *f = &w->frag[id];
     memset(o, 0, sizeof *o);
     o->id = id;
     o->parent = f->parent;
@@ -34,20 +34,20 @@ int cf_world_fragment_info(const cf_world *sim, int id, cf_frag_info *o)
     o->n_tets = f->nt;
     memcpy(o->inertia_principal, f->principal, sizeof f->principal);
     o->n_hulls = f->body >= 0 ? f->hulls.n_hulls : 0;
-    o->debris = cf_fragment_is_debris(f, &sim->def.solver);
+    o->debris = cf_fragment_is_debris(f, &w->def.solver);
     o->hull_volume_error = cf_hulls_error(&f->hulls);
     o->decomposition_time = f->decompose_time;
     memcpy(o->com_rest, f->com_rest, sizeof o->com_rest);
     return 0;
 }
 
-void cf_world_initial_bounds(const cf_world *sim, cf_initial_bounds *out) { *out = sim->bounds; }
+void cf_world_initial_bounds(const cf_world *w, cf_initial_bounds *out) { *out = w->bounds; }
 
-int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
+int cf_world_fragments(cf_world *w, cf_fragment_state *out, int cap)
 {
     int n = 0;
-    for (int fi = 0; fi < sim->n_frag; fi++) {
-        cf_fragment *f = &sim->frag[fi];
+    for (int fi = 0; fi < w->n_frag; fi++) {
+        cf_fragment *f = &w->frag[fi];
         if (f->mode == CF_MODE_DEAD)
             continue;
         if (n < cap) {
@@ -58,18 +58,18 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
             o->mode = f->mode, o->n_tets = f->nt, o->mass = f->mass;
             memcpy(o->principal, f->principal, sizeof o->principal);
             memcpy(o->axes, f->Q, sizeof o->axes);
-            cf_fragment_pose_peek(f, &sim->solid, sim->bullet, o->com, R, o->v, o->w);
+            cf_fragment_pose_peek(f, &w->solid, w->bullet, o->com, R, o->v, o->w);
             mat_to_quat(R, o->quat);
             for (int k = 0; k < 3; k++)
                 o->momentum[k] = f->mass * o->v[k];
             if (f->body >= 0) {
                 cfb_state st;
-                cfb_get_state(sim->bullet, f->body, &st);
+                cfb_get_state(w->bullet, f->body, &st);
                 cf_body_spin(f, &st, o->angular_momentum);
                 o->kinetic = cf_body_kinetic_energy(f, &st);
             } else {
                 cf_node_state ns;
-                cf_nodes_momenta(&sim->solid, f->nodes.v, f->nodes.n, &ns);
+                cf_nodes_momenta(&w->solid, f->nodes.v, f->nodes.n, &ns);
                 memcpy(o->angular_momentum, ns.L, sizeof ns.L);
                 for (int k = 0; k < 3; k++)
                     o->momentum[k] = ns.M * ns.v[k];
@@ -81,49 +81,49 @@ int cf_world_fragments(cf_world *sim, cf_fragment_state *out, int cap)
     return n;
 }
 
-double cf_world_fragment_support(cf_world *sim, int id, const double d[3])
+double cf_world_fragment_support(cf_world *w, int id, const double d[3])
 {
-    if (id < 0 || id >= sim->n_frag || sim->frag[id].mode == CF_MODE_DEAD)
+    if (id < 0 || id >= w->n_frag || w->frag[id].mode == CF_MODE_DEAD)
         return 0;
-    const cf_fragment *f = &sim->frag[id];
-    double com[3], R[9], v[3], w[3], Rd[3], best = -INFINITY;
-    cf_fragment_pose_peek(f, &sim->solid, sim->bullet, com, R, v, w);
+    const cf_fragment *f = &w->frag[id];
+    double com[3], R[9], v[3], omega[3], Rd[3], best = -INFINITY;
+    cf_fragment_pose_peek(f, &w->solid, w->bullet, com, R, v, omega);
     m3_tmulv(R, d, Rd); /* (R r).d = r.(R^T d), r from the rest centre of mass */
     for (int i = 0; i < f->nodes.n; i++) {
         double r[3];
-        v3_sub(&sim->solid.X[3 * f->nodes.v[i]], f->com_rest, r);
+        v3_sub(&w->solid.X[3 * f->nodes.v[i]], f->com_rest, r);
         best = fmax(best, v3_dot(r, Rd));
     }
     return f->nodes.n ? best : 0;
 }
 
-int cf_world_tet_count(const cf_world *sim) { return sim->solid.n_tets; }
+int cf_world_tet_count(const cf_world *w) { return w->solid.n_tets; }
 
-int cf_world_rest_node_count(const cf_world *sim) { return sim->solid.n_verts0; }
+int cf_world_rest_node_count(const cf_world *w) { return w->solid.n_verts0; }
 
-void cf_world_rest_nodes(const cf_world *sim, double *X)
+void cf_world_rest_nodes(const cf_world *w, double *X)
 {
-    memcpy(X, sim->solid.X, (size_t)sim->solid.n_verts0 * 3 * sizeof(double));
+    memcpy(X, w->solid.X, (size_t)w->solid.n_verts0 * 3 * sizeof(double));
 }
 
-int cf_world_rest_tet(const cf_world *sim, int t, int nodes[4])
+int cf_world_rest_tet(const cf_world *w, int t, int nodes[4])
 {
-    if (t < 0 || t >= sim->solid.n_tets)
+    if (t < 0 || t >= w->solid.n_tets)
         return -1;
-    memcpy(nodes, &sim->solid.tet0[4 * sim->tet_of_user[t]], 4 * sizeof(int));
+    memcpy(nodes, &w->solid.tet0[4 * w->tet_of_user[t]], 4 * sizeof(int));
     return 0;
 }
 
-int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
+int cf_world_tet_positions(const cf_world *w, int t, double x[12])
 {
-    if (t < 0 || t >= sim->solid.n_tets)
+    if (t < 0 || t >= w->solid.n_tets)
         return -1;
-    const cf_solid *s = &sim->solid;
-    int st = sim->tet_of_user[t], fi = s->tet_frag[st];
-    const cf_fragment *f = &sim->frag[fi];
-    double com[3], R[9], v[3], w[3];
+    const cf_solid *s = &w->solid;
+    int st = w->tet_of_user[t], fi = s->tet_frag[st];
+    const cf_fragment *f = &w->frag[fi];
+    double com[3], R[9], v[3], omega[3];
     if (f->body >= 0) /* rigid in Bullet: the nodes are not moved, the pose is */
-        cf_fragment_pose_peek(f, &sim->solid, sim->bullet, com, R, v, w);
+        cf_fragment_pose_peek(f, &w->solid, w->bullet, com, R, v, omega);
     for (int j = 0; j < 4; j++) {
         int a = s->tet[4 * st + j];
         if (f->body < 0) {
@@ -139,9 +139,9 @@ int cf_world_tet_positions(const cf_world *sim, int t, double x[12])
     return 0;
 }
 
-int cf_world_fracture_tets(const cf_world *sim, int *tets, double *stress, double *damage)
+int cf_world_fracture_tets(const cf_world *w, int *tets, double *stress, double *damage)
 {
-    const cf_solid *s = &sim->solid;
+    const cf_solid *s = &w->solid;
     int nt = s->n_tets, n = 0;
     /* damage by the solid's tets: each element's to both its sides */
     double *d = calloc((size_t)(nt > 0 ? nt : 1), sizeof *d);
@@ -154,8 +154,8 @@ int cf_world_fracture_tets(const cf_world *sim, int *tets, double *stress, doubl
     }
     static const int voigt[6] = {0, 4, 8, 5, 2, 1}; /* xx yy zz yz xz xy of [3][3] */
     for (int t = 0; t < nt; t++) {
-        int st = sim->tet_of_user[t];
-        if (sim->frag[s->tet_frag[st]].mode != CF_MODE_FRACTURE)
+        int st = w->tet_of_user[t];
+        if (w->frag[s->tet_frag[st]].mode != CF_MODE_FRACTURE)
             continue;
         tets[n] = t;
         damage[n] = d[st];
@@ -167,26 +167,26 @@ int cf_world_fracture_tets(const cf_world *sim, int *tets, double *stress, doubl
     return n;
 }
 
-int cf_world_tet_fragment(const cf_world *sim, int t)
+int cf_world_tet_fragment(const cf_world *w, int t)
 {
-    return t >= 0 && t < sim->solid.n_tets ? sim->solid.tet_frag[sim->tet_of_user[t]] : -1;
+    return t >= 0 && t < w->solid.n_tets ? w->solid.tet_frag[w->tet_of_user[t]] : -1;
 }
 
-int cf_world_cohesive_count(const cf_world *sim) { return sim->solid.n_coh; }
+int cf_world_cohesive_count(const cf_world *w) { return w->solid.n_coh; }
 
-int cf_world_crack(const cf_world *sim, int e, cf_crack_row *r)
+int cf_world_crack(const cf_world *w, int e, cf_crack_row *r)
 {
     memset(r, 0, sizeof *r);
-    if (e < 0 || e >= sim->solid.n_coh)
+    if (e < 0 || e >= w->solid.n_coh)
         return -1;
-    r->time = sim->t;
+    r->time = w->t;
     r->element = e;
-    cf_cohesive_state(&sim->solid, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
+    cf_cohesive_state(&w->solid, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
                       &r->failed);
     return 0;
 }
 
-double cf_world_crack_area(const cf_world *sim) { return cf_solid_crack_area(&sim->solid); }
+double cf_world_crack_area(const cf_world *w) { return cf_solid_crack_area(&w->solid); }
 
 const char *cf_stage_name(cf_stage s)
 {
@@ -196,76 +196,76 @@ const char *cf_stage_name(cf_stage s)
     return s >= 0 && s < CF_STAGE_COUNT ? names[s] : "?";
 }
 
-const cf_world_def *cf_world_definition(const cf_world *sim) { return &sim->def; }
+const cf_world_def *cf_world_definition(const cf_world *w) { return &w->def; }
 
-void cf_world_set_tick(cf_world *sim, cf_world_tick_fn fn, void *user)
+void cf_world_set_tick(cf_world *w, cf_world_tick_fn fn, void *user)
 {
-    sim->tick = fn, sim->tick_user = user;
+    w->tick = fn, w->tick_user = user;
 }
 
-void cf_world_set_threads(cf_world *sim, int n)
+void cf_world_set_threads(cf_world *w, int n)
 {
     if (n >= 1)
-        sim->threads = n;
+        w->threads = n;
 }
 
-long cf_world_step_count(const cf_world *sim) { return sim->step; }
+long cf_world_step_count(const cf_world *w) { return w->step; }
 
-double cf_world_dt_outer(const cf_world *sim) { return sim->dt_outer; }
+double cf_world_dt_outer(const cf_world *w) { return w->dt_outer; }
 
-double cf_world_time(const cf_world *sim) { return sim->t; }
+double cf_world_time(const cf_world *w) { return w->t; }
 
-double cf_world_dt_fracture(const cf_world *sim) { return sim->dt_fracture; }
+double cf_world_dt_fracture(const cf_world *w) { return w->dt_fracture; }
 
-double cf_world_dt_cfl(const cf_world *sim) { return sim->solid.dt_cfl; }
+double cf_world_dt_cfl(const cf_world *w) { return w->solid.dt_cfl; }
 
-uint64_t cf_world_state_hash(const cf_world *sim)
+uint64_t cf_world_state_hash(const cf_world *w)
 {
-    const cf_solid *s = &sim->solid;
+    const cf_solid *s = &w->solid;
     uint64_t h = CF_FNV1A_SEED;
     h = cf_fnv1a(h, s->x, (size_t)s->n_nodes * 3 * sizeof(double));
     h = cf_fnv1a(h, s->v, (size_t)s->n_nodes * 3 * sizeof(double));
     h = cf_fnv1a(h, s->tet_frag, (size_t)s->n_tets * sizeof(int));
-    for (int fi = 0; fi < sim->n_frag; fi++) {
-        const cf_fragment *f = &sim->frag[fi];
+    for (int fi = 0; fi < w->n_frag; fi++) {
+        const cf_fragment *f = &w->frag[fi];
         int mode = f->mode;
         h = cf_fnv1a(h, &mode, sizeof mode);
         if (f->body >= 0) {
             cfb_state st;
-            cfb_get_state(sim->bullet, f->body, &st);
+            cfb_get_state(w->bullet, f->body, &st);
             h = cf_fnv1a(h, &st, sizeof st);
         }
     }
     return h;
 }
 
-void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
+void cf_world_stats_get(const cf_world *w, cf_world_stats *o)
 {
-    const cf_profile *p = &sim->prof;
+    const cf_profile *p = &w->prof;
     memset(o, 0, sizeof *o);
-    o->tets = sim->solid.n_tets, o->nodes_input = sim->solid.n_verts0;
-    o->nodes = sim->solid.n_nodes;
-    o->dt_fracture = sim->dt_fracture, o->dt_cfl = sim->solid.dt_cfl, o->dt_outer = sim->dt_outer;
-    o->mass_scaled = sim->solid.n_mass_scaled, o->mass_added = sim->solid.mass_added;
-    o->mass_total = sim->solid.mass_total;
-    o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(sim->solid.mass_scale_max) : 1.0;
-    o->steps_rigid = sim->steps_rigid, o->steps_fracture = sim->steps_fracture;
-    o->threads = sim->threads;
-    o->alive = cf_world_alive_fragments(sim, &o->in_fracture);
-    o->ever = sim->n_frag;
-    o->cohesive = sim->solid.n_coh;
-    o->handoffs = sim->n_handoffs;
-    o->max_momentum_error = sim->max_momentum_error, o->handoff_loss = sim->total_handoff_loss;
+    o->tets = w->solid.n_tets, o->nodes_input = w->solid.n_verts0;
+    o->nodes = w->solid.n_nodes;
+    o->dt_fracture = w->dt_fracture, o->dt_cfl = w->solid.dt_cfl, o->dt_outer = w->dt_outer;
+    o->mass_scaled = w->solid.n_mass_scaled, o->mass_added = w->solid.mass_added;
+    o->mass_total = w->solid.mass_total;
+    o->wave_speed_least = o->mass_scaled ? 1.0 / sqrt(w->solid.mass_scale_max) : 1.0;
+    o->steps_rigid = w->steps_rigid, o->steps_fracture = w->steps_fracture;
+    o->threads = w->threads;
+    o->alive = cf_world_alive_fragments(w, &o->in_fracture);
+    o->ever = w->n_frag;
+    o->cohesive = w->solid.n_coh;
+    o->handoffs = w->n_handoffs;
+    o->max_momentum_error = w->max_momentum_error, o->handoff_loss = w->total_handoff_loss;
     memcpy(o->stage, p->stage, sizeof o->stage);
     /* Convex decomposition of the rigid fragments alive now: median and worst
      * error (NaN when there is no memory to sort them: unknown, not 0). */
-    double *e = malloc((size_t)(sim->n_frag + 1) * sizeof(double));
+    double *e = malloc((size_t)(w->n_frag + 1) * sizeof(double));
     int n = 0;
-    for (int fi = 0; fi < sim->n_frag; fi++) {
-        const cf_fragment *f = &sim->frag[fi];
+    for (int fi = 0; fi < w->n_frag; fi++) {
+        const cf_fragment *f = &w->frag[fi];
         if (f->mode != CF_MODE_DEAD)
             o->mass_alive += f->mass;
-        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(f, &sim->def.solver)) {
+        if (f->mode != CF_MODE_DEAD && cf_fragment_is_debris(f, &w->def.solver)) {
             o->debris++;
             o->debris_mass += f->mass;
             continue;
@@ -288,9 +288,9 @@ void cf_world_stats_get(const cf_world *sim, cf_world_stats *o)
     free(e);
 }
 
-void cf_world_memory(const cf_world *sim, cf_memory *m)
+void cf_world_memory(const cf_world *w, cf_memory *m)
 {
-    const cf_solid *s = &sim->solid;
+    const cf_solid *s = &w->solid;
     const unsigned long long D = sizeof(double), I = sizeof(int);
     unsigned long long cn = (unsigned long long)s->cap_nodes, nt = (unsigned long long)s->n_tets;
     memset(m, 0, sizeof *m);
@@ -301,9 +301,9 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
         m->fracture = nt * (9 * D + 2 + 20 * I) + cn * (1 + D) +
                       (unsigned long long)s->n_facets * (1 + (s->candidate != NULL));
     m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
-    m->fragments = (unsigned long long)sim->cap_frag * sizeof(cf_fragment);
-    for (int i = 0; i < sim->n_frag; i++) {
-        const cf_fragment *f = &sim->frag[i];
+    m->fragments = (unsigned long long)w->cap_frag * sizeof(cf_fragment);
+    for (int i = 0; i < w->n_frag; i++) {
+        const cf_fragment *f = &w->frag[i];
         m->fragments += (unsigned long long)f->nt * I + (unsigned long long)f->nodes.cap * I +
                         (unsigned long long)f->coh.cap * I +
                         (unsigned long long)f->bars.n * (2 * I + 3 * D) +
@@ -314,25 +314,25 @@ void cf_world_memory(const cf_world *sim, cf_memory *m)
                             ((unsigned long long)f->hulls.n_hulls + 1) * I;
     }
     unsigned long long b = cfb_allocated_bytes();
-    m->bullet = b > sim->bullet_base ? b - sim->bullet_base : 0;
-    for (int j = 0; sim->obs.mesh && j < sim->obs.n; j++)
-        m->collision += cff_mesh_bytes(sim->obs.mesh[j]);
-    for (int i = 0; i < sim->contact.cap; i++) {
-        const cf_frag_surface *fs = &sim->contact.v[i].surface;
+    m->bullet = b > w->bullet_base ? b - w->bullet_base : 0;
+    for (int j = 0; w->obs.mesh && j < w->obs.n; j++)
+        m->collision += cff_mesh_bytes(w->obs.mesh[j]);
+    for (int i = 0; i < w->contact.cap; i++) {
+        const cf_frag_surface *fs = &w->contact.v[i].surface;
         m->collision += cff_mesh_bytes(fs->mesh) +
                         (unsigned long long)fs->nv * (I + 3 * D) + 3ull * fs->ntri * I;
     }
 }
 
-void cf_world_step_stats(const cf_world *sim, cf_step_stats *o)
+void cf_world_step_stats(const cf_world *w, cf_step_stats *o)
 {
-    const cf_solver_settings *set = &sim->def.solver;
+    const cf_solver_settings *set = &w->def.solver;
     memset(o, 0, sizeof *o);
-    o->fracture_steps = sim->steps_fracture;
-    o->tet_steps = sim->tet_steps_fracture, o->fracture_time = sim->t_fracture;
-    memcpy(o->stage, sim->prof.stage, sizeof o->stage);
-    for (int i = 0; i < sim->n_frag; i++) {
-        const cf_fragment *f = &sim->frag[i];
+    o->fracture_steps = w->steps_fracture;
+    o->tet_steps = w->tet_steps_fracture, o->fracture_time = w->t_fracture;
+    memcpy(o->stage, w->prof.stage, sizeof o->stage);
+    for (int i = 0; i < w->n_frag; i++) {
+        const cf_fragment *f = &w->frag[i];
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         o->tets += f->nt, o->nodes += f->nodes.n, o->bars += f->bars.n, o->cohesive += f->coh.n;

@@ -18,19 +18,19 @@
 #include <stdio.h>
 
 /* The event of a hand-off the step made. */
-static cf_status handoff_event(cf_world *sim, const cf_handoff_record *r, cf_error *err)
+static cf_status handoff_event(cf_world *w, const cf_handoff_record *r, cf_error *err)
 {
-    cf_event e = {.type = CF_EVENT_HANDOFF, .time = sim->t, .first = r->fragment, .count = 1,
-                  .alive = cf_world_alive_fragments(sim, NULL), .handoff = *r};
-    return cf_world_push_event(sim, &e, err);
+    cf_event e = {.type = CF_EVENT_HANDOFF, .time = w->t, .first = r->fragment, .count = 1,
+                  .alive = cf_world_alive_fragments(w, NULL), .handoff = *r};
+    return cf_world_push_event(w, &e, err);
 }
 
 /* Fragment fi to fracture mode (cf_handoff_to_fracture), and its event. */
-static cf_status to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_error *err)
+static cf_status to_fracture(cf_world *w, int fi, const cfb_state *st, cf_error *err)
 {
     cf_handoff_record r;
-    cf_status rc = cf_handoff_to_fracture(sim, fi, st, &r, err);
-    return rc == CF_OK ? handoff_event(sim, &r, err) : rc;
+    cf_status rc = cf_handoff_to_fracture(w, fi, st, &r, err);
+    return rc == CF_OK ? handoff_event(w, &r, err) : rc;
 }
 
 /* Divergence: a non-finite position or a node faster than 1e5 m/s. */
@@ -48,10 +48,10 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
 
 /* Debris, and a fragment with no uncracked interior facet (a single tet,
  * say), cannot break further: an impact leaves it in rigid mode. */
-static int can_break(const cf_world *sim, const cf_fragment *f)
+static int can_break(const cf_world *w, const cf_fragment *f)
 {
-    const cf_solid *s = &sim->solid;
-    const cf_solver_settings *set = &sim->def.solver;
+    const cf_solid *s = &w->solid;
+    const cf_solver_settings *set = &w->def.solver;
     if (set->criterion == CF_CRITERION_NONE || cf_fragment_is_debris(f, set))
         return 0;
     for (int i = 0; i < f->nt; i++)
@@ -65,10 +65,10 @@ static int can_break(const cf_world *sim, const cf_fragment *f)
 
 /* Rigid fragment fi is hit: Bullet's contact impulse plus the pushes of
  * fracture-mode nodes, per unit mass, pass the impact threshold. */
-static int impact(const cf_world *sim, const cf_fragment *f)
+static int impact(const cf_world *w, const cf_fragment *f)
 {
-    double dv = (cfb_contact_impulse(sim->bullet, f->body) + f->pushed) / f->mass;
-    return dv > sim->def.solver.impact_threshold && can_break(sim, f);
+    double dv = (cfb_contact_impulse(w->bullet, f->body) + f->pushed) / f->mass;
+    return dv > w->def.solver.impact_threshold && can_break(w, f);
 }
 
 /* One Bullet step.  Fragments hit harder than the impact threshold go to
@@ -76,105 +76,105 @@ static int impact(const cf_world *sim, const cf_fragment *f)
  * then re-run from that start for every other body, so that none keeps the
  * contact response of a fragment that is now sub-cycled instead (momentum is
  * exchanged with it through its nodes). */
-static cf_status bullet_step(cf_world *sim, double dt, cf_error *err)
+static cf_status bullet_step(cf_world *w, double dt, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->def.solver;
-    int n = sim->n_frag, no = sim->def.n_obstacles;
-    size_t mark = cf_arena_mark(&sim->arena);
-    cfb_state *pre = cf_arena_take(&sim->arena, (size_t)(n + no) * sizeof *pre), *pre_obs = pre + n;
+    const cf_solver_settings *set = &w->def.solver;
+    int n = w->n_frag, no = w->def.n_obstacles;
+    size_t mark = cf_arena_mark(&w->arena);
+    cfb_state *pre = cf_arena_take(&w->arena, (size_t)(n + no) * sizeof *pre), *pre_obs = pre + n;
     if (!pre)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     for (int fi = 0; fi < n; fi++)
-        if (sim->frag[fi].body >= 0)
-            cfb_get_state(sim->bullet, sim->frag[fi].body, &pre[fi]);
+        if (w->frag[fi].body >= 0)
+            cfb_get_state(w->bullet, w->frag[fi].body, &pre[fi]);
     for (int j = 0; j < no; j++)
-        if (sim->obstacle_moving[j])
-            cfb_get_state(sim->bullet, sim->obstacle_body[j], &pre_obs[j]);
+        if (w->obstacle_moving[j])
+            cfb_get_state(w->bullet, w->obstacle_body[j], &pre_obs[j]);
     int any_moving = 0;
     for (int j = 0; j < no; j++)
-        any_moving |= sim->obstacle_moving[j];
+        any_moving |= w->obstacle_moving[j];
     cf_status st = CF_OK;
     for (int pass = 0; st == CF_OK; pass++) {
         /* Fails when Bullet ran out of memory, in this step or in an
          * earlier call that could not say so (the world is then unusable). */
-        if (cfb_step(sim->bullet, dt, set->rigid_substeps) < 0) {
+        if (cfb_step(w->bullet, dt, set->rigid_substeps) < 0) {
             st = cf_world_bullet_error(err, "the rigid step");
             break;
         }
         int hit = 0;
         for (int fi = 0; fi < n && st == CF_OK; fi++) {
-            cf_fragment *f = &sim->frag[fi];
-            if (f->mode != CF_MODE_RIGID || f->body < 0 || !impact(sim, f))
+            cf_fragment *f = &w->frag[fi];
+            if (f->mode != CF_MODE_RIGID || f->body < 0 || !impact(w, f))
                 continue;
-            cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
-            st = to_fracture(sim, fi, &pre[fi], err);
-            cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF);
+            cf_profile_lap(&w->prof, CF_STAGE_RIGID_STEP);
+            st = to_fracture(w, fi, &pre[fi], err);
+            cf_profile_lap(&w->prof, CF_STAGE_HANDOFF);
             hit++;
         }
         if (st != CF_OK || hit == 0 || pass == CF_MAX_RESTEPS)
             break;
         for (int fi = 0; fi < n; fi++)
-            if (sim->frag[fi].mode == CF_MODE_RIGID && sim->frag[fi].body >= 0)
-                cfb_set_state(sim->bullet, sim->frag[fi].body, &pre[fi]);
+            if (w->frag[fi].mode == CF_MODE_RIGID && w->frag[fi].body >= 0)
+                cfb_set_state(w->bullet, w->frag[fi].body, &pre[fi]);
         for (int j = 0; j < no; j++)
-            if (sim->obstacle_moving[j])
-                cfb_set_state(sim->bullet, sim->obstacle_body[j], &pre_obs[j]);
+            if (w->obstacle_moving[j])
+                cfb_set_state(w->bullet, w->obstacle_body[j], &pre_obs[j]);
     }
     /* What contact did to the rigid bodies' energy beyond gravity's work. */
     for (int fi = 0; fi < n; fi++) {
-        cf_fragment *f = &sim->frag[fi];
+        cf_fragment *f = &w->frag[fi];
         f->pushed = 0;
         if (f->mode != CF_MODE_RIGID || f->body < 0)
             continue;
         cfb_state now;
-        cfb_get_state(sim->bullet, f->body, &now);
-        double removed = cf_world_body_energy(sim, f, &pre[fi]) - cf_world_body_energy(sim, f, &now);
-        if (cfb_contact_impulse(sim->bullet, f->body) == 0) { /* free flight */
-            sim->flow.integration += removed;
+        cfb_get_state(w->bullet, f->body, &now);
+        double removed = cf_world_body_energy(w, f, &pre[fi]) - cf_world_body_energy(w, f, &now);
+        if (cfb_contact_impulse(w->bullet, f->body) == 0) { /* free flight */
+            w->flow.integration += removed;
             continue;
         }
         if (removed < 0 && any_moving) { /* a moving obstacle did work on it */
-            sim->flow.obstacles -= removed;
+            w->flow.obstacles -= removed;
             removed = 0;
         }
-        sim->flow.contact += removed;
+        w->flow.contact += removed;
     }
-    cf_arena_release(&sim->arena, mark);
-    sim->steps_rigid++;
-    cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
+    cf_arena_release(&w->arena, mark);
+    w->steps_rigid++;
+    cf_profile_lap(&w->prof, CF_STAGE_RIGID_STEP);
     return st;
 }
 
 /* Advance the rigid fragments by one rigid step; detect impacts. */
-static cf_status rigid_step(cf_world *sim, double dt, cf_error *err)
+static cf_status rigid_step(cf_world *w, double dt, cf_error *err)
 {
-    if (sim->bullet)
-        return bullet_step(sim, dt, err);
-    for (int fi = 0; fi < sim->n_frag; fi++) {
-        if (sim->frag[fi].mode != CF_MODE_RIGID)
+    if (w->bullet)
+        return bullet_step(w, dt, err);
+    for (int fi = 0; fi < w->n_frag; fi++) {
+        if (w->frag[fi].mode != CF_MODE_RIGID)
             continue;
-        cf_step_ctx ctx = cf_world_step_ctx(sim);
-        int hit = cf_pbd_impact(&ctx, &sim->frag[fi], sim->t, dt) && can_break(sim, &sim->frag[fi]);
-        cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
+        cf_step_ctx ctx = cf_world_step_ctx(w);
+        int hit = cf_pbd_impact(&ctx, &w->frag[fi], w->t, dt) && can_break(w, &w->frag[fi]);
+        cf_profile_lap(&w->prof, CF_STAGE_RIGID_STEP);
         if (hit) {
-            cf_status st = to_fracture(sim, fi, NULL, err);
-            cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF);
+            cf_status st = to_fracture(w, fi, NULL, err);
+            cf_profile_lap(&w->prof, CF_STAGE_HANDOFF);
             if (st != CF_OK)
                 return st;
             continue;
         }
         /* The damped step's own stages are timed as the solver's. */
-        if (cf_solver_step(&ctx, &sim->frag[fi], fi, sim->t, dt, 0) != CF_OK)
+        if (cf_solver_step(&ctx, &w->frag[fi], fi, w->t, dt, 0) != CF_OK)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory in the pbd rigid step");
     }
-    sim->steps_rigid++;
-    cf_profile_lap(&sim->prof, CF_STAGE_RIGID_STEP);
+    w->steps_rigid++;
+    cf_profile_lap(&w->prof, CF_STAGE_RIGID_STEP);
     return CF_OK;
 }
 
-static cf_status diverged(const cf_world *sim, cf_error *err, const char *what)
+static cf_status diverged(const cf_world *w, cf_error *err, const char *what)
 {
-    const cf_solver_settings *set = &sim->def.solver;
+    const cf_solver_settings *set = &w->def.solver;
     const char *fix = set->constraints == CF_CONSTRAINTS_NONE
                           ? "lower solver.dt_fracture (or solver.cfl_fraction) below dt_cfl, or use "
                             "solver.constraints = "
@@ -183,31 +183,31 @@ static cf_status diverged(const cf_world *sim, cf_error *err, const char *what)
                             "solver.pbd.k_stiffness";
     return cf_error_set(err, CF_ERR_DIVERGED,
                         "%s at t = %.6g s with dt_fracture/dt_cfl = %.3g (dt_cfl %.3g s): %s",
-                        what, sim->t, sim->dt_fracture / sim->solid.dt_cfl, sim->solid.dt_cfl, fix);
+                        what, w->t, w->dt_fracture / w->solid.dt_cfl, w->solid.dt_cfl, fix);
 }
 
 /* How far beyond fragment fi's nodes a rigid body can be touched during a
  * rigid step of dt: the fastest node's travel, plus gravity's. */
-static double contact_pad(const cf_world *sim, int fi, double dt)
+static double contact_pad(const cf_world *w, int fi, double dt)
 {
-    const cf_fragment *f = &sim->frag[fi];
+    const cf_fragment *f = &w->frag[fi];
     double v2 = 0; /* a maximum: the same for any thread count */
     CF_PARALLEL(f->nodes.n >= CF_NODES_PARALLEL_MIN,
                 "omp parallel for schedule(static) reduction(max : v2)",
         for (int i = 0; i < f->nodes.n; i++) {
-            const double *v = &sim->solid.v[3 * f->nodes.v[i]];
+            const double *v = &w->solid.v[3 * f->nodes.v[i]];
             v2 = fmax(v2, v3_dot(v, v));
         });
-    return dt * (sqrt(v2) + dt * v3_norm(sim->def.gravity));
+    return dt * (sqrt(v2) + dt * v3_norm(w->def.gravity));
 }
 
 /* Sub-cycle every fracture-mode fragment through the rigid step, all of
  * them in step so that fragments of different bodies meet in contact after
  * each sub-step. */
 /* Fracture sub-steps in a rigid step of dt: n_sub of h <= dt_fracture. */
-static long sub_steps(const cf_world *sim, double dt, double *h)
+static long sub_steps(const cf_world *w, double dt, double *h)
 {
-    long n_sub = lround(ceil(dt / sim->dt_fracture - 1e-9));
+    long n_sub = lround(ceil(dt / w->dt_fracture - 1e-9));
     if (n_sub < 1)
         n_sub = 1;
     *h = dt / (double)n_sub;
@@ -215,108 +215,108 @@ static long sub_steps(const cf_world *sim, double dt, double *h)
 }
 
 /* The contact stages' view of the world (contact.h). */
-static cf_contact_ctx contact_ctx(cf_world *sim)
+static cf_contact_ctx contact_ctx(cf_world *w)
 {
-    return (cf_contact_ctx){sim->frag, sim->contact.v, sim->n_frag, &sim->solid, sim->bullet,
-                            &sim->arena};
+    return (cf_contact_ctx){w->frag, w->contact.v, w->n_frag, &w->solid, w->bullet,
+                            &w->arena};
 }
 
 /* Stage collision, before the sub-steps: the hulls of the rigid bodies
  * near each fracture-mode fragment, from the bodies' boxes taken once.
  * Returns 0, or -1 out of memory. */
-static int gather_hulls(cf_world *sim, const cf_contact_ctx *cx, double dt)
+static int gather_hulls(cf_world *w, const cf_contact_ctx *cx, double dt)
 {
-    size_t mark = cf_arena_mark(&sim->arena);
+    size_t mark = cf_arena_mark(&w->arena);
     double *boxes = NULL;
     int rc = 0;
-    for (int fi = 0; fi < sim->n_frag && !rc; fi++) {
-        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+    for (int fi = 0; fi < w->n_frag && !rc; fi++) {
+        if (w->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
         if (!boxes) {
-            boxes = cf_arena_take(&sim->arena, (size_t)sim->n_frag * 6 * sizeof *boxes);
+            boxes = cf_arena_take(&w->arena, (size_t)w->n_frag * 6 * sizeof *boxes);
             if (!boxes) {
                 rc = -1;
                 break;
             }
             cf_body_boxes(cx, boxes);
         }
-        rc = cf_hull_set_gather(cx, fi, contact_pad(sim, fi, dt), boxes,
-                                &sim->contact.v[fi].near);
+        rc = cf_hull_set_gather(cx, fi, contact_pad(w, fi, dt), boxes,
+                                &w->contact.v[fi].near);
     }
-    cf_arena_release(&sim->arena, mark);
+    cf_arena_release(&w->arena, mark);
     return rc;
 }
 
-static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, cf_error *err)
+static cf_status fracture_steps(cf_world *w, double dt, long n_sub, double h, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->def.solver;
-    sim->h_fracture = h;
-    int n = sim->n_frag;
-    if (cf_contact_caches_reserve(&sim->contact, n))
+    const cf_solver_settings *set = &w->def.solver;
+    w->h_fracture = h;
+    int n = w->n_frag;
+    if (cf_contact_caches_reserve(&w->contact, n))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
     /* No fragment is made before the splits after these steps, so neither
      * table moves while cx points into them. */
-    const cf_contact_ctx cx = contact_ctx(sim);
+    const cf_contact_ctx cx = contact_ctx(w);
     int bodies = cf_body_contact_needed(&cx);
-    if (gather_hulls(sim, &cx, dt))
+    if (gather_hulls(w, &cx, dt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
-    cf_profile_lap(&sim->prof, CF_STAGE_COLLISION);
-    cf_step_ctx ctx = cf_world_step_ctx(sim);
+    cf_profile_lap(&w->prof, CF_STAGE_COLLISION);
+    cf_step_ctx ctx = cf_world_step_ctx(w);
     for (long k = 0; k < n_sub; k++) {
         for (int fi = 0; fi < n; fi++) {
-            if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+            if (w->frag[fi].mode != CF_MODE_FRACTURE)
                 continue;
-            if (cf_solver_step(&ctx, &sim->frag[fi], fi, sim->t + (double)k * h, h, 1) != CF_OK)
+            if (cf_solver_step(&ctx, &w->frag[fi], fi, w->t + (double)k * h, h, 1) != CF_OK)
                 return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
-            sim->steps_fracture++;
-            sim->tet_steps_fracture += sim->frag[fi].nt;
+            w->steps_fracture++;
+            w->tet_steps_fracture += w->frag[fi].nt;
         }
         if (bodies) {
             double removed;
             if (cf_body_contact(&cx, h, &removed))
                 return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
                                     cff_last_error());
-            sim->flow.contact += removed;
-            cf_profile_lap(&sim->prof, CF_STAGE_COLLISION);
+            w->flow.contact += removed;
+            cf_profile_lap(&w->prof, CF_STAGE_COLLISION);
         }
-        if (sim->tick) {
-            sim->tick(sim->tick_user, sim->t + (double)(k + 1) * h);
-            cf_profile_lap(&sim->prof, CF_STAGE_BOOKKEEPING);
+        if (w->tick) {
+            w->tick(w->tick_user, w->t + (double)(k + 1) * h);
+            cf_profile_lap(&w->prof, CF_STAGE_BOOKKEEPING);
         }
     }
     for (int fi = 0; fi < n; fi++) {
-        cf_fragment *f = &sim->frag[fi];
+        cf_fragment *f = &w->frag[fi];
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         double gained;
-        cf_contact_cache *cc = &sim->contact.v[fi];
+        cf_contact_cache *cc = &w->contact.v[fi];
         if (cf_node_impulses_flush(&cx, &cc->push, f->nodes.v, &gained))
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory pushing rigid fragments");
-        sim->flow.contact -= gained;
+        w->flow.contact -= gained;
         cc->near.n = 0;
-        cf_profile_lap(&sim->prof, CF_STAGE_COLLISION);
+        cf_profile_lap(&w->prof, CF_STAGE_COLLISION);
         char what[160];
-        if (!nodes_sane(&sim->solid, f)) {
+        if (!nodes_sane(&w->solid, f)) {
             snprintf(what, sizeof what,
                      "fragment %d diverged: a node position is not finite or a node is faster "
                      "than 1e5 m/s",
                      fi);
-            return diverged(sim, err, what);
+            return diverged(w, err, what);
         }
         /* Inverted tets counted over the fragment's whole initial body in
          * fracture mode (one inverted tet is all of a one-tet piece). */
-        int root = cf_fragment_root(sim->frag, fi), inv = 0, nt = 0;
+        int root = cf_fragment_root(w->frag, fi), inv = 0, nt = 0;
         for (int g = 0; f->n_inverted > 0 && g < n; g++)
-            if (sim->frag[g].mode == CF_MODE_FRACTURE && cf_fragment_root(sim->frag, g) == root)
-                inv += sim->frag[g].n_inverted, nt += sim->frag[g].nt;
+            if (w->frag[g].mode == CF_MODE_FRACTURE && cf_fragment_root(w->frag, g) == root)
+                inv += w->frag[g].n_inverted, nt += w->frag[g].nt;
         if (inv > set->max_inverted_fraction * nt) {
             snprintf(what, sizeof what,
                      "fragment %d diverged: %d of the %d tets of its body in fracture mode are "
                      "inverted (more than solver.guard.max_inverted_fraction = %g)",
                      fi, inv, nt, set->max_inverted_fraction);
-            return diverged(sim, err, what);
+            return diverged(w, err, what);
         }
-        cf_profile_lap(&sim->prof, CF_STAGE_BOOKKEEPING);
+        cf_profile_lap(&w->prof, CF_STAGE_BOOKKEEPING);
     }
     return CF_OK;
 }
@@ -326,22 +326,22 @@ static cf_status fracture_steps(cf_world *sim, double dt, long n_sub, double h, 
  * gravity, prescribed nodes and moving obstacles, and what hand-offs put
  * in: the squeeze of wedged pieces, gravity's potential of pieces moved
  * clear of obstacles). */
-static cf_status check_energy(cf_world *sim, cf_error *err)
+static cf_status check_energy(cf_world *w, cf_error *err)
 {
     cf_ledger l;
-    cf_world_ledger_terms(sim, &l, 0);
+    cf_world_ledger_terms(w, &l, 0);
     double have = l.kinetic + l.strain + l.cohesive_stored + l.cohesive_dissipated +
                   l.plastic_dissipated;
     double input = l.initial + fmax(0.0, l.work_gravity) + fmax(0.0, l.work_boundary) +
-                   fmax(0.0, l.work_obstacles) + sim->flow.put_in;
-    if (have <= (1 + sim->def.solver.max_energy_growth) * input + 1e-12)
+                   fmax(0.0, l.work_obstacles) + w->flow.put_in;
+    if (have <= (1 + w->def.solver.max_energy_growth) * input + 1e-12)
         return CF_OK;
     char what[200];
     snprintf(what, sizeof what,
              "energy grew with no work input: %.4g J against %.4g J put in (more than "
              "solver.guard.max_energy_growth = %g)",
-             have, input, sim->def.solver.max_energy_growth);
-    return diverged(sim, err, what);
+             have, input, w->def.solver.max_energy_growth);
+    return diverged(w, err, what);
 }
 
 #define CF_CONTACT_SLOP 1e-9 /* m: a node projected onto an obstacle, up to round-off */
@@ -361,28 +361,28 @@ static cf_status check_energy(cf_world *sim, cf_error *err)
  * wave that breaks a body never built up.  A body that rests on the ground
  * holds next to no strain energy, so it still goes back
  * (docs/physics.md §9). */
-static int impact_unfinished(cf_world *sim, int fi)
+static int impact_unfinished(cf_world *w, int fi)
 {
-    const cf_fragment *f = &sim->frag[fi];
-    const cf_solid *s = &sim->solid;
-    double com[3], R[9], v[3], w[3], P[3], L[3], r[3], wr[3], vr[3];
-    double reach = sim->def.solver.dt_rigid;
-    cf_fragment_pose(&sim->frag[fi], &sim->solid, sim->bullet, com, R, v, w);
+    const cf_fragment *f = &w->frag[fi];
+    const cf_solid *s = &w->solid;
+    double com[3], R[9], v[3], omega[3], P[3], L[3], r[3], wr[3], vr[3];
+    double reach = w->def.solver.dt_rigid;
+    cf_fragment_pose(&w->frag[fi], &w->solid, w->bullet, com, R, v, omega);
     int touching = 0;
     for (int i = 0; i < f->nodes.n; i++) {
         const double *x = &s->x[3 * f->nodes.v[i]];
         v3_sub(x, com, r);
-        v3_cross(w, r, wr);
-        for (int j = 0; j < sim->obs.n; j++) {
+        v3_cross(omega, r, wr);
+        for (int j = 0; j < w->obs.n; j++) {
             double n[3], u[3];
-            double d = cf_obstacle_distance(&sim->obs, j, sim->t, x, n);
-            cf_obstacle_velocity(&sim->obs.o[j], u);
+            double d = cf_obstacle_distance(&w->obs, j, w->t, x, n);
+            cf_obstacle_velocity(&w->obs.o[j], u);
             for (int k = 0; k < 3; k++)
                 vr[k] = v[k] + wr[k] - u[k];
             double approach = -v3_dot(vr, n);
             if (d > fmax(0.0, approach) * reach + CF_CONTACT_SLOP)
                 continue;
-            if (approach > sim->def.solver.impact_threshold)
+            if (approach > w->def.solver.impact_threshold)
                 return 1; /* rigid mode would see an impact at once */
             touching = 1;
         }
@@ -390,10 +390,10 @@ static int impact_unfinished(cf_world *sim, int fi)
     if (!touching)
         return 0;
     double Lo[3]; /* the spin's angular momentum, about the centre of mass */
-    cf_fragment_momenta(f, &sim->solid, sim->bullet, P, L);
+    cf_fragment_momenta(f, &w->solid, w->bullet, P, L);
     v3_cross(com, P, r);
     v3_sub(L, r, Lo);
-    double rigid = 0.5 * f->mass * v3_dot(v, v) + 0.5 * v3_dot(w, Lo);
+    double rigid = 0.5 * f->mass * v3_dot(v, v) + 0.5 * v3_dot(omega, Lo);
     double deformation = f->e_strain + fmax(0.0, f->e_kin - rigid);
     return deformation > CF_IMPACT_OVER * f->e_enter;
 }
@@ -401,30 +401,30 @@ static int impact_unfinished(cf_world *sim, int fi)
 /* Fracture-mode fragments that have been quiet long enough, and no longer
  * drive into an obstacle, go back to rigid mode; debris at once, as it
  * cannot break further. */
-static cf_status return_to_rigid(cf_world *sim, cf_error *err)
+static cf_status return_to_rigid(cf_world *w, cf_error *err)
 {
-    const cf_solver_settings *set = &sim->def.solver;
-    int n = sim->n_frag;
+    const cf_solver_settings *set = &w->def.solver;
+    int n = w->n_frag;
     for (int fi = 0; fi < n; fi++) {
-        cf_fragment *f = &sim->frag[fi];
+        cf_fragment *f = &w->frag[fi];
         if (f->mode != CF_MODE_FRACTURE)
             continue;
-        int timed_out = sim->t - f->t_enter >= set->max_fracture_time - 1e-12;
-        if (!timed_out && !cf_fragment_is_debris(f, &sim->def.solver) &&
-            (f->quiet < set->quiet_steps || impact_unfinished(sim, fi)))
+        int timed_out = w->t - f->t_enter >= set->max_fracture_time - 1e-12;
+        if (!timed_out && !cf_fragment_is_debris(f, &w->def.solver) &&
+            (f->quiet < set->quiet_steps || impact_unfinished(w, fi)))
             continue;
-        int first_new = sim->n_frag;
+        int first_new = w->n_frag;
         cf_handoff_record r;
-        cf_status st = cf_handoff_to_rigid(sim, fi, &r, err);
-        cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF);
+        cf_status st = cf_handoff_to_rigid(w, fi, &r, err);
+        cf_profile_lap(&w->prof, CF_STAGE_HANDOFF);
         if (st == CF_OK)
-            st = handoff_event(sim, &r, err);
+            st = handoff_event(w, &r, err);
         if (st == CF_OK)
-            st = cf_world_fragments_born(sim, first_new, err);
+            st = cf_world_fragments_born(w, first_new, err);
         if (st != CF_OK)
             return st;
     }
-    cf_profile_lap(&sim->prof, CF_STAGE_HANDOFF); /* the checks of those that stay */
+    cf_profile_lap(&w->prof, CF_STAGE_HANDOFF); /* the checks of those that stay */
     return CF_OK;
 }
 
@@ -437,19 +437,19 @@ static cf_status return_to_rigid(cf_world *sim, cf_error *err)
  * between pieces that tumble apart, acted along a mid-surface that no
  * longer means anything and pumped energy in (an explicit drop's cohesive
  * stored energy fell to -280 J within 50 us, docs/physics.md §14.6). */
-static cf_status split_fragments(cf_world *sim, cf_error *err)
+static cf_status split_fragments(cf_world *w, cf_error *err)
 {
-    int n = sim->n_frag;
+    int n = w->n_frag;
     for (int fi = 0; fi < n; fi++) {
-        if (sim->frag[fi].mode != CF_MODE_FRACTURE)
+        if (w->frag[fi].mode != CF_MODE_FRACTURE)
             continue;
-        int first = sim->n_frag;
-        int k = cf_fragment_split_fracture(sim, fi, &first);
-        cf_profile_lap(&sim->prof, CF_STAGE_SPLIT);
+        int first = w->n_frag;
+        int k = cf_fragment_split_fracture(w, fi, &first);
+        cf_profile_lap(&w->prof, CF_STAGE_SPLIT);
         if (k < 0)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory splitting fragment %d", fi);
         if (k > 0) {
-            cf_status st = cf_world_fragments_born(sim, first, err);
+            cf_status st = cf_world_fragments_born(w, first, err);
             if (st != CF_OK)
                 return st;
         }
@@ -457,12 +457,12 @@ static cf_status split_fragments(cf_world *sim, cf_error *err)
     return CF_OK;
 }
 
-static cf_status world_step(cf_world *sim, double want, cf_error *err)
+static cf_status world_step(cf_world *w, double want, cf_error *err)
 {
-    cf_profile_start(&sim->prof);
-    const cf_world_def *sc = &sim->def;
-    double dt = sim->dt_outer, h, t0 = sim->t;
-    long n_sub = sub_steps(sim, dt, &h);
+    cf_profile_start(&w->prof);
+    const cf_world_def *sc = &w->def;
+    double dt = w->dt_outer, h, t0 = w->t;
+    long n_sub = sub_steps(w, dt, &h);
     /* A step shorter than the regular one (a run that ends between two):
      * in rigid mode exactly `want`; a fracture-only run in whole fracture
      * steps of the same h (the leapfrog energy estimate needs a constant
@@ -473,43 +473,43 @@ static cf_status world_step(cf_world *sim, double want, cf_error *err)
         dt = (double)n_sub * h;
     } else if (cut) {
         dt = want;
-        n_sub = sub_steps(sim, dt, &h);
+        n_sub = sub_steps(w, dt, &h);
     }
-    int n_coh = sim->solid.n_coh;
-    long stepped = sim->steps_fracture;
-    cf_status st = rigid_step(sim, dt, err);
+    int n_coh = w->solid.n_coh;
+    long stepped = w->steps_fracture;
+    cf_status st = rigid_step(w, dt, err);
     if (st == CF_OK)
-        st = fracture_steps(sim, dt, n_sub, h, err);
-    if (sim->steps_fracture > stepped)
-        sim->t_fracture += dt;
-    sim->step++;
+        st = fracture_steps(w, dt, n_sub, h, err);
+    if (w->steps_fracture > stepped)
+        w->t_fracture += dt;
+    w->step++;
     /* Regular steps count from zero, so that no rounding builds up. */
-    sim->t = !cut ? (double)sim->step * sim->dt_outer : t0 + dt;
-    if (st == CF_OK && sim->solid.n_coh > n_coh) {
-        cf_event e = {.type = CF_EVENT_INSERTIONS, .time = sim->t, .first = n_coh,
-                      .count = sim->solid.n_coh - n_coh, .alive = cf_world_alive_fragments(sim, NULL)};
-        st = cf_world_push_event(sim, &e, err);
+    w->t = !cut ? (double)w->step * w->dt_outer : t0 + dt;
+    if (st == CF_OK && w->solid.n_coh > n_coh) {
+        cf_event e = {.type = CF_EVENT_INSERTIONS, .time = w->t, .first = n_coh,
+                      .count = w->solid.n_coh - n_coh, .alive = cf_world_alive_fragments(w, NULL)};
+        st = cf_world_push_event(w, &e, err);
     }
     if (st == CF_OK)
-        st = split_fragments(sim, err);
+        st = split_fragments(w, err);
     if (st == CF_OK && sc->solver.mode == CF_RUN_HYBRID)
-        st = return_to_rigid(sim, err);
+        st = return_to_rigid(w, err);
     if (st == CF_OK)
-        st = check_energy(sim, err);
-    if (cf_arena_end_step(&sim->arena) && st == CF_OK)
+        st = check_energy(w, err);
+    if (cf_arena_end_step(&w->arena) && st == CF_OK)
         st = cf_error_set(err, CF_ERR_NOMEM, "out of memory growing the step's scratch");
-    cf_profile_lap(&sim->prof, CF_STAGE_BOOKKEEPING);
+    cf_profile_lap(&w->prof, CF_STAGE_BOOKKEEPING);
     return st;
 }
 
-cf_status cf_world_step(cf_world *sim, double dt, cf_error *err)
+cf_status cf_world_step(cf_world *w, double dt, cf_error *err)
 {
-    assert(dt > 0 && dt <= sim->dt_outer * (1 + 1e-9)); /* the caller's step (world.h) */
+    assert(dt > 0 && dt <= w->dt_outer * (1 + 1e-9)); /* the caller's step (world.h) */
     /* OpenMP's thread count is the calling thread's setting: the step runs
      * on the world's and gives the caller back its own. */
     int caller = omp_get_max_threads();
-    omp_set_num_threads(sim->threads);
-    cf_status st = world_step(sim, dt, err);
+    omp_set_num_threads(w->threads);
+    cf_status st = world_step(w, dt, err);
     omp_set_num_threads(caller);
     return st;
 }
