@@ -37,7 +37,7 @@
 -- of the 305 J it lands with, about 208 J go into crushing and 5.0 J into
 -- the cracks, and 44 J of strain energy are dropped (and booked) at the
 -- hand-offs; the fastest piece leaves at 10.1 m/s against the bound
--- 15.0 m/s of tools/check_physics.py; about 6 s.  Seeds 2-5 give 1, 2, 1
+-- 15.0 m/s of tests/checks/check_physics.py; about 6 s.  Seeds 2-5 give 1, 2, 1
 -- and 4 pieces of at least 5% (docs/physics.md §14.17).
 return {
   name = "plaster_bunny_drop",

@@ -10,7 +10,7 @@
 -- Mesh: gmsh's sphere at mesh_size l_ch/2 (1,464 tets for 50 mm, 4,430
 -- for 75 mm).  Method: explicit fracture mode at 0.5 dt_cfl, cracks that
 -- grow from fronts, penalty floor, as the bunny drop.
--- The ladder: tools/fragmentation.py (ctest -L fragmentation) varies
+-- The ladder: tests/checks/fragmentation.py (ctest -L fragmentation) varies
 --   --set 'bodies[1].velocity={0,0,-V}'  --set bodies[1].mesh.radius=R
 --   --set 'bodies[1].position={0,0,R+0.0005}'  --set bodies[1].mesh.mesh_size=H
 -- Expected (2026-11-24): at 5 m/s it stays whole (99 %, a few crumbs);

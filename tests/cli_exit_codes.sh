@@ -47,8 +47,8 @@ expect 3 "divergence (dt far above the CFL step, no PBD iterations to hold it)" 
     --set solver.pbd.k_stiffness=0 --set duration=0.05
 # The diverged run's file stays readable, and the plausibility check fails
 # it: it never reached its duration (its frames so far may all look fine).
-expect 1 "tools/check_physics.py on the diverged run's file" \
-    /usr/bin/python3 "$(dirname "$0")/../tools/check_physics.py" "$tmp/out/tiny.h5"
+expect 1 "tests/checks/check_physics.py on the diverged run's file" \
+    /usr/bin/python3 "$(dirname "$0")/../tests/checks/check_physics.py" "$tmp/out/tiny.h5"
 grep -q 'FAIL  complete' "$tmp/log" || { echo "FAIL  no failed 'complete' check"; fails=$((fails + 1)); }
 expect 4 "output under a regular file" "$exe" run "$tmp/drop.lua" --mesh-dir "$meshes" -q \
     -o "$tmp/file/x.h5"

@@ -34,8 +34,10 @@ echo "both builds ran and printed the same fragments"
 # installed beside it (a marker in the installed copy shows which ran).
 export XDG_CACHE_HOME="$tmp/cache"
 unset COHFRAC_MESH_DIR
-py="$prefix/share/cohfrac/python"
-for f in render.py cohfrac_h5.py; do
+site=$(find "$prefix/lib" -path '*dist-packages/cohfrac/__init__.py' | head -1)
+[ -n "$site" ] || { echo "FAIL: the Python package is not installed"; exit 1; }
+py=$(dirname "$site")
+for f in render.py h5.py; do
     sed -i '/^if __name__ == "__main__":/i print("installed helper", file=__import__("sys").stderr)' "$py/$f"
 done
 cp "$src/tests/data/box_break.lua" "$tmp/box.lua"
@@ -70,8 +72,6 @@ fi
 
 # The Python package, installed where Debian's python3 looks under the
 # prefix (lib/python3.X/dist-packages), loads the installed library.
-site=$(find "$prefix/lib" -path '*dist-packages/cohfrac/__init__.py' | head -1)
-[ -n "$site" ] || { echo "FAIL: the Python package is not installed"; exit 1; }
 lib=$(env -u COHFRAC_LIB PYTHONPATH="$(dirname "$(dirname "$site")")" /usr/bin/python3 -c \
     'import cohfrac; print(cohfrac.library()._name)')
 case "$lib" in "$prefix"/*) ;; *) echo "FAIL: import cohfrac loaded $lib, not the install's"; exit 1 ;; esac

@@ -1,8 +1,8 @@
 #!/bin/sh
 # The output's geometry (docs/output.md) on a cube that cracks on the
-# ground: tools/check_geometry.py (closed, outward surfaces enclosing their
+# ground: tests/checks/check_geometry.py (closed, outward surfaces enclosing their
 # tets' volume, crack faces marked, posed surfaces above the floor, units),
-# then `cohfrac export` writes glTF that tools/check_gltf.py reads back
+# then `cohfrac export` writes glTF that tests/checks/check_gltf.py reads back
 # (a node and three channels per fragment, the last pose), and `cohfrac
 # render` makes PNG frames and an MP4 of the run.
 #   tests/output_geometry.sh COHFRAC SOURCE_DIR MESH_DIR
@@ -13,18 +13,19 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$exe" run "$src/tests/data/box_break.lua" -q -m "$3" -o "$tmp/box.h5" > "$tmp/run.txt"
 grep '^fragments' "$tmp/run.txt"
-/usr/bin/python3 "$src/tools/check_geometry.py" "$tmp/box.h5"
-/usr/bin/python3 "$src/tools/cohfrac_h5.py" "$tmp/box.h5"
+/usr/bin/python3 "$src/tests/checks/check_geometry.py" "$tmp/box.h5"
+/usr/bin/python3 "$src/python/cohfrac/h5.py" "$tmp/box.h5"
 "$exe" export "$tmp/box.h5" --format gltf -o "$tmp/box.glb"
-/usr/bin/python3 "$src/tools/check_gltf.py" "$tmp/box.h5" "$tmp/box.glb"
+/usr/bin/python3 "$src/tests/checks/check_gltf.py" "$tmp/box.h5" "$tmp/box.glb"
 "$exe" export "$tmp/box.h5" --format pvd -o "$tmp/pvd"
-/usr/bin/python3 - "$tmp/box.h5" "$tmp/pvd" "$src/tools" <<'PY'
+/usr/bin/python3 - "$tmp/box.h5" "$tmp/pvd" "$src/python" <<'PY'
 # The ParaView series: a .vtu per frame whose cells carry every alive
 # fragment (read back with meshio), their velocity field, and a .pvd that
 # lists them.
 import os, sys
 sys.path.insert(0, sys.argv[3])
-import meshio, numpy as np, cohfrac_h5
+import meshio, numpy as np
+from cohfrac import h5 as cohfrac_h5
 run = cohfrac_h5.load(sys.argv[1])
 for k in (0, len(run.times) - 1):
     m = meshio.read(os.path.join(sys.argv[2], f"frame_{k:04d}.vtu"))
@@ -53,15 +54,15 @@ grep -q 'frame_0000.vtu' "$tmp/pvd/box_break.pvd"
 
 /usr/bin/python3 -c "import h5py,sys; f=h5py.File(sys.argv[1]); t=f['visual/tet'][:]; n=len(f['mesh/rest/tets']); assert len(t) > 50000 and t.min() >= 0 and t.max() < n, (len(t), t.min(), t.max()); print(f'visual: {len(t)} triangles on {n} rest tets')" "$tmp/vis.h5"
 "$exe" export "$tmp/vis.h5" --format gltf -o "$tmp/vis.glb"
-/usr/bin/python3 "$src/tools/check_gltf.py" "$tmp/vis.h5" "$tmp/vis.glb"
+/usr/bin/python3 "$src/tests/checks/check_gltf.py" "$tmp/vis.h5" "$tmp/vis.glb"
 # The ParaView series draws it too: at a frame with every fragment rigid,
 # each visual triangle once (crack = 0), and the collision view beside it.
 "$exe" export "$tmp/vis.h5" --format pvd -o "$tmp/vispvd" > /dev/null
-/usr/bin/python3 - "$tmp/vis.h5" "$tmp/vispvd" "$src/tools" <<'PY'
+/usr/bin/python3 - "$tmp/vis.h5" "$tmp/vispvd" "$src/python" <<'PY'
 import os, sys
 sys.path.insert(0, sys.argv[3])
 import meshio
-import cohfrac_h5
+from cohfrac import h5 as cohfrac_h5
 run = cohfrac_h5.load(sys.argv[1])
 n_vis = len(run.visual["triangles"])
 rigid = [k for k in range(len(run.times)) if run.fracture_tets_at(k) is None]

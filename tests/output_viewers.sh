@@ -31,10 +31,10 @@ trap 'rm -rf "$tmp"' EXIT
 "$exe" run "$src/tests/data/box_break.lua" -q -m "$4" -o "$tmp/box.h5" > /dev/null
 # What the HDF5 file says: fragments with a surface, alive at the end, the
 # largest of those, the last time and its position there.
-set -- $(/usr/bin/python3 - "$tmp/box.h5" "$src/tools" <<'PY'
+set -- $(/usr/bin/python3 - "$tmp/box.h5" "$src/python" <<'PY'
 import sys
 sys.path.insert(0, sys.argv[2])
-import cohfrac_h5
+from cohfrac import h5 as cohfrac_h5
 r = cohfrac_h5.load(sys.argv[1])
 n = sum(1 for i in range(r.n_fragments) if len(r.fragment(i).triangles))
 big = max(r.alive(-1), key=lambda i: r.fragments["mass"][i])
@@ -51,7 +51,7 @@ PY
 n=$1 alive=$2 big=$3 t_end=$4 hx=$5 hy=$6 hz=$7 h5_volume=$8
 if [ "$tool" = blender ]; then
     "$exe" export "$tmp/box.h5" --format gltf -o "$tmp/box.glb" > /dev/null
-    HOME=$tmp blender -b --factory-startup --python "$src/tools/blender_check.py" -- \
+    HOME=$tmp blender -b --factory-startup --python "$src/tests/checks/blender_check.py" -- \
         "$tmp/box.glb" "$big" "$t_end" > "$tmp/out.txt" 2>&1 || { cat "$tmp/out.txt"; exit 1; }
     got=$(awk '$1 == "objects" {print $2}' "$tmp/out.txt")
     pos=$(awk '$1 == "position" {print $2, $3, $4}' "$tmp/out.txt")
@@ -60,7 +60,7 @@ if [ "$tool" = blender ]; then
     /usr/bin/python3 -c "import sys; a = [float(v) for v in sys.argv[1].split()]; b = [float(v) for v in sys.argv[2:]]; sys.exit(max(abs(p - q) for p, q in zip(a, b)) > 1e-3)" "$pos" "$hx" "$hy" "$hz"
 else
     "$exe" export "$tmp/box.h5" --format pvd -o "$tmp/pvd" > /dev/null
-    HOME=$tmp xvfb-run -a pvpython "$src/tools/paraview_check.py" "$tmp/pvd/box_break.pvd" \
+    HOME=$tmp xvfb-run -a pvpython "$src/tests/checks/paraview_check.py" "$tmp/pvd/box_break.pvd" \
         "$tmp/box.xdmf" > "$tmp/out.txt" 2>&1 || { cat "$tmp/out.txt"; exit 1; }
     pieces=$(awk '$1 == "pieces" {print $2}' "$tmp/out.txt")
     echo "ParaView: $(awk '$1 == "times" {print $2}' "$tmp/out.txt") time steps; at the last, $pieces connected surface pieces; the HDF5 file has $alive fragments alive"

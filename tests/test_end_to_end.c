@@ -4,7 +4,7 @@
  * 5 % of the mass each, and every hand-off conserves linear momentum to
  * 1e-9.  (The source's own bunny drop, with its cohesive law that never
  * lets go, no longer breaks once the hand-off keeps what still holds.)  The HDF5 file it
- * writes is checked further by tools/check_run.py (free fall, datasets). */
+ * writes is checked further by tests/checks/check_run.py (free fall, datasets). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

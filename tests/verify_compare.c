@@ -60,7 +60,7 @@ static void run_compare(const char *scene, char *dir, cf_compare_result *res)
                               .out_dir = dir,
                               .mesh_dir = COHFRAC_MESH_DIR,
                               .plot = 1,
-                              .plot_script = COHFRAC_SOURCE_DIR "/tools/compare_plot.py",
+                              .plot_script = COHFRAC_SOURCE_DIR "/python/cohfrac/compare_plot.py",
                               .headline = stdout};
     cf_error err = {0};
     if (cf_compare_run(&opt, res, &err) != CF_OK)

@@ -8,7 +8,7 @@ text says each one shows (docs/scenes.md, "The chapter's figures").
 Runs every scene of FIGURES at its defaults (`cohfrac run SCENE -t 1`),
 then for each: fragments, the largest and next pieces' shares of the mass,
 pieces of at least 5 % and 1 %, the mass in chips (fragments of at most 4
-tets), the fastest piece against tools/check_physics.py's bound, and
+tets), the fastest piece against tests/checks/check_physics.py's bound, and
 whether the outcome the text describes holds.  Writes DIR/figures.md (a
 table; with --md the same table replaces the section between the markers
 in that file), DIR/figures.json, and a sheet of pictures before the break
@@ -25,7 +25,9 @@ import os
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The test checkers and the reader, from the source tree.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "checks"))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 import numpy as np  # noqa: E402
 
 import check_physics  # noqa: E402
@@ -118,7 +120,7 @@ def table(results):
 def sheet(results, path):
     """Before the break and at the end, one row per figure (the pieces of
     at least 5 % in colour, tools/plot_pieces.py)."""
-    import cohfrac_h5
+    from cohfrac import h5 as cohfrac_h5
     import plot_pieces
     plt = plot_pieces.plt
     fig = plt.figure(figsize=(9, 4.2 * len(results)))

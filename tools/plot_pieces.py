@@ -7,7 +7,7 @@ usage: plot_pieces.py OUT.h5 [-t T ...] [--share S] [-o PNG]
   -t, --time T   simulated time of a view, s (repeatable; default the last frame)
   --share S      smallest share of the mass drawn in colour (default 0.05)
   -o, --output   the PNG to write (default OUT_pieces.png beside OUT.h5)
-Reads the file with tools/cohfrac_h5.py; matplotlib draws it.
+Reads the file with python/cohfrac/h5.py; matplotlib draws it.
 """
 import argparse
 import os
@@ -20,8 +20,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import cohfrac_h5  # noqa: E402
+# The test checkers and the reader, from the source tree.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "checks"))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from cohfrac import h5 as cohfrac_h5  # noqa: E402
 
 COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e"]
 

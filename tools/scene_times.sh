@@ -8,7 +8,7 @@
 #   ~/.cache/cohfrac/meshes, as `make run` prepares them), scenes/
 #   SCENE_TIMEOUT: stop a run after S seconds of wall time (default 0: no
 #   limit); its row then gives how far it got, read from its HDF5 file
-#   (needs /usr/bin/python3 with h5py, as tools/check_run.py).
+#   (needs /usr/bin/python3 with h5py, as tests/checks/check_run.py).
 #
 # scenes/verification/ and scenes/compare/ are left out (ctest runs those),
 # except the source's mixed-mode beam, which lives in scenes/verification/.

@@ -365,7 +365,7 @@ int cf_world_crack(const cf_world *w, int e, cf_crack_row *out);
 double cf_world_crack_area(const cf_world *w);
 
 /* The initial state's bounds, for readers that check a run's outcome
- * (tools/check_physics.py): the box around the nodes (m), total mass (kg),
+ * (tests/checks/check_physics.py): the box around the nodes (m), total mass (kg),
  * kinetic + strain energy (J), fastest node (m/s), fastest kinematic
  * obstacle or prescribed velocity (m/s), and the release speed (m/s): the
  * particle velocity a stress wave of the strongest facet's strength carries,

@@ -12,7 +12,7 @@
 -- not believable: the explicit Tet4 kick is unstable on the smallest tets,
 -- the projection removes the energy it invents (ledger residual 68 % of
 -- the input) and single tets leave at 68 m/s against the bound 55 m/s of
--- tools/check_physics.py.  At 1e-5 s: residual 0.02 %, fastest 49 m/s
+-- tests/checks/check_physics.py.  At 1e-5 s: residual 0.02 %, fastest 49 m/s
 -- (docs/physics.md §14.8).
 return {
   name = "mixed_mode_beam",

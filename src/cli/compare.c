@@ -303,7 +303,7 @@ static cf_status write_md(const char *dir, const char *headline, const state *st
                 cf_cmp_quat_angle(f->quat, sb->f[j].quat));
     }
     fprintf(o.f, "\nFiles: `compare.csv` (time series), `fragments.csv` (every fragment at "
-                 "the end), `compare.png` (plots by tools/compare_plot.py, when "
+                 "the end), `compare.png` (plots by python/cohfrac/compare_plot.py, when "
                  "python3-matplotlib is installed).\n");
     free(order);
     return cf_out_close(&o, err);

@@ -45,7 +45,7 @@
  *   compare.md      the report (Markdown)
  *   compare.csv     time series: one row per sample
  *   fragments.csv   the Bullet run's fragments at the end with their partners
- *   compare.png     2x2 plots by tools/compare_plot.py (Debian python3 and
+ *   compare.png     2x2 plots by python/cohfrac/compare_plot.py (Debian python3 and
  *                   python3-matplotlib); a failure there is a warning only */
 #ifndef COHFRAC_COMPARE_H
 #define COHFRAC_COMPARE_H
@@ -74,7 +74,7 @@ typedef struct cf_compare_options {
     int threads;                     /* OpenMP threads, 0: the scene's setting */
     int progress;                    /* 1: progress lines on stderr */
     int plot;                        /* 1: make compare.png */
-    const char *plot_script;         /* NULL: tools/compare_plot.py from the
+    const char *plot_script;         /* NULL: python/cohfrac/compare_plot.py from the
                                         working directory, else next to the
                                         executable (../tools/) */
     FILE *headline;                  /* the report's headline goes here (NULL: nowhere) */

@@ -652,7 +652,7 @@ static int cmd_bench(int argc, char **argv)
     return cf_bench_run(&o, &r, &err) == CF_OK ? 0 : fail(&err);
 }
 
-/* tools/render.py on an output file (matplotlib frames, ffmpeg movie). */
+/* python/cohfrac/render.py on an output file (matplotlib frames, ffmpeg movie). */
 static int cmd_render(int argc, char **argv)
 {
     static const struct option lo[] = {{"output", required_argument, 0, 'o'},
@@ -772,9 +772,9 @@ static int cmd_export(int argc, char **argv)
         snprintf(def, sizeof def, "%.*s%s", len, in, pvd ? "_pvd" : ".glb");
         out = def;
     }
-    if (pvd) { /* tools/cohfrac_h5.py writes it (meshio) */
+    if (pvd) { /* python/cohfrac/h5.py writes it (meshio) */
         const char *args[] = {in, "--pvd", out, NULL};
-        return cf_report_plot("cohfrac_h5.py", NULL, args, "no ParaView series")
+        return cf_report_plot("h5.py", NULL, args, "no ParaView series")
                    ? 0
                    : cf_status_exit_code(CF_ERR_EXTERNAL);
     }

@@ -40,19 +40,20 @@ cf_status cf_out_close(cf_outfile *o, cf_error *err)
     return CF_OK;
 }
 
-/* The Python helpers the program runs, where the build put them: the
- * source tree's tools/ (build tree), and the install's
- * share/cohfrac/python relative to the executable's bin/. */
+/* The Python helpers the program runs, modules of the Python package
+ * cohfrac, where the build put them: the source tree's python/cohfrac
+ * (build tree), and the install's site directory relative to the
+ * executable's bin/ (CMakeLists.txt sets both). */
 #ifndef COHFRAC_TOOLS_DIR
-#define COHFRAC_TOOLS_DIR "tools"
+#define COHFRAC_TOOLS_DIR "python/cohfrac"
 #endif
 #ifndef COHFRAC_INSTALLED_PYTHON
-#define COHFRAC_INSTALLED_PYTHON "../share/cohfrac/python"
+#define COHFRAC_INSTALLED_PYTHON "../lib/python3/dist-packages/cohfrac"
 #endif
 
-/* The script: the given path; else next to the executable as installed
- * (bin/../share/cohfrac/python); else the source tree's tools/ the program
- * was built from; so it is found from any working directory. */
+/* The script: the given path; else in the installed package beside the
+ * executable; else the source tree's python/cohfrac the program was
+ * built from; so it is found from any working directory. */
 static int find_script(const char *script, const char *given, char *out, size_t n)
 {
     if (given) {

@@ -1,6 +1,6 @@
 /* Report files for the studies (`compare`, `stability`; their directories
- * come from cf_mkdirs in file_text.h): whole-or-nothing text files, and the matplotlib plots made by the scripts
- * in tools/ with Debian's python3. */
+ * come from cf_mkdirs in file_text.h): whole-or-nothing text files, and the matplotlib plots made by the
+ * helpers of the Python package (python/cohfrac) with Debian's python3. */
 #ifndef COHFRAC_REPORT_H
 #define COHFRAC_REPORT_H
 
@@ -20,8 +20,9 @@ typedef struct cf_outfile {
 cf_status cf_out_open(cf_outfile *o, const char *dir, const char *name, cf_error *err);
 cf_status cf_out_close(cf_outfile *o, cf_error *err);
 
-/* Run tools/<script> (or `script_path` when not NULL; else ./tools/, then
- * ../tools/ next to the executable) with /usr/bin/python3 and the NULL-ended
+/* Run the package's <script> (or `script_path` when not NULL; else the
+ * installed package found from the executable's bin/, then the source
+ * tree's python/cohfrac) with /usr/bin/python3 and the NULL-ended
  * `args`.  Returns 1 when it exited with 0; otherwise warns on stderr (exit
  * status 3 from the script means matplotlib is missing) that only `others`
  * were written, and returns 0. */

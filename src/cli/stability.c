@@ -417,7 +417,7 @@ static cf_status write_md(const cf_stability_result *r, int quick, const char *c
                 mass, c->dt_ratio, c->dt, res, c->energy_ratio);
     }
     fprintf(f, "\nFiles: `stability.csv` (every case), `stability.png` (heatmaps by "
-               "tools/stability_plot.py).\n");
+               "python/cohfrac/stability_plot.py).\n");
     return cf_out_close(&o, err);
 }
 

@@ -45,7 +45,7 @@
  *   stability.md   date, machine and command; the criteria and one table
  *                  per slice
  *   stability.csv  one row per case
- *   stability.png  heatmaps by tools/stability_plot.py (Debian python3 and
+ *   stability.png  heatmaps by python/cohfrac/stability_plot.py (Debian python3 and
  *                  python3-matplotlib); a failure there is a warning only */
 #ifndef COHFRAC_STABILITY_H
 #define COHFRAC_STABILITY_H
@@ -88,7 +88,7 @@ typedef struct cf_stability_case {
 typedef struct cf_stability_options {
     int quick;
     const char *out_dir;    /* NULL: build/stability */
-    const char *plot_script;/* NULL: tools/stability_plot.py (see report.h) */
+    const char *plot_script;/* NULL: python/cohfrac/stability_plot.py (see report.h) */
     int progress;           /* 1: a line per case on stderr */
     int plot;               /* 1: make stability.png */
     const char *command;    /* the command line, quoted in stability.md (may be NULL) */

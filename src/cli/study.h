@@ -64,7 +64,7 @@
  *               Pareto front and the verdict
  *   study.csv   one row per case, the columns above
  *   study.png   traj_rel against wall time, log-log, Pareto front marked,
- *               by tools/study_plot.py (Debian python3 + matplotlib); a
+ *               by python/cohfrac/study_plot.py (Debian python3 + matplotlib); a
  *               failure there is a warning only
  *   runs/<hash>.{lua,h5,xdmf,log,meta}: each case's resolved scene, output,
  *               summary and process figures */
@@ -92,7 +92,7 @@ typedef struct cf_study_options {
     double tolerance;                  /* traj_rel bound of the verdict (0: 0.05) */
     int progress;                      /* 1: a line per finished case on stderr */
     int plot;                          /* 1: make study.png */
-    const char *plot_script;           /* NULL: tools/study_plot.py (see report.h) */
+    const char *plot_script;           /* NULL: python/cohfrac/study_plot.py (see report.h) */
 } cf_study_options;
 
 typedef struct cf_study_case {

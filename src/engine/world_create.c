@@ -307,7 +307,7 @@ static cf_status add_obstacles(cf_world *w, const cf_world_def *def, cf_error *e
     return cf_obstacles_create(&w->obs, def, w->bullet, w->obstacle_body, err);
 }
 
-/* What a reader needs to bound a run's outcome (tools/check_physics.py):
+/* What a reader needs to bound a run's outcome (tests/checks/check_physics.py):
  * the box around the nodes, mass, energy and fastest node at t = 0, and the
  * fastest kinematic obstacle or prescribed node; taken at create. */
 static void initial_bounds(cf_world *w)

@@ -221,7 +221,7 @@ static cf_status drain_events(cf_sim *sim, cf_error *err)
     return st;
 }
 
-/* The obstacles, for readers that draw them (tools/render.py):
+/* The obstacles, for readers that draw them (python/cohfrac/render.py):
  * /parameters/obstacle_{type (0 plane, 1 sphere, 2 box, 3 mesh), point,
  * normal, center (at t = 0), radius, half_extents, velocity}. */
 static cf_status write_obstacles(cf_sim *sim, cf_error *err)
@@ -255,7 +255,7 @@ static cf_status write_obstacles(cf_sim *sim, cf_error *err)
     return st;
 }
 
-/* What a reader needs to bound the run's outcome (tools/check_physics.py). */
+/* What a reader needs to bound the run's outcome (tests/checks/check_physics.py). */
 static cf_status write_initial_bounds(cf_sim *sim, cf_error *err)
 {
     cf_initial_bounds b;

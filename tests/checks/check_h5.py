@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Print a summary of a cohfrac output file and check its invariants.
 
-Usage: tools/check_h5.py RUN.h5 [--quiet]
+Usage: tests/checks/check_h5.py RUN.h5 [--quiet]
 
 Reads the layout documented in src/io/include/cohfrac/h5_output.h with h5py (Debian
 package python3-h5py; hence /usr/bin/python3).  Exits 0 when the file is

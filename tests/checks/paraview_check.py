@@ -4,7 +4,7 @@ pieces there (Connectivity filter; each fragment's surface is one piece);
 then find the first time that holds deformed tets of fracture mode and
 measure them (CellSize filter) and their fields.
 
-    pvpython tools/paraview_check.py DIR/<name>.pvd [OUT.xdmf]
+    pvpython tests/checks/paraview_check.py DIR/<name>.pvd [OUT.xdmf]
 
 Prints "times N", "last T", "pieces P" and, when the series has
 fracture-mode tets, "fracture T0 TETS VOLUME DAMAGE_MAX VON_MISES_MAX"

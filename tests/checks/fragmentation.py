@@ -22,7 +22,7 @@ the CI size stops at 1/3),
   conv_tau    tau within 0.15 between them;
   one_tet     mass in one-tet fragments below 1 % and falling with refinement;
   residual    ledger residual at most 1 % in every run, and every run within
-              the physical bounds of tools/check_physics.py.
+              the physical bounds of tests/checks/check_physics.py.
 
 tau is the maximum-likelihood exponent of a power law above m_min = 10
 element masses (Clauset, Shalizi and Newman, SIAM Review 51:661, 2009):
@@ -55,7 +55,7 @@ sys.path.insert(0, HERE)
 import check_physics  # noqa: E402
 import fragment_stats  # noqa: E402
 
-SCENE = os.path.join(HERE, "..", "scenes", "plaster_sphere_drop.lua")
+SCENE = os.path.join(HERE, "..", "..", "scenes", "plaster_sphere_drop.lua")
 L_CH = 0.0125  # m, E G_I / sigma_max^2 of the scene's plaster
 SIZES = {
     # ladder element size, speeds (m/s), convergence element sizes
@@ -190,7 +190,7 @@ def main():
     bad = [r["tag"] for r in every if not r["plausible"]]
     checks.append(("residual", worst["residual"] <= 0.01 and not bad,
                    f"{len(every)} runs, largest residual {100 * worst['residual']:.3g} % "
-                   f"({worst['tag']}); outside tools/check_physics.py: {', '.join(bad) or 'none'}"))
+                   f"({worst['tag']}); outside tests/checks/check_physics.py: {', '.join(bad) or 'none'}"))
 
     write_report(out, a.size, ladder, threshold, twice, conv, checks)
     known = read_known(a.known, a.size)

@@ -1,8 +1,8 @@
 """Inside Blender (headless): render a cohfrac glTF export, frame by frame,
 with depth, lighting and shadows (Workbench), from a camera that follows
-the pieces.  Run by tools/render.py:
+the pieces.  Run by python/cohfrac/render.py:
 
-    xvfb-run -a blender -b -P tools/render_blender.py -- \
+    xvfb-run -a blender -b -P python/cohfrac/render_blender.py -- \
         RUN.glb OUT_DIR FPS W H T0 N SLOW FLOOR_Z
 
 Writes OUT_DIR/frame_0000.png ...: movie frame k shows the run at

@@ -2,7 +2,7 @@
 # The one-way rule between modules (docs/architecture.md), checked on every
 # build: exit 1, naming the file and line, when a source includes a header
 # of a module above its own, or when an engine source does file I/O.
-#   tools/check_layering.sh SRC_DIR
+#   tests/check_layering.sh SRC_DIR
 src=${1:-src}
 status=0
 

@@ -2,8 +2,8 @@
 # Every shipped scene against physical bounds: each scene under scenes/ runs
 # at coarse settings (its own mesh, and the duration a line
 # "-- plausibility: --set ..." in its header asks for, e.g. the first part of
-# a long run), then tools/check_physics.py checks the output.  Checks listed
-# in tools/plausibility_known.txt may fail for their scene (and must: a
+# a long run), then tests/checks/check_physics.py checks the output.  Checks listed
+# in tests/plausibility_known.txt may fail for their scene (and must: a
 # listed failure that passes is reported, to be removed from the list).
 #
 # usage: plausibility.sh COHFRAC_EXE MESH_DIR [SCENES_DIR]
@@ -33,7 +33,7 @@ while IFS= read -r scene; do
         fails=$((fails + 1))
         continue
     fi
-    /usr/bin/python3 "$here/check_physics.py" "$tmp/out.h5" >"$tmp/check" 2>&1
+    /usr/bin/python3 "$here/checks/check_physics.py" "$tmp/out.h5" >"$tmp/check" 2>&1
     failed=$(sed -n 's/^  FAIL  \([a-z]*\).*/\1/p' "$tmp/check" | sort | tr '\n' ' ')
     expected=$(awk -v s="$rel" '$1 == s {print $2}' "$known" | sort | tr '\n' ' ')
     if [ "$failed" = "$expected" ]; then

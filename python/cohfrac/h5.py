@@ -1,9 +1,8 @@
 #!/usr/bin/python3
 """Read a cohfrac output file (docs/output.md) with h5py and numpy only.
 
-    import sys; sys.path.insert(0, "tools")
-    import cohfrac_h5
-    run = cohfrac_h5.load("out/bunny_drop.h5")
+    from cohfrac import h5         # installed; from a source tree, python/ on sys.path
+    run = h5.load("out/bunny_drop.h5")
     run.times                      # [T] s, one per frame
     run.fragments                  # records: parent, birth_time, mass, n_tets, com_rest, ...
     frag = run.fragment(0)         # one fragment: surface triangles, crack flags, rest nodes

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Render a cohfrac run: PNG frames and an MP4 of every fragment's surface.
 
-    tools/render.py OUT.h5 [-o DIR] [--fps N] [--size WxH] [--from T0] [--to T1]
+    python/cohfrac/render.py OUT.h5 [-o DIR] [--fps N] [--size WxH] [--from T0] [--to T1]
                     [--slow-motion F] [--glb RUN.glb] [--engine auto|blender|matplotlib]
 
 Writes DIR/frame_0000.png ... and DIR/<name>.mp4 (ffmpeg, H.264); without
@@ -14,11 +14,11 @@ output frame, and never faster than the run).
 Engines: `blender` renders the glTF export (--glb, which `cohfrac render`
 writes) in Blender headless (Workbench: depth, studio lighting, shadows;
 under xvfb-run) with a camera that follows the pieces
-(tools/render_blender.py); `matplotlib` draws the posed surfaces from a
+(python/cohfrac/render_blender.py); `matplotlib` draws the posed surfaces from a
 fixed camera that sees the whole run (no depth buffer).  `auto` (default)
 takes Blender when --glb is given and blender and xvfb-run are installed.
 Fragments are coloured by id, crack faces in their own colour, debris
-small.  Reads the file with tools/cohfrac_h5.py.
+small.  Reads the file with python/cohfrac/h5.py.
 
 Exit status: 0 done, 2 the file has no geometry (an older file), 3
 matplotlib is missing, 5 ffmpeg or Blender failed or is missing (the PNGs
@@ -30,7 +30,10 @@ import shutil
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The package's parent on the path, so that the reader imports as
+# cohfrac.h5 when this file is run as a script (the way `cohfrac render`
+# runs it) as well as with `python3 -m cohfrac.render`.
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 try:
     import matplotlib
@@ -42,7 +45,7 @@ except ImportError:
     sys.exit(3)
 import numpy as np
 
-import cohfrac_h5
+from cohfrac import h5 as cohfrac_h5  # noqa: E402
 
 LIGHT = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
 

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Check the geometry in a cohfrac output file (docs/output.md).
 
-    tools/check_geometry.py OUT.h5
+    tests/checks/check_geometry.py OUT.h5
 
 For every fragment alive at the end:
   - its surface (/surfaces rows of its record) is closed and consistently
@@ -25,11 +25,12 @@ import collections
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The reader, from the source tree's Python package.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
 import h5py
 import numpy as np
 
-import cohfrac_h5
+from cohfrac import h5 as cohfrac_h5  # noqa: E402
 
 COUNTS = {"fragment_count", "cohesive_elements", "fragments_in_fracture_mode",
           "handoff_momentum_error_max"}

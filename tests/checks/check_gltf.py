@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Check a glTF export (cohfrac export) against the run it came from.
 
-    tools/check_gltf.py OUT.h5 OUT.glb
+    tests/checks/check_gltf.py OUT.h5 OUT.glb
 
 Reads the .glb's JSON and binary chunks (glTF 2.0 container: a 12-byte
 header, then length-type-data chunks) with the standard library and numpy,
@@ -21,11 +21,12 @@ import os
 import struct
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The reader, from the source tree's Python package.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
 import h5py
 import numpy as np
 
-import cohfrac_h5
+from cohfrac import h5 as cohfrac_h5  # noqa: E402
 
 COMPONENTS = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}
 DTYPES = {5126: np.float32, 5125: np.uint32}

@@ -1,7 +1,7 @@
 """Inside Blender (headless): import a cohfrac glTF export and print what
 Blender sees, for tests/output_gltf_blender.sh to compare with the HDF5.
 
-    blender -b --python tools/blender_check.py -- OUT.glb FRAGMENT T_END
+    blender -b --python tests/checks/blender_check.py -- OUT.glb FRAGMENT T_END
 
 Prints "objects N" (mesh objects imported) and "position x y z" (fragment
 FRAGMENT's world position at time T_END s, after Blender's +y-up to +z-up
