@@ -77,7 +77,7 @@ static const char *impact_scene =
     "}\n";
 
 /* The scene text loaded in memory (no file), and its run. */
-static cf_sim *make_sim(const char *text, cf_world_def *sc)
+static cf_sim *make_sim(const char *text, cf_scene *sc)
 {
     cf_error err = {0};
     cf_status st = cf_scene_load_text("scene.lua", text, NULL, 0, COHFRAC_MESH_DIR, sc, &err);
@@ -106,7 +106,7 @@ static void run_to_end(cf_sim *sim)
         advance(sim);
 }
 
-static cf_sim *impact_sim(double duration, int threads, cf_world_def *sc)
+static cf_sim *impact_sim(double duration, int threads, cf_scene *sc)
 {
     char text[2048];
     snprintf(text, sizeof text, impact_scene, duration, dir, threads);
@@ -141,7 +141,7 @@ static int any_in_fracture_mode(cf_sim *sim)
 static void test_momentum_across_fracture_mode_contact(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = impact_sim(0.12, 0, &sc);
     cf_ledger l0, l;
     cf_world_ledger(cf_sim_world(sim), &l0);
@@ -175,7 +175,7 @@ static void test_determinism_hash(void **state)
     (void)state;
     uint64_t h[2];
     for (int r = 0; r < 2; r++) {
-        cf_world_def sc;
+        cf_scene sc;
         cf_sim *sim = impact_sim(0.06, r + 1, &sc);
         run_to_end(sim);
         h[r] = cf_world_state_hash(cf_sim_world(sim));
@@ -210,7 +210,7 @@ static void count_tick(void *user, double t)
 static void test_heartbeat_inside_a_step(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = impact_sim(0.06, 1, &sc);
     cf_world *w = (cf_world *)cf_sim_world(sim);
     heartbeat h;
@@ -243,7 +243,7 @@ static void test_heartbeat_inside_a_step(void **state)
 static void test_reading_poses_changes_nothing(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = impact_sim(0.06, 1, &sc);
     int read_in_fracture = 0;
     while (!cf_sim_done(sim)) {
@@ -284,7 +284,7 @@ static void run_coloured(double sigma_max, const char *criterion, uint64_t h[2],
     for (int r = 0; r < 2; r++) {
         char text[2048];
         snprintf(text, sizeof text, coloured_scene, sigma_max, criterion, r + 1);
-        cf_world_def sc;
+        cf_scene sc;
         cf_sim *sim = make_sim(text, &sc);
         assert_true(cf_sim_world(sim)->frag[0].bars.n >= CF_BARS_PARALLEL_MIN); /* the coloured sweep runs */
         run_to_end(sim);
@@ -339,7 +339,7 @@ static const char *bonded_scene =
 static void test_handoff_keeps_bonded_pieces_together(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(bonded_scene, &sc);
     run_to_end(sim);
     const cf_world *w = cf_sim_world(sim);
@@ -391,7 +391,7 @@ static const char *reentry_scene =
 
 /* The re-entry scene without debris (so its pieces can break again), or
  * with every piece of at most 64 tets debris (the box has 135). */
-static cf_sim *reentry_sim(int debris, cf_world_def *sc)
+static cf_sim *reentry_sim(int debris, cf_scene *sc)
 {
     char text[2048];
     snprintf(text, sizeof text, reentry_scene,
@@ -405,7 +405,7 @@ static cf_sim *reentry_sim(int debris, cf_world_def *sc)
 static void test_reentry_keeps_the_family_tree(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = reentry_sim(0, &sc);
     enum { CAP = 4096 };
     static int parent[CAP];
@@ -459,7 +459,7 @@ static void test_reentry_keeps_the_family_tree(void **state)
 static void test_debris_stays_rigid_and_conserves(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = reentry_sim(1, &sc);
     const cf_world *w = cf_sim_world(sim);
     double mass0 = w->frag[0].mass;
@@ -535,7 +535,7 @@ static void crush_run(double sc_strength, double eps, int *crushed, double *fast
 {
     char text[2048];
     snprintf(text, sizeof text, crush_scene, sc_strength, eps);
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(text, &sc);
     const cf_world *w = cf_sim_world(sim);
     double mass0 = w->frag[0].mass;
@@ -605,7 +605,7 @@ static void run_ground(const char *obstacle, cf_fragment_state *out)
 {
     char text[2048];
     snprintf(text, sizeof text, ground_scene, obstacle);
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(text, &sc);
     run_to_end(sim);
     assert_int_equal(cf_world_fragments(cf_sim_world(sim), out, 1), 1);
@@ -654,7 +654,7 @@ static const char *overlap_scene =
 static void test_handoff_clears_obstacle_overlap(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(overlap_scene, &sc);
     double ke_max = 0;
     int entered = 0;
@@ -698,7 +698,7 @@ static const char *wedge_scene =
 static void test_wedged_piece_enters_clear(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(wedge_scene, &sc);
     double worst = 0, ke_max = 0;
     int entered = 0;
@@ -743,7 +743,7 @@ static const char *chatter_scene =
 static void test_no_return_while_driving_in(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(chatter_scene, &sc);
     int entries = 0, was = 0;
     while (!cf_sim_done(sim)) {
@@ -787,7 +787,7 @@ static const char *resting_scene =
 static void test_resting_body_stays_rigid(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(resting_scene, &sc);
     int entries = 0, was = 0, after_rest = 0, handoffs_at_rest = -1;
     double rest_time = -1;
@@ -838,7 +838,7 @@ static const char *cube_drop_scene =
 static void test_handback_in_flight_stays_rigid(void **state)
 {
     (void)state;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = make_sim(cube_drop_scene, &sc);
     int entries = 0, was = 0;
     double t_back = -1, v_back = 0, worst = 0;
@@ -876,7 +876,7 @@ static int expanding_bar(const char *strength, int threads, uint64_t *hash)
     snprintf(set_strength, sizeof set_strength, "material.strength=%s", strength);
     snprintf(set_threads, sizeof set_threads, "solver.threads=%d", threads);
     const char *sets[] = {set_strength, set_threads, "output.file=\"\""};
-    cf_world_def sc;
+    cf_scene sc;
     cf_error err = {0};
     if (cf_scene_load(path, sets, 3, COHFRAC_MESH_DIR, &sc, &err) != CF_OK)
         fail_msg("scene: %s", err.msg);

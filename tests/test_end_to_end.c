@@ -24,7 +24,7 @@ static void test_bunny_drop_breaks(void **state)
         "duration=0.535",
         "output.file=\"" COHFRAC_BINARY_DIR "/e2e/bunny_1k_drop.h5\"",
     };
-    cf_world_def sc;
+    cf_scene sc;
     cf_error err = {0};
     cf_status st = cf_scene_load(COHFRAC_SOURCE_DIR "/scenes/plaster_bunny_drop.lua", sets, 2,
                                  COHFRAC_MESH_DIR, &sc, &err);

@@ -23,7 +23,7 @@ static cf_memory run(const char **sets, int n)
 {
     const char *all[8] = {"duration=0.02", "output.frame_interval=0.01"};
     memcpy(&all[2], sets, (size_t)n * sizeof *sets);
-    cf_world_def sc;
+    cf_scene sc;
     cf_error err = {0};
     if (cf_scene_load(BOUNCE, all, n + 2, COHFRAC_MESH_DIR, &sc, &err) != CF_OK)
         fail_msg("scene: %s", err.msg);

@@ -105,14 +105,14 @@ static int teardown(void **state)
 }
 
 /* Write `text` as scene.lua and load it. */
-static cf_status load_text(const char *text, const char *const *ov, int n_ov, cf_world_def *s,
+static cf_status load_text(const char *text, const char *const *ov, int n_ov, cf_scene *s,
                            cf_error *e)
 {
     write_file("scene.lua", text);
     return cf_scene_load(at("scene.lua"), ov, n_ov, mesh_dir, s, e);
 }
 
-static void load_ok(const char *text, const char *const *ov, int n_ov, cf_world_def *s)
+static void load_ok(const char *text, const char *const *ov, int n_ov, cf_scene *s)
 {
     cf_error e = {0};
     cf_status st = load_text(text, ov, n_ov, s, &e);
@@ -120,9 +120,9 @@ static void load_ok(const char *text, const char *const *ov, int n_ov, cf_world_
         fail_msg("expected success, got %s: %s\nscene:\n%s", cf_status_name(st), e.msg, text);
 }
 
-static int is_empty(const cf_world_def *s)
+static int is_empty(const cf_scene *s)
 {
-    static const cf_world_def zero;
+    static const cf_scene zero;
     return memcmp(s, &zero, sizeof zero) == 0;
 }
 
@@ -131,7 +131,7 @@ static int is_empty(const cf_world_def *s)
 static void expect_error(const char *text, const char *const *ov, int n_ov, cf_status code,
                          const char *needle)
 {
-    cf_world_def s;
+    cf_scene s;
     cf_error e = {0};
     cf_status st = load_text(text, ov, n_ov, &s, &e);
     if (st != code || e.code != code || !strstr(e.msg, needle))
@@ -168,67 +168,67 @@ static void assert_mesh(const char *got, const char *rel)
 
 static void test_defaults_minimal(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     (void)state;
     load_ok("return { " MIN_BODY " }", NULL, 0, &s);
 
     assert_string_equal(s.name, "scene");
     assert_double_equal(s.duration, 1.0, 0);
-    assert_vec(s.gravity, (const double[]){0, 0, -9.81}, 3);
+    assert_vec(s.world.gravity, (const double[]){0, 0, -9.81}, 3);
 
-    assert_double_equal(s.material.E, 1e6, 0);
-    assert_double_equal(s.material.nu, 0.3, 0);
-    assert_double_equal(s.material.rho, 2400, 0);
-    assert_double_equal(s.material.G_I, 22, 0);
-    assert_double_equal(s.material.sigma_max, 1e4, 0);
-    assert_double_equal(s.material.alpha, 2, 0);
-    assert_double_equal(s.material.G_II, 22, 0);
-    assert_double_equal(s.material.tau_max, 1e4, 0);
-    assert_double_equal(s.material.beta, 2, 0);
-    assert_double_equal(s.material.friction, 0.5, 0);
-    assert_double_equal(s.material.restitution, 0.0, 0);
+    assert_double_equal(s.world.material.E, 1e6, 0);
+    assert_double_equal(s.world.material.nu, 0.3, 0);
+    assert_double_equal(s.world.material.rho, 2400, 0);
+    assert_double_equal(s.world.material.G_I, 22, 0);
+    assert_double_equal(s.world.material.sigma_max, 1e4, 0);
+    assert_double_equal(s.world.material.alpha, 2, 0);
+    assert_double_equal(s.world.material.G_II, 22, 0);
+    assert_double_equal(s.world.material.tau_max, 1e4, 0);
+    assert_double_equal(s.world.material.beta, 2, 0);
+    assert_double_equal(s.world.material.friction, 0.5, 0);
+    assert_double_equal(s.world.material.restitution, 0.0, 0);
 
-    assert_int_equal(s.n_bodies, 1);
-    assert_mesh(s.bodies[0].mesh, "cube");
-    assert_double_equal(s.bodies[0].scale, 1.0, 0);
-    assert_vec(s.bodies[0].position, (const double[]){0, 0, 0}, 3);
-    assert_vec(s.bodies[0].orientation, (const double[]){1, 0, 0, 0}, 4);
-    assert_vec(s.bodies[0].velocity, (const double[]){0, 0, 0}, 3);
-    assert_vec(s.bodies[0].angular_velocity, (const double[]){0, 0, 0}, 3);
-    assert_int_equal(s.bodies[0].primitive.type, CF_PRIM_NONE);
-    assert_vec(s.bodies[0].expansion_rate, (const double[]){0, 0, 0}, 3);
-    assert_int_equal(s.bodies[0].has_expansion_center, 0);
-    assert_int_equal(s.bodies[0].hollow_layers, 0);
-    assert_int_equal(s.n_boundaries, 0);
-    assert_null(s.boundaries);
-    assert_int_equal(s.n_obstacles, 0);
-    assert_null(s.obstacles);
+    assert_int_equal(s.world.n_bodies, 1);
+    assert_mesh(s.world.bodies[0].mesh, "cube");
+    assert_double_equal(s.world.bodies[0].scale, 1.0, 0);
+    assert_vec(s.world.bodies[0].position, (const double[]){0, 0, 0}, 3);
+    assert_vec(s.world.bodies[0].orientation, (const double[]){1, 0, 0, 0}, 4);
+    assert_vec(s.world.bodies[0].velocity, (const double[]){0, 0, 0}, 3);
+    assert_vec(s.world.bodies[0].angular_velocity, (const double[]){0, 0, 0}, 3);
+    assert_int_equal(s.world.bodies[0].primitive.type, CF_PRIM_NONE);
+    assert_vec(s.world.bodies[0].expansion_rate, (const double[]){0, 0, 0}, 3);
+    assert_int_equal(s.world.bodies[0].has_expansion_center, 0);
+    assert_int_equal(s.world.bodies[0].hollow_layers, 0);
+    assert_int_equal(s.world.n_boundaries, 0);
+    assert_null(s.world.boundaries);
+    assert_int_equal(s.world.n_obstacles, 0);
+    assert_null(s.world.obstacles);
 
-    assert_int_equal(s.solver.rigid_backend, CF_RIGID_BULLET);
-    assert_double_equal(s.solver.dt_rigid, 1e-3, 0);
-    assert_int_equal(s.solver.rigid_substeps, 5);
-    assert_int_equal(s.solver.ccd, 1);
-    assert_double_equal(s.solver.sleep_linear, 0.0, 0);
-    assert_double_equal(s.solver.sleep_angular, 0.0, 0);
-    assert_double_equal(s.solver.dt_fracture, 5e-6, 0);
-    assert_int_equal(s.solver.check_interval, 1);
-    assert_int_equal(s.solver.quiet_steps, 400);
-    assert_double_equal(s.solver.max_fracture_time, 0.05, 0);
-    assert_double_equal(s.solver.impact_threshold, 0.2, 0);
-    assert_int_equal(s.solver.elasticity, CF_ELASTICITY_COROTATIONAL);
-    assert_double_equal(s.solver.k_stiffness, 0.9, 0);
-    assert_int_equal(s.solver.iterations, 3);
-    assert_double_equal(s.solver.k_damping, 1.0, 0);
-    assert_int_equal(s.solver.threads, 0);
-    assert_int_equal(s.solver.mode, CF_RUN_HYBRID);
-    assert_int_equal(s.solver.criterion, CF_CRITERION_TRACTION);
-    assert_int_equal(s.solver.has_crack_plane, 0);
-    assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_PBD);
-    assert_int_equal(s.solver.iteration_independent, 0);
-    assert_double_equal(s.solver.compliance_scale, 1.0, 0);
-    assert_double_equal(s.solver.contact_stiffness, 0.0, 0);
-    assert_double_equal(s.solver.max_inverted_fraction, 0.01, 0);
-    assert_double_equal(s.solver.max_energy_growth, 0.5, 0);
+    assert_int_equal(s.world.solver.rigid_backend, CF_RIGID_BULLET);
+    assert_double_equal(s.world.solver.dt_rigid, 1e-3, 0);
+    assert_int_equal(s.world.solver.rigid_substeps, 5);
+    assert_int_equal(s.world.solver.ccd, 1);
+    assert_double_equal(s.world.solver.sleep_linear, 0.0, 0);
+    assert_double_equal(s.world.solver.sleep_angular, 0.0, 0);
+    assert_double_equal(s.world.solver.dt_fracture, 5e-6, 0);
+    assert_int_equal(s.world.solver.check_interval, 1);
+    assert_int_equal(s.world.solver.quiet_steps, 400);
+    assert_double_equal(s.world.solver.max_fracture_time, 0.05, 0);
+    assert_double_equal(s.world.solver.impact_threshold, 0.2, 0);
+    assert_int_equal(s.world.solver.elasticity, CF_ELASTICITY_COROTATIONAL);
+    assert_double_equal(s.world.solver.k_stiffness, 0.9, 0);
+    assert_int_equal(s.world.solver.iterations, 3);
+    assert_double_equal(s.world.solver.k_damping, 1.0, 0);
+    assert_int_equal(s.world.solver.threads, 0);
+    assert_int_equal(s.world.solver.mode, CF_RUN_HYBRID);
+    assert_int_equal(s.world.solver.criterion, CF_CRITERION_TRACTION);
+    assert_int_equal(s.world.solver.has_crack_plane, 0);
+    assert_int_equal(s.world.solver.constraints, CF_CONSTRAINTS_PBD);
+    assert_int_equal(s.world.solver.iteration_independent, 0);
+    assert_double_equal(s.world.solver.compliance_scale, 1.0, 0);
+    assert_double_equal(s.world.solver.contact_stiffness, 0.0, 0);
+    assert_double_equal(s.world.solver.max_inverted_fraction, 0.01, 0);
+    assert_double_equal(s.world.solver.max_energy_growth, 0.5, 0);
 
     assert_true(s.output.file[0] == '/' && strstr(s.output.file, "/out/scene.h5") != NULL); /* beside the scene */
     assert_double_equal(s.output.frame_interval, 0.01, 0);
@@ -266,65 +266,65 @@ static const char FULL_SCENE[] =
 
 static void test_full_scene(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     const double h = sqrt(0.5);
     (void)state;
     load_ok(FULL_SCENE, NULL, 0, &s);
 
     assert_string_equal(s.name, "drop");
     assert_double_equal(s.duration, 2.5, 0);
-    assert_vec(s.gravity, (const double[]){0, -9.8, 0}, 3);
-    assert_double_equal(s.material.E, 0.6, 0);
-    assert_double_equal(s.material.nu, 0.23, 0);
-    assert_double_equal(s.material.rho, 1000, 0);
-    assert_double_equal(s.material.G_I, 20, 0);
-    assert_double_equal(s.material.sigma_max, 1e-4, 0);
-    assert_double_equal(s.material.alpha, 3, 0);
-    assert_double_equal(s.material.G_II, 30, 0);
-    assert_double_equal(s.material.tau_max, 2e-4, 0);
-    assert_double_equal(s.material.beta, 4, 0);
-    assert_double_equal(s.material.friction, 0.7, 0);
-    assert_double_equal(s.material.restitution, 0.2, 0);
+    assert_vec(s.world.gravity, (const double[]){0, -9.8, 0}, 3);
+    assert_double_equal(s.world.material.E, 0.6, 0);
+    assert_double_equal(s.world.material.nu, 0.23, 0);
+    assert_double_equal(s.world.material.rho, 1000, 0);
+    assert_double_equal(s.world.material.G_I, 20, 0);
+    assert_double_equal(s.world.material.sigma_max, 1e-4, 0);
+    assert_double_equal(s.world.material.alpha, 3, 0);
+    assert_double_equal(s.world.material.G_II, 30, 0);
+    assert_double_equal(s.world.material.tau_max, 2e-4, 0);
+    assert_double_equal(s.world.material.beta, 4, 0);
+    assert_double_equal(s.world.material.friction, 0.7, 0);
+    assert_double_equal(s.world.material.restitution, 0.2, 0);
 
-    assert_int_equal(s.n_bodies, 3);
-    assert_mesh(s.bodies[0].mesh, "cube");
-    assert_double_equal(s.bodies[0].scale, 2, 0);
-    assert_vec(s.bodies[0].position, (const double[]){1, 2, 3}, 3);
-    assert_vec(s.bodies[0].orientation, (const double[]){0, 0, 0, 1}, 4);
-    assert_vec(s.bodies[0].velocity, (const double[]){0, 0, -1}, 3);
-    assert_vec(s.bodies[0].angular_velocity, (const double[]){0.5, 0, 0}, 3);
-    assert_mesh(s.bodies[1].mesh, "meshes/bunny");
-    assert_vec(s.bodies[1].orientation, (const double[]){0.5, 0.5, 0.5, 0.5}, 4);
-    assert_mesh(s.bodies[2].mesh, "sub/part");
+    assert_int_equal(s.world.n_bodies, 3);
+    assert_mesh(s.world.bodies[0].mesh, "cube");
+    assert_double_equal(s.world.bodies[0].scale, 2, 0);
+    assert_vec(s.world.bodies[0].position, (const double[]){1, 2, 3}, 3);
+    assert_vec(s.world.bodies[0].orientation, (const double[]){0, 0, 0, 1}, 4);
+    assert_vec(s.world.bodies[0].velocity, (const double[]){0, 0, -1}, 3);
+    assert_vec(s.world.bodies[0].angular_velocity, (const double[]){0.5, 0, 0}, 3);
+    assert_mesh(s.world.bodies[1].mesh, "meshes/bunny");
+    assert_vec(s.world.bodies[1].orientation, (const double[]){0.5, 0.5, 0.5, 0.5}, 4);
+    assert_mesh(s.world.bodies[2].mesh, "sub/part");
 
-    assert_int_equal(s.n_obstacles, 4);
-    assert_int_equal(s.obstacles[0].type, CF_OBSTACLE_PLANE);
-    assert_vec(s.obstacles[0].point, (const double[]){0, 0, -1}, 3);
-    assert_vec(s.obstacles[0].normal, (const double[]){0, 0, 1}, 3);
-    assert_int_equal(s.obstacles[1].type, CF_OBSTACLE_SPHERE);
-    assert_vec(s.obstacles[1].center, (const double[]){0, 0, 3}, 3);
-    assert_double_equal(s.obstacles[1].radius, 0.5, 0);
-    assert_vec(s.obstacles[1].velocity, (const double[]){0, 0, -10}, 3);
-    assert_int_equal(s.obstacles[2].type, CF_OBSTACLE_BOX);
-    assert_vec(s.obstacles[2].center, (const double[]){1, 1, 1}, 3);
-    assert_vec(s.obstacles[2].half_extents, (const double[]){1, 2, 3}, 3);
-    assert_vec(s.obstacles[2].velocity, (const double[]){0, 0, 0}, 3);
-    assert_vec(s.obstacles[3].point, (const double[]){0, 0, 0}, 3);
-    assert_vec(s.obstacles[3].normal, (const double[]){h, h, 0}, 3);
+    assert_int_equal(s.world.n_obstacles, 4);
+    assert_int_equal(s.world.obstacles[0].type, CF_OBSTACLE_PLANE);
+    assert_vec(s.world.obstacles[0].point, (const double[]){0, 0, -1}, 3);
+    assert_vec(s.world.obstacles[0].normal, (const double[]){0, 0, 1}, 3);
+    assert_int_equal(s.world.obstacles[1].type, CF_OBSTACLE_SPHERE);
+    assert_vec(s.world.obstacles[1].center, (const double[]){0, 0, 3}, 3);
+    assert_double_equal(s.world.obstacles[1].radius, 0.5, 0);
+    assert_vec(s.world.obstacles[1].velocity, (const double[]){0, 0, -10}, 3);
+    assert_int_equal(s.world.obstacles[2].type, CF_OBSTACLE_BOX);
+    assert_vec(s.world.obstacles[2].center, (const double[]){1, 1, 1}, 3);
+    assert_vec(s.world.obstacles[2].half_extents, (const double[]){1, 2, 3}, 3);
+    assert_vec(s.world.obstacles[2].velocity, (const double[]){0, 0, 0}, 3);
+    assert_vec(s.world.obstacles[3].point, (const double[]){0, 0, 0}, 3);
+    assert_vec(s.world.obstacles[3].normal, (const double[]){h, h, 0}, 3);
 
-    assert_int_equal(s.solver.rigid_backend, CF_RIGID_PBD);
-    assert_double_equal(s.solver.dt_rigid, 2e-3, 0);
-    assert_int_equal(s.solver.rigid_substeps, 10);
-    assert_double_equal(s.solver.dt_fracture, 3e-6, 0);
-    assert_int_equal(s.solver.check_interval, 10);
-    assert_int_equal(s.solver.quiet_steps, 100);
-    assert_double_equal(s.solver.max_fracture_time, 0.1, 0);
-    assert_double_equal(s.solver.impact_threshold, 0.5, 0);
-    assert_int_equal(s.solver.elasticity, CF_ELASTICITY_LINEAR);
-    assert_double_equal(s.solver.k_stiffness, 1, 0);
-    assert_int_equal(s.solver.iterations, 4);
-    assert_double_equal(s.solver.k_damping, 0, 0);
-    assert_int_equal(s.solver.threads, 2);
+    assert_int_equal(s.world.solver.rigid_backend, CF_RIGID_PBD);
+    assert_double_equal(s.world.solver.dt_rigid, 2e-3, 0);
+    assert_int_equal(s.world.solver.rigid_substeps, 10);
+    assert_double_equal(s.world.solver.dt_fracture, 3e-6, 0);
+    assert_int_equal(s.world.solver.check_interval, 10);
+    assert_int_equal(s.world.solver.quiet_steps, 100);
+    assert_double_equal(s.world.solver.max_fracture_time, 0.1, 0);
+    assert_double_equal(s.world.solver.impact_threshold, 0.5, 0);
+    assert_int_equal(s.world.solver.elasticity, CF_ELASTICITY_LINEAR);
+    assert_double_equal(s.world.solver.k_stiffness, 1, 0);
+    assert_int_equal(s.world.solver.iterations, 4);
+    assert_double_equal(s.world.solver.k_damping, 0, 0);
+    assert_int_equal(s.world.solver.threads, 2);
     /* A relative output path starts at the scene file's directory. */
     assert_true(s.output.file[0] == '/' && strstr(s.output.file, "/res/drop.h5") != NULL);
     assert_double_equal(s.output.frame_interval, 0.02, 0);
@@ -334,14 +334,14 @@ static void test_full_scene(void **state)
 /* G_II, tau_max, beta follow G_I, sigma_max, alpha; output.file follows name. */
 static void test_derived_defaults(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     (void)state;
     load_ok("return { name = 'beam', material = { G_I = 5, sigma_max = 7, alpha = 3 }, " MIN_BODY
             " }",
             NULL, 0, &s);
-    assert_double_equal(s.material.G_II, 5, 0);
-    assert_double_equal(s.material.tau_max, 7, 0);
-    assert_double_equal(s.material.beta, 3, 0);
+    assert_double_equal(s.world.material.G_II, 5, 0);
+    assert_double_equal(s.world.material.tau_max, 7, 0);
+    assert_double_equal(s.world.material.beta, 3, 0);
     assert_true(s.output.file[0] == '/' && strstr(s.output.file, "/out/beam.h5") != NULL); /* beside the scene */
     cf_scene_free(&s);
 }
@@ -354,30 +354,30 @@ static void test_mesh_paths(void **state)
     char text[1200];
     (void)state;
     for (int i = 0; spellings[i]; i++) {
-        cf_world_def s;
+        cf_scene s;
         const char *m = spellings[i];
         /* A bare "cube" would be a prepared mesh name: give it a directory. */
         snprintf(text, sizeof text, "return { bodies = { { mesh = '%s%s' } } }",
                  strchr(m, '/') || strchr(m, '.') ? "" : "./", m);
         load_ok(text, NULL, 0, &s);
-        assert_mesh(s.bodies[0].mesh, "cube");
+        assert_mesh(s.world.bodies[0].mesh, "cube");
         cf_scene_free(&s);
     }
     {
-        cf_world_def s;
+        cf_scene s;
         snprintf(text, sizeof text, "return { bodies = { { mesh = '%s/sub/part' } } }", tmp);
         load_ok(text, NULL, 0, &s);
-        assert_mesh(s.bodies[0].mesh, "sub/part");
+        assert_mesh(s.world.bodies[0].mesh, "sub/part");
         cf_scene_free(&s);
     }
 }
 
 static void test_prepared_mesh(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     (void)state;
     load_ok("return { bodies = { { mesh = 'bunny' } } }", NULL, 0, &s);
-    assert_mesh(s.bodies[0].mesh, "meshes/bunny");
+    assert_mesh(s.world.bodies[0].mesh, "meshes/bunny");
     cf_scene_free(&s);
 }
 
@@ -413,63 +413,63 @@ static const char NEW_KEYS_SCENE[] =
 
 static void test_new_keys(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     const cf_primitive *p;
     const cf_boundary *b;
     (void)state;
     load_ok(NEW_KEYS_SCENE, NULL, 0, &s);
 
-    assert_int_equal(s.n_bodies, 6);
-    p = &s.bodies[0].primitive;
-    assert_string_equal(s.bodies[0].mesh, "");
+    assert_int_equal(s.world.n_bodies, 6);
+    p = &s.world.bodies[0].primitive;
+    assert_string_equal(s.world.bodies[0].mesh, "");
     assert_int_equal(p->type, CF_PRIM_BOX);
     assert_vec(p->size, (const double[]){1, 2, 3}, 3);
     assert_int_equal(p->cells[0], 2);
     assert_int_equal(p->cells[1], 3);
     assert_int_equal(p->cells[2], 4);
     assert_int_equal(p->tets_per_cell, 5);
-    assert_vec(s.bodies[0].expansion_rate, (const double[]){0.5, 0.5, 0.5}, 3);
-    assert_int_equal(s.bodies[0].has_expansion_center, 1);
-    assert_vec(s.bodies[0].expansion_center, (const double[]){1, 0, 0}, 3);
+    assert_vec(s.world.bodies[0].expansion_rate, (const double[]){0.5, 0.5, 0.5}, 3);
+    assert_int_equal(s.world.bodies[0].has_expansion_center, 1);
+    assert_vec(s.world.bodies[0].expansion_center, (const double[]){1, 0, 0}, 3);
 
-    p = &s.bodies[1].primitive;
-    assert_string_equal(s.bodies[1].mesh, "");
+    p = &s.world.bodies[1].primitive;
+    assert_string_equal(s.world.bodies[1].mesh, "");
     assert_int_equal(p->type, CF_PRIM_SPHERE);
     assert_double_equal(p->radius, 0.5, 0);
     assert_double_equal(p->mesh_size, 0.1, 0);
-    assert_vec(s.bodies[1].expansion_rate, (const double[]){1, 2, 3}, 3);
-    assert_int_equal(s.bodies[1].has_expansion_center, 0);
+    assert_vec(s.world.bodies[1].expansion_rate, (const double[]){1, 2, 3}, 3);
+    assert_int_equal(s.world.bodies[1].has_expansion_center, 0);
 
-    p = &s.bodies[2].primitive;
+    p = &s.world.bodies[2].primitive;
     assert_int_equal(p->type, CF_PRIM_HOLLOW_SPHERE);
     assert_double_equal(p->radius, 0.5, 0);
     assert_double_equal(p->thickness, 0.1, 0);
     assert_double_equal(p->mesh_size, 0.05, 0);
 
-    p = &s.bodies[3].primitive;
+    p = &s.world.bodies[3].primitive;
     assert_int_equal(p->type, CF_PRIM_PLATE);
     assert_vec(p->size, (const double[]){1, 1, 0.01}, 3);
     assert_double_equal(p->mesh_size, 0.02, 0);
 
-    p = &s.bodies[4].primitive;
+    p = &s.world.bodies[4].primitive;
     assert_int_equal(p->type, CF_PRIM_NOTCHED_BEAM);
     assert_vec(p->size, (const double[]){2, 0.1, 0.2}, 3);
     assert_vec(p->notch, (const double[]){0.1, 0.02, 0.3}, 3);
     assert_double_equal(p->mesh_size, 0.01, 0);
 
     /* A Gmsh file keeps its extension and becomes absolute. */
-    assert_int_equal(s.bodies[5].primitive.type, CF_PRIM_NONE);
-    assert_mesh(s.bodies[5].mesh, "beam.msh");
+    assert_int_equal(s.world.bodies[5].primitive.type, CF_PRIM_NONE);
+    assert_mesh(s.world.bodies[5].mesh, "beam.msh");
 
-    assert_int_equal(s.n_boundaries, 3);
-    b = &s.boundaries[0];
+    assert_int_equal(s.world.n_boundaries, 3);
+    b = &s.world.boundaries[0];
     assert_int_equal(b->type, CF_REGION_BOX);
     assert_vec(b->min, (const double[]){-1, -1, -1}, 3);
     assert_vec(b->max, (const double[]){1, 1, -0.9}, 3);
     assert_vec(b->velocity, (const double[]){0, 0, 0}, 3);
     assert_int_equal(b->axes, 7);
     assert_int_equal(b->body, -1);
-    b = &s.boundaries[1];
+    b = &s.world.boundaries[1];
     assert_int_equal(b->type, CF_REGION_PLANE);
     assert_vec(b->point, (const double[]){0, 0, 1}, 3);
     assert_vec(b->normal, (const double[]){0, 0, 1}, 3);
@@ -477,26 +477,26 @@ static void test_new_keys(void **state)
     assert_vec(b->velocity, (const double[]){0, 0, -0.1}, 3);
     assert_int_equal(b->axes, 1 | 4);
     assert_int_equal(b->body, 1);
-    b = &s.boundaries[2];
+    b = &s.world.boundaries[2];
     assert_int_equal(b->type, CF_REGION_GROUP);
     assert_string_equal(b->group, "top");
     assert_vec(b->velocity, (const double[]){0, 1, 0}, 3);
     assert_int_equal(b->axes, 2);
     assert_int_equal(b->body, -1);
 
-    assert_int_equal(s.solver.mode, CF_RUN_FRACTURE);
-    assert_int_equal(s.solver.criterion, CF_CRITERION_NONE);
-    assert_int_equal(s.solver.has_crack_plane, 1);
-    assert_vec(s.solver.crack_plane_point, (const double[]){0, 0, 0.5}, 3);
-    assert_vec(s.solver.crack_plane_normal, (const double[]){0.6, 0, 0.8}, 3);
-    assert_double_equal(s.solver.crack_plane_tolerance, 1e-4, 0);
-    assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_XPBD);
-    assert_int_equal(s.solver.iteration_independent, 1);
-    assert_double_equal(s.solver.k_stiffness, 0.9, 0);
-    assert_double_equal(s.solver.compliance_scale, 2, 0);
-    assert_double_equal(s.solver.contact_stiffness, 1e9, 0);
-    assert_double_equal(s.solver.max_inverted_fraction, 0.1, 0);
-    assert_double_equal(s.solver.max_energy_growth, 2, 0);
+    assert_int_equal(s.world.solver.mode, CF_RUN_FRACTURE);
+    assert_int_equal(s.world.solver.criterion, CF_CRITERION_NONE);
+    assert_int_equal(s.world.solver.has_crack_plane, 1);
+    assert_vec(s.world.solver.crack_plane_point, (const double[]){0, 0, 0.5}, 3);
+    assert_vec(s.world.solver.crack_plane_normal, (const double[]){0.6, 0, 0.8}, 3);
+    assert_double_equal(s.world.solver.crack_plane_tolerance, 1e-4, 0);
+    assert_int_equal(s.world.solver.constraints, CF_CONSTRAINTS_XPBD);
+    assert_int_equal(s.world.solver.iteration_independent, 1);
+    assert_double_equal(s.world.solver.k_stiffness, 0.9, 0);
+    assert_double_equal(s.world.solver.compliance_scale, 2, 0);
+    assert_double_equal(s.world.solver.contact_stiffness, 1e9, 0);
+    assert_double_equal(s.world.solver.max_inverted_fraction, 0.1, 0);
+    assert_double_equal(s.world.solver.max_energy_growth, 2, 0);
     assert_string_equal(s.output.file, "");
     assert_non_null(strstr(s.resolved, "file = \"\","));
     cf_scene_free(&s);
@@ -507,7 +507,7 @@ static void test_new_keys(void **state)
  * tolerances, boundary axes and body, and the other constraint modes. */
 static void test_new_defaults(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     (void)state;
     load_ok("return { bodies = { { mesh = { type = 'box', size = {1, 1, 1} } } },\n"
             "  boundary = { { region = { type = 'plane', point = {0,0,0}, normal = {0,1,0} },\n"
@@ -515,23 +515,23 @@ static void test_new_defaults(void **state)
             "  solver = { mode = 'fracture', crack_plane = { point = {0,0,0}, normal = {0,0,1} },\n"
             "             constraints = 'none', criterion = 'source', xpbd = {}, guard = {} } }",
             NULL, 0, &s);
-    assert_int_equal(s.bodies[0].primitive.type, CF_PRIM_BOX);
-    assert_int_equal(s.bodies[0].primitive.cells[0], 1);
-    assert_int_equal(s.bodies[0].primitive.cells[1], 1);
-    assert_int_equal(s.bodies[0].primitive.cells[2], 1);
-    assert_int_equal(s.bodies[0].primitive.tets_per_cell, 6);
-    assert_int_equal(s.n_boundaries, 1);
-    assert_double_equal(s.boundaries[0].tolerance, 1e-6, 0);
-    assert_int_equal(s.boundaries[0].axes, 7);
-    assert_int_equal(s.boundaries[0].body, -1);
-    assert_vec(s.boundaries[0].velocity, (const double[]){1, 2, 3}, 3);
-    assert_int_equal(s.solver.has_crack_plane, 1);
-    assert_double_equal(s.solver.crack_plane_tolerance, 1e-6, 0);
-    assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_NONE);
-    assert_int_equal(s.solver.criterion, CF_CRITERION_SOURCE);
-    assert_double_equal(s.solver.compliance_scale, 1, 0);
-    assert_double_equal(s.solver.max_inverted_fraction, 0.01, 0);
-    assert_double_equal(s.solver.max_energy_growth, 0.5, 0);
+    assert_int_equal(s.world.bodies[0].primitive.type, CF_PRIM_BOX);
+    assert_int_equal(s.world.bodies[0].primitive.cells[0], 1);
+    assert_int_equal(s.world.bodies[0].primitive.cells[1], 1);
+    assert_int_equal(s.world.bodies[0].primitive.cells[2], 1);
+    assert_int_equal(s.world.bodies[0].primitive.tets_per_cell, 6);
+    assert_int_equal(s.world.n_boundaries, 1);
+    assert_double_equal(s.world.boundaries[0].tolerance, 1e-6, 0);
+    assert_int_equal(s.world.boundaries[0].axes, 7);
+    assert_int_equal(s.world.boundaries[0].body, -1);
+    assert_vec(s.world.boundaries[0].velocity, (const double[]){1, 2, 3}, 3);
+    assert_int_equal(s.world.solver.has_crack_plane, 1);
+    assert_double_equal(s.world.solver.crack_plane_tolerance, 1e-6, 0);
+    assert_int_equal(s.world.solver.constraints, CF_CONSTRAINTS_NONE);
+    assert_int_equal(s.world.solver.criterion, CF_CRITERION_SOURCE);
+    assert_double_equal(s.world.solver.compliance_scale, 1, 0);
+    assert_double_equal(s.world.solver.max_inverted_fraction, 0.01, 0);
+    assert_double_equal(s.world.solver.max_energy_growth, 0.5, 0);
     cf_scene_free(&s);
 
     /* The new keys also take overrides, primitives included. */
@@ -540,9 +540,9 @@ static void test_new_defaults(void **state)
                                          "bodies[1].expansion_rate={1, 0, 0}"};
         load_ok("return { bodies = { { mesh = { type = 'sphere', radius = 1, mesh_size = 0.1 } } } }",
                 ov, 3, &s);
-        assert_double_equal(s.bodies[0].primitive.radius, 0.25, 0);
-        assert_int_equal(s.solver.constraints, CF_CONSTRAINTS_XPBD);
-        assert_vec(s.bodies[0].expansion_rate, (const double[]){1, 0, 0}, 3);
+        assert_double_equal(s.world.bodies[0].primitive.radius, 0.25, 0);
+        assert_int_equal(s.world.solver.constraints, CF_CONSTRAINTS_XPBD);
+        assert_vec(s.world.bodies[0].expansion_rate, (const double[]){1, 0, 0}, 3);
         cf_scene_free(&s);
     }
 }
@@ -561,19 +561,19 @@ static void test_overrides(void **state)
         "name = 'a=b'",                  /* '=' inside the value */
         "material.E = 2 * 1e5",          /* any expression */
     };
-    cf_world_def s;
+    cf_scene s;
     (void)state;
     load_ok("return { solver = { dt_rigid = 1 }, " MIN_BODY " }", ov, 8, &s);
-    assert_double_equal(s.solver.dt_rigid, 2e-3, 0);
-    assert_int_equal(s.solver.rigid_backend, CF_RIGID_PBD);
-    assert_vec(s.gravity, (const double[]){0, 0, -1}, 3);
-    assert_double_equal(s.bodies[0].scale, 3, 0);
-    assert_int_equal(s.solver.iterations, 7);
-    assert_int_equal(s.n_bodies, 2);
-    assert_mesh(s.bodies[1].mesh, "sub/part");
+    assert_double_equal(s.world.solver.dt_rigid, 2e-3, 0);
+    assert_int_equal(s.world.solver.rigid_backend, CF_RIGID_PBD);
+    assert_vec(s.world.gravity, (const double[]){0, 0, -1}, 3);
+    assert_double_equal(s.world.bodies[0].scale, 3, 0);
+    assert_int_equal(s.world.solver.iterations, 7);
+    assert_int_equal(s.world.n_bodies, 2);
+    assert_mesh(s.world.bodies[1].mesh, "sub/part");
     assert_string_equal(s.name, "a=b");
     assert_true(s.output.file[0] == '/' && strstr(s.output.file, "/out/a=b.h5") != NULL); /* beside the scene */
-    assert_double_equal(s.material.E, 2e5, 0);
+    assert_double_equal(s.world.material.E, 2e5, 0);
     cf_scene_free(&s);
 
     /* Overrides apply in order; a later one wins.  They also reach a scene
@@ -605,15 +605,15 @@ static const char SHELL_KEYS_SCENE[] =
 
 /* ---------------------------------------------------------------- round trip */
 
-static void assert_same_scene(const cf_world_def *a, const cf_world_def *b)
+static void assert_same_scene(const cf_scene *a, const cf_scene *b)
 {
     assert_string_equal(a->name, b->name);
     assert_memory_equal(&a->duration, &b->duration, sizeof a->duration);
-    assert_memory_equal(a->gravity, b->gravity, sizeof a->gravity);
-    assert_memory_equal(&a->material, &b->material, sizeof a->material);
-    assert_int_equal(a->n_bodies, b->n_bodies);
-    for (int i = 0; i < a->n_bodies; i++) {
-        const cf_body_def *x = &a->bodies[i], *y = &b->bodies[i];
+    assert_memory_equal(a->world.gravity, b->world.gravity, sizeof a->world.gravity);
+    assert_memory_equal(&a->world.material, &b->world.material, sizeof a->world.material);
+    assert_int_equal(a->world.n_bodies, b->world.n_bodies);
+    for (int i = 0; i < a->world.n_bodies; i++) {
+        const cf_body_def *x = &a->world.bodies[i], *y = &b->world.bodies[i];
         assert_string_equal(x->mesh, y->mesh);
         assert_memory_equal(&x->scale, &y->scale, sizeof x->scale);
         assert_memory_equal(x->position, y->position, sizeof x->position);
@@ -634,9 +634,9 @@ static void assert_same_scene(const cf_world_def *a, const cf_world_def *b)
                             sizeof x->expansion_center);
         assert_int_equal(x->hollow_layers, y->hollow_layers);
     }
-    assert_int_equal(a->n_boundaries, b->n_boundaries);
-    for (int i = 0; i < a->n_boundaries; i++) {
-        const cf_boundary *x = &a->boundaries[i], *y = &b->boundaries[i];
+    assert_int_equal(a->world.n_boundaries, b->world.n_boundaries);
+    for (int i = 0; i < a->world.n_boundaries; i++) {
+        const cf_boundary *x = &a->world.boundaries[i], *y = &b->world.boundaries[i];
         assert_int_equal(x->type, y->type);
         assert_memory_equal(x->min, y->min, sizeof x->min);
         assert_memory_equal(x->max, y->max, sizeof x->max);
@@ -648,9 +648,9 @@ static void assert_same_scene(const cf_world_def *a, const cf_world_def *b)
         assert_int_equal(x->axes, y->axes);
         assert_memory_equal(x->velocity, y->velocity, sizeof x->velocity);
     }
-    assert_int_equal(a->n_obstacles, b->n_obstacles);
-    for (int i = 0; i < a->n_obstacles; i++) {
-        const cf_obstacle *x = &a->obstacles[i], *y = &b->obstacles[i];
+    assert_int_equal(a->world.n_obstacles, b->world.n_obstacles);
+    for (int i = 0; i < a->world.n_obstacles; i++) {
+        const cf_obstacle *x = &a->world.obstacles[i], *y = &b->world.obstacles[i];
         assert_int_equal(x->type, y->type);
         assert_memory_equal(x->point, y->point, sizeof x->point);
         assert_memory_equal(x->normal, y->normal, sizeof x->normal);
@@ -665,40 +665,41 @@ static void assert_same_scene(const cf_world_def *a, const cf_world_def *b)
         assert_memory_equal(&x->friction, &y->friction, sizeof x->friction);
         assert_memory_equal(&x->restitution, &y->restitution, sizeof x->restitution);
     }
-    assert_int_equal(a->solver.rigid_backend, b->solver.rigid_backend);
-    assert_int_equal(a->solver.ccd, b->solver.ccd);
-    assert_memory_equal(&a->solver.sleep_linear, &b->solver.sleep_linear, sizeof(double));
-    assert_memory_equal(&a->solver.sleep_angular, &b->solver.sleep_angular, sizeof(double));
-    assert_memory_equal(&a->solver.dt_rigid, &b->solver.dt_rigid, sizeof(double));
-    assert_int_equal(a->solver.rigid_substeps, b->solver.rigid_substeps);
-    assert_memory_equal(&a->solver.dt_fracture, &b->solver.dt_fracture, sizeof(double));
-    assert_int_equal(a->solver.check_interval, b->solver.check_interval);
-    assert_int_equal(a->solver.quiet_steps, b->solver.quiet_steps);
-    assert_memory_equal(&a->solver.max_fracture_time, &b->solver.max_fracture_time,
+    const cf_solver_settings *sa = &a->world.solver, *sb = &b->world.solver;
+    assert_int_equal(sa->rigid_backend, sb->rigid_backend);
+    assert_int_equal(sa->ccd, sb->ccd);
+    assert_memory_equal(&sa->sleep_linear, &sb->sleep_linear, sizeof(double));
+    assert_memory_equal(&sa->sleep_angular, &sb->sleep_angular, sizeof(double));
+    assert_memory_equal(&sa->dt_rigid, &sb->dt_rigid, sizeof(double));
+    assert_int_equal(sa->rigid_substeps, sb->rigid_substeps);
+    assert_memory_equal(&sa->dt_fracture, &sb->dt_fracture, sizeof(double));
+    assert_int_equal(sa->check_interval, sb->check_interval);
+    assert_int_equal(sa->quiet_steps, sb->quiet_steps);
+    assert_memory_equal(&sa->max_fracture_time, &sb->max_fracture_time,
                         sizeof(double));
-    assert_memory_equal(&a->solver.impact_threshold, &b->solver.impact_threshold,
+    assert_memory_equal(&sa->impact_threshold, &sb->impact_threshold,
                         sizeof(double));
-    assert_int_equal(a->solver.elasticity, b->solver.elasticity);
-    assert_memory_equal(&a->solver.k_stiffness, &b->solver.k_stiffness, sizeof(double));
-    assert_int_equal(a->solver.iterations, b->solver.iterations);
-    assert_memory_equal(&a->solver.k_damping, &b->solver.k_damping, sizeof(double));
-    assert_int_equal(a->solver.threads, b->solver.threads);
-    assert_int_equal(a->solver.mode, b->solver.mode);
-    assert_int_equal(a->solver.criterion, b->solver.criterion);
-    assert_int_equal(a->solver.has_crack_plane, b->solver.has_crack_plane);
-    assert_memory_equal(a->solver.crack_plane_point, b->solver.crack_plane_point, 3 * sizeof(double));
-    assert_memory_equal(a->solver.crack_plane_normal, b->solver.crack_plane_normal, 3 * sizeof(double));
-    assert_memory_equal(&a->solver.crack_plane_tolerance, &b->solver.crack_plane_tolerance,
+    assert_int_equal(sa->elasticity, sb->elasticity);
+    assert_memory_equal(&sa->k_stiffness, &sb->k_stiffness, sizeof(double));
+    assert_int_equal(sa->iterations, sb->iterations);
+    assert_memory_equal(&sa->k_damping, &sb->k_damping, sizeof(double));
+    assert_int_equal(sa->threads, sb->threads);
+    assert_int_equal(sa->mode, sb->mode);
+    assert_int_equal(sa->criterion, sb->criterion);
+    assert_int_equal(sa->has_crack_plane, sb->has_crack_plane);
+    assert_memory_equal(sa->crack_plane_point, sb->crack_plane_point, 3 * sizeof(double));
+    assert_memory_equal(sa->crack_plane_normal, sb->crack_plane_normal, 3 * sizeof(double));
+    assert_memory_equal(&sa->crack_plane_tolerance, &sb->crack_plane_tolerance,
                         sizeof(double));
-    assert_int_equal(a->solver.constraints, b->solver.constraints);
-    assert_int_equal(a->solver.iteration_independent, b->solver.iteration_independent);
-    assert_memory_equal(&a->solver.compliance_scale, &b->solver.compliance_scale,
+    assert_int_equal(sa->constraints, sb->constraints);
+    assert_int_equal(sa->iteration_independent, sb->iteration_independent);
+    assert_memory_equal(&sa->compliance_scale, &sb->compliance_scale,
                         sizeof(double));
-    assert_memory_equal(&a->solver.contact_stiffness, &b->solver.contact_stiffness,
+    assert_memory_equal(&sa->contact_stiffness, &sb->contact_stiffness,
                         sizeof(double));
-    assert_memory_equal(&a->solver.max_inverted_fraction, &b->solver.max_inverted_fraction,
+    assert_memory_equal(&sa->max_inverted_fraction, &sb->max_inverted_fraction,
                         sizeof(double));
-    assert_memory_equal(&a->solver.max_energy_growth, &b->solver.max_energy_growth,
+    assert_memory_equal(&sa->max_energy_growth, &sb->max_energy_growth,
                         sizeof(double));
     assert_string_equal(a->output.file, b->output.file);
     assert_memory_equal(&a->output.frame_interval, &b->output.frame_interval, sizeof(double));
@@ -709,7 +710,7 @@ static void assert_same_scene(const cf_world_def *a, const cf_world_def *b)
  * mesh directory): the same scene, bit for bit, and the same text. */
 static void round_trip(const char *text, const char *const *ov, int n_ov)
 {
-    cf_world_def a, b;
+    cf_scene a, b;
     cf_error e = {0};
     load_ok(text, ov, n_ov, &a);
     write_file("sub/resolved.lua", a.resolved);
@@ -761,26 +762,26 @@ static void test_round_trip(void **state)
 
 static void test_shell_obstacle_keys(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     const cf_obstacle *o;
     (void)state;
     load_ok(SHELL_KEYS_SCENE, NULL, 0, &s);
-    assert_int_equal(s.bodies[0].hollow_layers, 2);
-    assert_int_equal(s.bodies[1].hollow_layers, 0);
+    assert_int_equal(s.world.bodies[0].hollow_layers, 2);
+    assert_int_equal(s.world.bodies[1].hollow_layers, 0);
 
-    assert_int_equal(s.n_obstacles, 5);
-    o = &s.obstacles[0];
+    assert_int_equal(s.world.n_obstacles, 5);
+    o = &s.world.obstacles[0];
     assert_double_equal(o->friction, 0.5, 0);
     assert_double_equal(o->restitution, 0.0, 0);
-    o = &s.obstacles[1];
+    o = &s.world.obstacles[1];
     assert_double_equal(o->friction, 2, 0);
     assert_double_equal(o->restitution, 0.25, 0);
     assert_vec(o->velocity, (const double[]){10, 0, 0}, 3);
     /* Defaults: factors of 1 (the material's own values). */
-    o = &s.obstacles[2];
+    o = &s.world.obstacles[2];
     assert_double_equal(o->friction, 1, 0);
     assert_double_equal(o->restitution, 1, 0);
-    o = &s.obstacles[3];
+    o = &s.world.obstacles[3];
     assert_int_equal(o->type, CF_OBSTACLE_MESH);
     assert_mesh(o->file, "sub/wall.obj");
     assert_double_equal(o->scale, 2, 0);
@@ -788,16 +789,16 @@ static void test_shell_obstacle_keys(void **state)
     assert_vec(o->position, (const double[]){1, 2, 3}, 3);
     assert_double_equal(o->friction, 0, 0);
     assert_double_equal(o->restitution, 1, 0);
-    o = &s.obstacles[4];
+    o = &s.world.obstacles[4];
     assert_int_equal(o->type, CF_OBSTACLE_MESH);
     assert_mesh(o->file, "ramp.STL");
     assert_double_equal(o->scale, 1, 0);
     assert_vec(o->orientation, (const double[]){1, 0, 0, 0}, 4);
     assert_vec(o->position, (const double[]){0, 0, 0}, 3);
 
-    assert_int_equal(s.solver.ccd, 0);
-    assert_double_equal(s.solver.sleep_linear, 0.05, 0);
-    assert_double_equal(s.solver.sleep_angular, 0.1, 0);
+    assert_int_equal(s.world.solver.ccd, 0);
+    assert_double_equal(s.world.solver.sleep_linear, 0.05, 0);
+    assert_double_equal(s.world.solver.sleep_angular, 0.1, 0);
     assert_non_null(strstr(s.resolved, "hollow_layers = 2,"));
     assert_non_null(strstr(s.resolved, "ccd = false,"));
     assert_non_null(strstr(s.resolved, "type = \"mesh\","));
@@ -815,12 +816,12 @@ static void test_shell_obstacle_keys(void **state)
                  " solver = { ccd = false } }",
                  tmp);
         load_ok(text, ov, 5, &s);
-        assert_mesh(s.obstacles[0].file, "sub/wall.obj");
-        assert_double_equal(s.obstacles[0].friction, 0.75, 0);
-        assert_double_equal(s.solver.sleep_linear, 0.5, 0);
-        assert_double_equal(s.solver.sleep_angular, 0.125, 0);
-        assert_int_equal(s.solver.ccd, 1);
-        assert_int_equal(s.bodies[0].hollow_layers, 1);
+        assert_mesh(s.world.obstacles[0].file, "sub/wall.obj");
+        assert_double_equal(s.world.obstacles[0].friction, 0.75, 0);
+        assert_double_equal(s.world.solver.sleep_linear, 0.5, 0);
+        assert_double_equal(s.world.solver.sleep_angular, 0.125, 0);
+        assert_int_equal(s.world.solver.ccd, 1);
+        assert_int_equal(s.world.bodies[0].hollow_layers, 1);
         cf_scene_free(&s);
     }
 }
@@ -911,7 +912,7 @@ static void test_error_shell_obstacle_keys(void **state)
 
 static void test_sandbox_libraries(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     (void)state;
     load_ok("local t = {'a', 'b'}; table.insert(t, 'c')\n"
             "return { name = string.format('%s%d', table.concat(t), math.floor(2.5)),\n"
@@ -945,7 +946,7 @@ static int dump_writer(lua_State *L, const void *p, size_t size, void *ud)
 
 static void test_bytecode_rejected(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     cf_error e = {0};
     lua_State *L = luaL_newstate();
     FILE *f;
@@ -968,7 +969,7 @@ static void test_bytecode_rejected(void **state)
 
 static void test_error_file_open(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     cf_error e = {0};
     (void)state;
     assert_int_equal(cf_scene_load(at("missing.lua"), NULL, 0, mesh_dir, &s, &e),
@@ -1346,7 +1347,7 @@ static void test_error_override(void **state)
 /* A NULL error record is allowed; the scene still comes back empty. */
 static void test_error_without_record(void **state)
 {
-    cf_world_def s;
+    cf_scene s;
     (void)state;
     write_file("scene.lua", "return { }");
     assert_int_equal(cf_scene_load(at("scene.lua"), NULL, 0, mesh_dir, &s, NULL),

@@ -127,7 +127,6 @@ static cf_world *make_world(scene_kind kind, int threads, int n, cf_mesh *box)
     if (cf_mesh_box(size, cells, 6, box, &err) != CF_OK)
         fail_msg("box: %s", err.msg);
     cf_world_def def = cf_default_world_def();
-    def.duration = 10.0;
     def.material.E = 1e6;
     def.material.sigma_max = def.material.tau_max = 1e9;
     def.solver.threads = threads;

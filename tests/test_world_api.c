@@ -33,6 +33,9 @@ static const char lua_scene[] =
     "  output = { file = '' } }\n";
 
 /* The same scene as lua_scene, built in C; *box receives the mesh. */
+/* s of simulated time, the Lua scene's duration */
+#define API_DURATION 0.5
+
 static cf_world_def api_scene(cf_mesh *box, cf_body_def *body, cf_obstacle *ground)
 {
     const double size[3] = {0.2, 0.2, 0.2};
@@ -41,8 +44,6 @@ static cf_world_def api_scene(cf_mesh *box, cf_body_def *body, cf_obstacle *grou
     if (cf_mesh_box(size, cells, 6, box, &err) != CF_OK)
         fail_msg("box: %s", err.msg);
     cf_world_def def = cf_default_world_def();
-    snprintf(def.name, sizeof def.name, "api");
-    def.duration = 0.5;
     def.material.E = 1e5;
     def.material.sigma_max = def.material.tau_max = 3e3;
     def.solver.constraints = CF_CONSTRAINTS_XPBD;
@@ -72,7 +73,7 @@ static void test_api_world_equals_lua_scene(void **state)
     int handoffs = 0, born = 0, inserted = 0;
     /* As the run loop steps it: ceil(duration / dt) regular steps. */
     double dt = cf_world_dt_outer(w);
-    long n_steps = lround(ceil(def.duration / dt - 1e-9));
+    long n_steps = lround(ceil(API_DURATION / dt - 1e-9));
     while (cf_world_step_count(w) < n_steps) {
         assert_int_equal(cf_world_step(w, dt, &err), CF_OK);
         int n;
@@ -124,7 +125,7 @@ static void test_api_world_equals_lua_scene(void **state)
     assert_int_equal(cf_world_tet_positions(w, -1, x), -1);
     cf_world_destroy(w);
 
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = NULL;
     assert_int_equal(cf_scene_load_text("api.lua", lua_scene, NULL, 0, COHFRAC_MESH_DIR, &sc, &err),
                      CF_OK);

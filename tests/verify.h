@@ -17,7 +17,7 @@
 
 /* Load scenes/verification/<file> with `sets` overrides (NULL-terminated)
  * and build the simulation; output goes to <build>/verification/. */
-static cf_sim *verify_open(const char *file, const char *const *sets, cf_world_def *sc)
+static cf_sim *verify_open(const char *file, const char *const *sets, cf_scene *sc)
 {
     char path[1024], out[1200];
     const char *all[32];

@@ -38,10 +38,10 @@ static void bars_exchange_momentum(void **state)
 {
     (void)state;
     verify_begin("bar_collision");
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open("bar_collision.lua", NULL, &sc);
-    const cf_material *m = &sc.material;
-    double c0 = sqrt(m->E / m->rho), v0 = sc.bodies[0].velocity[0], L = 0.5;
+    const cf_material *m = &sc.world.material;
+    double c0 = sqrt(m->E / m->rho), v0 = sc.world.bodies[0].velocity[0], L = 0.5;
     cf_ledger l;
     cf_world_ledger(cf_sim_world(sim), &l);
     double P0 = l.momentum[0], drift = 0, t_part = -1;

@@ -20,7 +20,7 @@ static void apex_ratio_is_e_squared(void **state)
 {
     (void)state;
     verify_begin("bounce");
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open("bounce.lua", NULL, &sc);
     cf_error err;
     double com[3], R[9], v[3], w[3];
@@ -29,7 +29,7 @@ static void apex_ratio_is_e_squared(void **state)
     double bottom = INFINITY;
     for (int i = 0; i < cf_sim_world(sim)->solid.n_nodes; i++)
         bottom = fmin(bottom, cf_sim_world(sim)->solid.x[3 * i + 2]);
-    double z0 = com[2], g = -sc.gravity[2], z_contact = INFINITY, apex = -INFINITY;
+    double z0 = com[2], g = -sc.world.gravity[2], z_contact = INFINITY, apex = -INFINITY;
     double z_rest = z0 - bottom; /* the plane is z = 0 */
     double fall_err = 0, vz_prev = 0;
     int phase = 0; /* 0 falling, 1 rising after the first bounce, 2 done */
@@ -52,7 +52,7 @@ static void apex_ratio_is_e_squared(void **state)
         }
         vz_prev = v[2];
     }
-    double e = sc.material.restitution;
+    double e = sc.world.material.restitution;
     double ratio = (apex - z_rest) / (z0 - z_rest);
     printf("bounce: z0 = %.4f m, resting height %.4f m, lowest %.4f m, apex %.4f m\n", z0,
            z_rest, z_contact, apex);

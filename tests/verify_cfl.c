@@ -17,7 +17,7 @@
  * simulated time reached. */
 static cf_status run_at(const char *fraction, double *t_end, double *growth)
 {
-    cf_world_def sc;
+    cf_scene sc;
     char set[64];
     snprintf(set, sizeof set, "solver.cfl_fraction=%s", fraction);
     const char *sets[] = {set, "duration=0.03", NULL};

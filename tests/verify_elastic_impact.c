@@ -25,7 +25,7 @@
  * input then in *input. */
 static double run(const char *const *sets, double *contact, double *input)
 {
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open("elastic_impact.lua", sets, &sc);
     cf_ledger l;
     double worst = verify_worst_residual(sim, &l);
@@ -81,7 +81,7 @@ static double flat_rebound(const char *contact, double *removed)
     const char *sets[] = {"bodies[1].orientation={1,0,0,0}", "bodies[1].position={0,0,0.0505}",
                           "bodies[1].velocity={0,0,-4.4}", "material.friction=0",
                           "duration=3e-4", setting, NULL};
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open("elastic_impact.lua", sets, &sc);
     cf_ledger l;
     verify_worst_residual(sim, &l);

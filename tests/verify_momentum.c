@@ -27,7 +27,7 @@ static void momentum_to_round_off(void **state)
 {
     (void)state;
     verify_begin("momentum");
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open("momentum.lua", NULL, &sc);
     cf_error err;
     cf_ledger l;

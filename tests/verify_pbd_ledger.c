@@ -41,7 +41,7 @@ static double worst_residual(const char *file, const char *const *sets)
         all[n++] = sets[i];
     all[n++] = out;
     all[n] = NULL;
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open(rel, all, &sc);
     cf_ledger l;
     double worst = verify_worst_residual(sim, &l);

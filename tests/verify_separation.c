@@ -19,7 +19,7 @@
 static void separate(const char *scene, const char *name, double G, double area)
 {
     verify_begin(name);
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open(scene, NULL, &sc);
     cf_error err;
     cf_ledger l;

@@ -36,7 +36,7 @@ static spin_result spin(const char *backend, const char *dt)
     snprintf(b, sizeof b, "solver.rigid_backend=\"%s\"", backend);
     snprintf(d, sizeof d, "solver.dt_rigid=%s", dt);
     const char *sets[] = {b, d, NULL};
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open("free_spin.lua", sets, &sc);
     cf_ledger l0, l;
     cf_world_ledger(cf_sim_world(sim), &l0);
@@ -52,7 +52,7 @@ static spin_result spin(const char *backend, const char *dt)
                               l0.angular_momentum[1] * l0.angular_momentum[1] +
                               l0.angular_momentum[2] * l0.angular_momentum[2]),
                      (l.kinetic - l0.kinetic) / l0.kinetic, l.contact,
-                     sc.bodies[0].angular_velocity[2]};
+                     sc.world.bodies[0].angular_velocity[2]};
     printf("free_spin %s dt %s: |dL|/L %.3g, dE/E %.3g, contact %.3g J, rigid integration "
            "%.3g J, PBD %.3g J, damping %.3g J, residual %.3g J\n",
            backend, dt, r.dL, r.dE, l.contact, l.integration, l.pbd, l.damping, l.residual);

@@ -18,7 +18,7 @@ static void energy_is_conserved(void **state)
 {
     (void)state;
     verify_begin("vibration");
-    cf_world_def sc;
+    cf_scene sc;
     const char *sets[] = {"duration=2.9", NULL};
     cf_sim *sim = verify_open("vibration.lua", sets, &sc);
     cf_error err;

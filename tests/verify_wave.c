@@ -37,10 +37,10 @@ static void front_speed_and_stress(void **state)
 {
     (void)state;
     verify_begin("wave_bar");
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = verify_open("wave_bar.lua", NULL, &sc);
-    const cf_material *m = &sc.material;
-    double c0 = sqrt(m->E / m->rho), v0 = sc.boundaries[0].velocity[0];
+    const cf_material *m = &sc.world.material;
+    double c0 = sqrt(m->E / m->rho), v0 = sc.world.boundaries[0].velocity[0];
     double sigma_ref = -m->rho * c0 * v0, gauge = 0.25, d = gauge + 0.5, L = 1.0;
     double t_prev = 0, s_prev = 0, t_arrive = -1, plateau = 0;
     int n_plateau = 0;

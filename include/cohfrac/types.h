@@ -192,21 +192,13 @@ typedef struct cf_solver_settings {
     int threads;
 } cf_solver_settings;
 
-typedef struct cf_output_settings {
-    char file[1024];
-    double frame_interval;
-    int cracks;                  /* write /cracks at frames */
-    int fields;                  /* write /fracture_mode (deformed tets, stress, damage of
-                                    fracture-mode fragments) at frames */
-} cf_output_settings;
-
-/* A world definition: everything cf_world_create needs.  Start from
- * cf_default_world_def() and fill in; the Lua scene loader (cohfrac/scene.h)
- * fills one the same way. */
+/* A world definition: the physics, everything cf_world_create needs and
+ * nothing of a run around it (its name, duration and output file are the
+ * I/O layer's cf_scene, cohfrac/scene.h).  Start from
+ * cf_default_world_def() and fill in; the Lua scene loader fills one the
+ * same way. */
 typedef struct cf_world_def {
-    char name[128];
-    double duration;
-    double gravity[3];
+    double gravity[3];          /* m/s^2 */
     cf_material material;
     int n_bodies;
     cf_body_def *bodies;
@@ -215,9 +207,6 @@ typedef struct cf_world_def {
     int n_boundaries;
     cf_boundary *boundaries;
     cf_solver_settings solver;
-    cf_output_settings output;
-    char *resolved; /* the resolved scene as Lua text (every key, defaults filled,
-                       mesh paths absolute); loading it again gives this scene */
 } cf_world_def;
 
 /* Bounds on the work one setting can ask for (cf_world_def_check rejects
@@ -233,14 +222,12 @@ typedef struct cf_world_def {
  * (cohfrac/scene.h); a scene key left out takes the same value. */
 cf_material cf_default_material(void);
 cf_solver_settings cf_default_solver(void);
-cf_output_settings cf_default_output(void);
 /* A body at the origin, unit scale, at rest, with no mesh yet. */
 cf_body_def cf_default_body(void);
 /* An obstacle of `type` with the schema's defaults (plane through the origin
  * facing +z; sphere, box and mesh still need their geometry). */
 cf_obstacle cf_default_obstacle(cf_obstacle_type type);
-/* No bodies, no obstacles, the defaults above; name "scene", duration 1 s,
- * gravity (0, 0, -9.81) m/s^2, no output file. */
+/* No bodies, no obstacles, the defaults above, gravity (0, 0, -9.81) m/s^2. */
 cf_world_def cf_default_world_def(void);
 
 /* Check a definition as cf_world_create does: every value in the range the

@@ -66,7 +66,7 @@ static double median(double *v, int n)
 /* The bench scene for `mesh` under `criterion`: the half height of the
  * mesh along its y axis (z once rotated) puts its lowest point on the plane. */
 static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_criterion criterion,
-                            cf_world_def *sc, cf_error *err)
+                            cf_scene *sc, cf_error *err)
 {
     static const char *fmt =
         "return {\n"
@@ -88,7 +88,7 @@ static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_crit
     if (st != CF_OK)
         return st;
     cf_mesh m;
-    st = cf_mesh_load_tetgen(sc->bodies[0].mesh, &m, err);
+    st = cf_mesh_load_tetgen(sc->world.bodies[0].mesh, &m, err);
     if (st != CF_OK) {
         cf_scene_free(sc);
         return st;
@@ -110,7 +110,7 @@ typedef struct sample {
 } sample;
 
 /* One repeat: build the world, `warmup` steps, then `steps` timed ones. */
-static cf_status time_steps(const cf_bench_options *o, const cf_world_def *sc, int threads,
+static cf_status time_steps(const cf_bench_options *o, const cf_scene *sc, int threads,
                             sample *out, cf_error *err)
 {
     cf_run_options ro = {.progress = 0, .threads = threads, .mesh_dir = o->mesh_dir};
@@ -143,7 +143,7 @@ static cf_status time_steps(const cf_bench_options *o, const cf_world_def *sc, i
 
 /* The peer on the same mesh, steps and dt: its ms per step (min), or a
  * negative number when it failed (the log is kept and named). */
-static double run_peer(const cf_bench_options *o, const cf_world_def *sc, cf_error *err)
+static double run_peer(const cf_bench_options *o, const cf_scene *sc, cf_error *err)
 {
     char log[] = "/tmp/cohfrac_peer_XXXXXX", steps[32], dt[32];
     int fd = mkstemp(log);
@@ -151,8 +151,8 @@ static double run_peer(const cf_bench_options *o, const cf_world_def *sc, cf_err
         return cf_error_set(err, CF_ERR_EXTERNAL, "cannot create a log for the peer"), -1;
     close(fd);
     snprintf(steps, sizeof steps, "%d", o->steps);
-    snprintf(dt, sizeof dt, "%.17g", sc->solver.dt_fracture);
-    char *argv[] = {(char *)o->peer, (char *)sc->bodies[0].mesh, "--steps", steps, "--dt", dt,
+    snprintf(dt, sizeof dt, "%.17g", sc->world.solver.dt_fracture);
+    char *argv[] = {(char *)o->peer, (char *)sc->world.bodies[0].mesh, "--steps", steps, "--dt", dt,
                     "--iterations", "3", NULL};
     pid_t pid;
     int status = 0;
@@ -207,7 +207,7 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
     int nt = o->threads > 0 ? o->threads : omp_get_num_procs();
     int reps = o->repeats < 1 ? 1 : o->repeats > 64 ? 64 : o->repeats;
     FILE *log = o->log;
-    cf_world_def sc;
+    cf_scene sc;
     cf_status st = make_scene(o, o->mesh, o->criterion, &sc, err);
     if (st != CF_OK)
         return st;
@@ -217,7 +217,7 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
                 "cohfrac bench: mesh %s, criterion %s, %d steps x %d repeats after %d warm-up "
                 "steps, dt %.3g s\n",
                 o->mesh, criterion_name[o->criterion], o->steps, reps, o->warmup,
-                sc.solver.dt_fracture);
+                sc.world.solver.dt_fracture);
     sample s1[64], sn[64];
     double peer[64];
     int np = 0;
@@ -306,7 +306,7 @@ cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes,
     int reps = o->repeats < 1 ? 1 : o->repeats > 64 ? 64 : o->repeats;
     FILE *log = o->log;
     *bytes_per_tet = 0;
-    cf_world_def *sc = calloc((size_t)(n > 0 ? n : 1), sizeof *sc);
+    cf_scene *sc = calloc((size_t)(n > 0 ? n : 1), sizeof *sc);
     sample *last = calloc((size_t)(n > 0 ? n : 1), sizeof *last);
     double *best = malloc((size_t)(n > 0 ? n : 1) * sizeof *best);
     if (!sc || !last || !best) {
@@ -375,7 +375,7 @@ typedef struct scene_sample {
 static cf_status scene_once(const cf_bench_options *o, const cf_bench_scene_options *so,
                             scene_sample *out, cf_error *err)
 {
-    cf_world_def def;
+    cf_scene def;
     const char **sets = malloc((size_t)(so->n_overrides + 1) * sizeof *sets);
     if (!sets)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");

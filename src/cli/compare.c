@@ -176,7 +176,7 @@ static void row(FILE *f, const char *metric, const char *unit, const double fin[
             num(b, 32, mx[0]), num(c, 32, fin[1]), num(d, 32, mx[1]), closer);
 }
 
-static void write_headline(FILE *f, const cf_compare_options *opt, const cf_world_def *sc,
+static void write_headline(FILE *f, const cf_compare_options *opt, const cf_scene *sc,
                            const cf_compare_result *r, const reference *ref, cf_status run_st)
 {
     char a[32], b[32], c[32];
@@ -185,11 +185,12 @@ static void write_headline(FILE *f, const cf_compare_options *opt, const cf_worl
     for (int i = 0; i < opt->n_overrides; i++)
         fprintf(f, " `--set %s`", opt->overrides[i]);
     fprintf(f, "\n- simulated %.4g s of %.4g s, dt_rigid %.3g s, %d samples every %.3g s\n",
-            r->duration, sc->duration, sc->solver.dt_rigid, r->n_samples,
+            r->duration, sc->duration, sc->world.solver.dt_rigid, r->n_samples,
             sc->output.frame_interval);
     fprintf(f, "- backends: **bullet** (Bullet, %d sub-steps per dt_rigid) and **pbd** "
                "(damped PBD rigid mode: k_damping = 1, k_stiffness %.3g, %d iterations)\n",
-            sc->solver.rigid_substeps, sc->solver.k_stiffness, sc->solver.iterations);
+            sc->world.solver.rigid_substeps, sc->world.solver.k_stiffness,
+            sc->world.solver.iterations);
     double ratio = r->wall[0] > 0 ? r->wall[1] / r->wall[0] : NAN;
     fprintf(f, "- wall time of the steps: bullet %.3f s, pbd %.3f s (pbd / bullet = %s)\n",
             r->wall[0], r->wall[1], num(a, 32, ratio));
@@ -209,10 +210,10 @@ static void write_headline(FILE *f, const cf_compare_options *opt, const cf_worl
     if (r->top)
         fprintf(f, " + symmetric top");
     fputs("\n", f);
-    if (sc->solver.mode == CF_RUN_FRACTURE)
+    if (sc->world.solver.mode == CF_RUN_FRACTURE)
         fprintf(f, "- solver.mode = \"fracture\": no rigid mode, so the backend makes no "
                    "difference\n");
-    if (sc->n_obstacles > 0)
+    if (sc->world.n_obstacles > 0)
         fprintf(f, "- drifts include the obstacles' impulses and the energy contact removes "
                    "(they measure conservation in free flight only)\n");
     if (run_st != CF_OK)
@@ -253,7 +254,7 @@ static void write_headline(FILE *f, const cf_compare_options *opt, const cf_worl
                        : r->reference != CF_CMP_REF_NONE ? "max COM error"
                                                          : "max kinetic-energy drift";
     /* with obstacles and no reference the drifts mix contact losses in: no verdict */
-    int judged = r->reference != CF_CMP_REF_NONE || sc->n_obstacles == 0;
+    int judged = r->reference != CF_CMP_REF_NONE || sc->world.n_obstacles == 0;
     if (judged && !isnan(crit[0]) && !isnan(crit[1]) && r->wall[0] > 0 && r->wall[1] > 0) {
         int w = crit[1] < crit[0];
         fprintf(f, "\n**%s is closer%s** (%s %s vs %s) at %s× the wall time of %s.\n",
@@ -458,7 +459,7 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     const char *mesh_dir = opt->mesh_dir ? opt->mesh_dir : cf_default_mesh_dir();
     cf_compare_result local, *r = res ? res : &local;
     memset(r, 0, sizeof *r);
-    cf_world_def sc[2];
+    cf_scene sc[2];
     memset(sc, 0, sizeof sc);
     state st;
     memset(&st, 0, sizeof st);
@@ -489,7 +490,7 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
     }
     if (rc != CF_OK)
         goto done;
-    st.scene = &sc[0];
+    st.scene = &sc[0].world;
     st.T = sc[0].duration;
     snprintf(r->scene_name, sizeof r->scene_name, "%s", sc[0].name);
     if (opt->out_dir)
@@ -502,10 +503,10 @@ cf_status cf_compare_run(const cf_compare_options *opt, cf_compare_result *res, 
 
     if ((rc = snap_take(st.sim[0], &st.s[0], err)) != CF_OK)
         goto done;
-    cf_cmp_reference_setup(&sc[0], st.sim[0], &st.s[0], &st.ref);
+    cf_cmp_reference_setup(&sc[0].world, st.sim[0], &st.s[0], &st.ref);
     if ((rc = take_sample(&st, err)) != CF_OK)
         goto done;
-    double dt = sc[0].solver.dt_rigid, every = sc[0].output.frame_interval;
+    double dt = sc[0].world.solver.dt_rigid, every = sc[0].output.frame_interval;
     double next = every, next_report = 0.1 * st.T;
     cf_error run_err = {0};
     int n_bodies = cf_world_fragments(cf_sim_world(st.sim[0]), NULL, 0);

@@ -409,7 +409,7 @@ static int cmd_run(int argc, char **argv)
         return rc;
     }
     cf_error err = {0};
-    cf_world_def scene;
+    cf_scene scene;
     cf_sim *sim = NULL;
     cf_run_options opt = {.progress = a.progress, .threads = a.threads, .mesh_dir = a.mesh_dir,
                           .force = a.force, .stop = &stop_signal};

@@ -1,6 +1,7 @@
 /* Report files for the studies (`compare`, `stability`; their directories
- * come from cf_mkdirs in file_text.h): whole-or-nothing text files, and the matplotlib plots made by the
- * helpers of the Python package (python/cohfrac) with Debian's python3. */
+ * come from cf_mkdirs in file_text.h): whole-or-nothing text files, and the matplotlib
+ * plots made by the helpers of the Python package (python/cohfrac) with Debian's
+ * python3. */
 #ifndef COHFRAC_REPORT_H
 #define COHFRAC_REPORT_H
 

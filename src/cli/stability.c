@@ -169,7 +169,7 @@ static int case_overrides(const cf_stability_case *c, double dt, char ov[][160])
     return n;
 }
 
-static cf_status make_sim(const char *scene, const cf_stability_case *c, double dt, cf_world_def *sc,
+static cf_status make_sim(const char *scene, const cf_stability_case *c, double dt, cf_scene *sc,
                           cf_sim **sim, cf_error *err)
 {
     char ov[12][160];
@@ -223,7 +223,7 @@ static int system_com(cf_sim *sim, double com[3])
 static cf_status run_case(const char *scene, cf_stability_case *c, cf_error *err)
 {
     double t0 = cf_wall_time();
-    cf_world_def sc;
+    cf_scene sc;
     cf_sim *sim = NULL;
     cf_status st = make_sim(scene, c, 0, &sc, &sim, err);
     if (st != CF_OK)

@@ -117,8 +117,9 @@ static char *format(const char *fmt, const char *a, const char *b)
  * dt_fracture, or over cfl_fraction x dt_cfl) x (1 + PBD iterations).
  * Only an ordering: 0 when the meshes cannot be made (the run will say
  * why). */
-static double case_cost(cf_world_def *sc, const char *mesh_dir)
+static double case_cost(cf_scene *scene, const char *mesh_dir)
 {
+    cf_world_def *sc = &scene->world;
     cf_world_meshes wm;
     cf_error e;
     if (cf_world_meshes_load(sc, mesh_dir, &wm, &e) != CF_OK)
@@ -132,7 +133,7 @@ static double case_cost(cf_world_def *sc, const char *mesh_dir)
     cf_world_meshes_free(&wm);
     const cf_solver_settings *so = &sc->solver;
     double dt = so->cfl_fraction > 0 ? so->cfl_fraction * dt_cfl : so->dt_fracture;
-    double cost = tets * sc->duration / dt * (1 + so->iterations);
+    double cost = tets * scene->duration / dt * (1 + so->iterations);
     return isfinite(cost) ? cost : 0;
 }
 
@@ -150,7 +151,7 @@ static cf_status resolve_case(const cf_study_options *o, job *j, cf_study_case *
     for (int i = 0; i < j->n_sets; i++)
         all[o->n_overrides + i] = j->sets[i];
     all[n - 1] = "output.file=\"\"";
-    cf_world_def sc;
+    cf_scene sc;
     cf_error e2 = {0};
     cf_status st = cf_scene_load(o->scene, all, n, o->mesh_dir, &sc, &e2);
     free(all);

@@ -365,7 +365,6 @@ static cf_status copy_def(cf_world *w, const cf_world_def *def, cf_error *err)
     int fail = 0;
     w->def = *def;
     w->def.bodies = NULL, w->def.n_bodies = 0;
-    w->def.resolved = NULL;
     w->def.obstacles = copy_array(def->obstacles, def->n_obstacles, sizeof *def->obstacles, &fail);
     w->def.boundaries = copy_array(def->boundaries, def->n_boundaries, sizeof *def->boundaries,
                                      &fail);

@@ -48,15 +48,6 @@ cf_material cf_default_material(void) { return schema_defaults().material; }
 
 cf_solver_settings cf_default_solver(void) { return schema_defaults().solver; }
 
-cf_output_settings cf_default_output(void)
-{
-    cf_output_settings o;
-    memset(&o, 0, sizeof o);
-    o.frame_interval = 0.01;
-    o.fields = 1;
-    return o;
-}
-
 cf_body_def cf_default_body(void)
 {
     cf_body_def b;
@@ -82,12 +73,9 @@ cf_world_def cf_default_world_def(void)
 {
     cf_world_def d;
     memset(&d, 0, sizeof d);
-    snprintf(d.name, sizeof d.name, "scene");
-    d.duration = 1.0;
     d.gravity[2] = -9.81;
     d.material = cf_default_material();
     d.solver = cf_default_solver();
-    d.output = cf_default_output();
     return d;
 }
 
@@ -153,18 +141,11 @@ static cf_status check_schema(const cf_world_def *d, cf_error *err)
 cf_status cf_world_def_check(const cf_world_def *d, cf_error *err)
 {
     const cf_solver_settings *s = &d->solver;
-    CHECK("duration", d->duration, CF_POSITIVE);
     cf_status st = check_schema(d, err);
     if (st == CF_OK)
         st = cf_solver_check_rules(s, err);
     if (st != CF_OK)
         return st;
-    if (s->dt_rigid > d->duration)
-        return cf_error_set(err, CF_ERR_SCENE_VALUE,
-                            "'solver.dt_rigid' (%g s) exceeds 'duration' (%g s): the run is "
-                            "whole rigid steps; lower solver.dt_rigid to at most the duration",
-                            s->dt_rigid, d->duration);
-    CHECK("output.frame_interval", d->output.frame_interval, CF_POSITIVE);
     if (s->has_crack_plane) {
         st = cf_check_unit("solver.crack_plane.normal", s->crack_plane_normal, 3, err);
         if (st != CF_OK)

@@ -130,7 +130,8 @@ typedef struct loader {
     const char *mesh_dir; /* where prepared meshes live; may be NULL */
     const char *const *overrides;
     int n_overrides;
-    cf_world_def *s;
+    cf_scene *sc;         /* the scene being filled */
+    cf_world_def *s;      /* its world definition, &sc->world */
     cf_error *err;
     cf_status status;   /* result of the protected part */
     char path[512];     /* key path of the table being read, e.g. "solver.pbd" */
@@ -1173,12 +1174,13 @@ static cf_status read_scene(loader *ld, int t)
 {
     static const double duration = 1.0;
     lua_State *L = ld->L;
+    cf_scene *sc = ld->sc;
     cf_world_def *s = ld->s;
     int n, li;
 
     TRY(check_keys(ld, t, top_keys, COUNT(top_keys)));
-    TRY(get_str(ld, t, "name", "scene", s->name, sizeof s->name));
-    TRY(get_num(ld, t, "duration", &duration, &POSITIVE, &s->duration));
+    TRY(get_str(ld, t, "name", "scene", sc->name, sizeof sc->name));
+    TRY(get_num(ld, t, "duration", &duration, &POSITIVE, &sc->duration));
     TRY(get_vec(ld, t, "gravity", 3, GRAVITY, s->gravity));
     WITH_TABLE(ld, t, "material", read_settings(ld, lua_gettop(L), "material"));
 
@@ -1250,8 +1252,8 @@ static cf_status read_scene(loader *ld, int t)
                     s->n_boundaries, s->n_boundaries == 1 ? "y" : "ies",
                     cf_setting_find("solver", "mode")->names[s->solver.mode]);
     WITH_TABLE(ld, t, "output",
-               read_output(ld, lua_gettop(L), s->name, s->solver.mode == CF_RUN_FRACTURE,
-                           &s->output));
+               read_output(ld, lua_gettop(L), sc->name, s->solver.mode == CF_RUN_FRACTURE,
+                           &sc->output));
     return CF_OK;
 }
 
@@ -1652,12 +1654,13 @@ static void put_settings(text *b, int ind, const cf_world_def *d, const char *ta
 }
 
 /* The whole scene as Lua text in schema order; NULL when out of memory. */
-static char *resolved_text(const cf_world_def *s)
+static char *resolved_text(const cf_scene *sc)
 {
+    const cf_world_def *s = &sc->world;
     text b = {0};
     put(&b, "return {\n");
-    put_str(&b, 2, "name", s->name);
-    put_num(&b, 2, "duration", s->duration);
+    put_str(&b, 2, "name", sc->name);
+    put_num(&b, 2, "duration", sc->duration);
     put_vec(&b, 2, "gravity", s->gravity, 3);
     put(&b, "  material = {\n");
     put_settings(&b, 4, s, "material");
@@ -1720,10 +1723,10 @@ static char *resolved_text(const cf_world_def *s)
     put(&b, "  },\n  solver = {\n");
     put_settings(&b, 4, s, "solver");
     put(&b, "  },\n  output = {\n");
-    put_str(&b, 4, "file", s->output.file);
-    put_num(&b, 4, "frame_interval", s->output.frame_interval);
-    put(&b, "    cracks = %s,\n", s->output.cracks ? "true" : "false");
-    put(&b, "    fields = %s,\n", s->output.fields ? "true" : "false");
+    put_str(&b, 4, "file", sc->output.file);
+    put_num(&b, 4, "frame_interval", sc->output.frame_interval);
+    put(&b, "    cracks = %s,\n", sc->output.cracks ? "true" : "false");
+    put(&b, "    fields = %s,\n", sc->output.fields ? "true" : "false");
     put(&b, "  },\n}\n");
     if (b.oom) {
         free(b.p);
@@ -1847,8 +1850,8 @@ static cf_status load(loader *ld)
     if (ld->status != CF_OK)
         return ld->status;
 
-    ld->s->resolved = resolved_text(ld->s);
-    if (!ld->s->resolved)
+    ld->sc->resolved = resolved_text(ld->sc);
+    if (!ld->sc->resolved)
         return fail(ld, CF_ERR_NOMEM, "out of memory for the resolved scene");
     return CF_OK;
 }
@@ -1856,7 +1859,7 @@ static cf_status load(loader *ld)
 /* The loader behind cf_scene_load and cf_scene_load_text: `text` NULL
  * reads the file `path`, otherwise `path` only names the text in messages. */
 static cf_status load_scene(const char *path, const char *text, const char *const *overrides,
-                            int n_overrides, const char *mesh_dir, cf_world_def *out, cf_error *err)
+                            int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err)
 {
     loader ld;
     const char *slash;
@@ -1870,7 +1873,8 @@ static cf_status load_scene(const char *path, const char *text, const char *cons
     ld.mesh_dir = mesh_dir;
     ld.overrides = overrides;
     ld.n_overrides = n_overrides;
-    ld.s = out;
+    ld.sc = out;
+    ld.s = &out->world;
     ld.err = err;
 
     slash = text ? NULL : strrchr(path, '/');
@@ -1896,25 +1900,62 @@ static cf_status load_scene(const char *path, const char *text, const char *cons
 }
 
 cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
-                        const char *mesh_dir, cf_world_def *out, cf_error *err)
+                        const char *mesh_dir, cf_scene *out, cf_error *err)
 {
     return load_scene(path, NULL, overrides, n_overrides, mesh_dir, out, err);
 }
 
 cf_status cf_scene_load_text(const char *name, const char *text, const char *const *overrides,
-                             int n_overrides, const char *mesh_dir, cf_world_def *out, cf_error *err)
+                             int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err)
 {
     assert(text);
     return load_scene(name, text, overrides, n_overrides, mesh_dir, out, err);
 }
 
-void cf_scene_free(cf_world_def *s)
+void cf_scene_free(cf_scene *s)
 {
     if (!s)
         return;
-    free(s->bodies);
-    free(s->obstacles);
-    free(s->boundaries);
+    free(s->world.bodies);
+    free(s->world.obstacles);
+    free(s->world.boundaries);
     free(s->resolved);
     memset(s, 0, sizeof *s);
+}
+
+cf_output_settings cf_default_output(void)
+{
+    cf_output_settings o;
+    memset(&o, 0, sizeof o);
+    o.frame_interval = 0.01;
+    o.fields = 1;
+    return o;
+}
+
+cf_scene cf_default_scene(void)
+{
+    cf_scene s;
+    memset(&s, 0, sizeof s);
+    snprintf(s.name, sizeof s.name, "scene");
+    s.duration = 1.0;
+    s.world = cf_default_world_def();
+    s.output = cf_default_output();
+    return s;
+}
+
+cf_status cf_scene_check(const cf_scene *s, cf_error *err)
+{
+    if (!(s->duration > 0))
+        return cf_error_set(err, CF_ERR_SCENE_VALUE, "'duration' must be > 0, got %.17g",
+                            s->duration);
+    if (s->world.solver.dt_rigid > s->duration)
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'solver.dt_rigid' (%g s) exceeds 'duration' (%g s): the run is "
+                            "whole rigid steps; lower solver.dt_rigid to at most the duration",
+                            s->world.solver.dt_rigid, s->duration);
+    if (!(s->output.frame_interval > 0))
+        return cf_error_set(err, CF_ERR_SCENE_VALUE,
+                            "'output.frame_interval' must be > 0, got %.17g",
+                            s->output.frame_interval);
+    return CF_OK;
 }

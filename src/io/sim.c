@@ -293,24 +293,28 @@ static void close_after_error(cf_sim *sim, cf_error *err)
 
 static void tick(void *user, double t);
 
-cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
+cf_status cf_sim_create(const cf_scene *sc, const cf_run_options *opt, cf_sim **out,
                         cf_error *err)
 {
     *out = NULL;
+    cf_status st = cf_scene_check(sc, err);
+    if (st != CF_OK)
+        return st;
+    const cf_world_def *def = &sc->world;
     cf_sim *sim = calloc(1, sizeof *sim);
     if (!sim)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     sim->opt = *opt;
     sim->wall_start = cf_wall_time();
-    snprintf(sim->name, sizeof sim->name, "%s", def->name);
-    sim->duration = def->duration;
-    sim->output = def->output;
+    snprintf(sim->name, sizeof sim->name, "%s", sc->name);
+    sim->duration = sc->duration;
+    sim->output = sc->output;
     /* The world reads a copy whose meshes point at what mesh preparation made. */
     cf_world_def w = *def;
     size_t nb = (size_t)def->n_bodies, no = (size_t)def->n_obstacles;
     w.bodies = malloc((nb + 1) * sizeof *w.bodies);
     w.obstacles = malloc((no + 1) * sizeof *w.obstacles);
-    cf_status st = w.bodies && w.obstacles ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+    st = w.bodies && w.obstacles ? CF_OK : cf_error_set(err, CF_ERR_NOMEM, "out of memory");
     if (st == CF_OK) {
         if (nb) /* (a definition without obstacles may hold a NULL list) */
             memcpy(w.bodies, def->bodies, nb * sizeof *w.bodies);
@@ -323,20 +327,20 @@ cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_s
      * preparation or convex decomposition (minutes on a large mesh) still
      * leaves a readable file that says what was run. */
     struct stat out_stat;
-    if (st == CF_OK && def->output.file[0] && stat(def->output.file, &out_stat) == 0 &&
+    if (st == CF_OK && sc->output.file[0] && stat(sc->output.file, &out_stat) == 0 &&
         S_ISDIR(out_stat.st_mode))
         st = cf_error_set(err, CF_ERR_OUTPUT,
                           "cannot write the output to %s: it is a directory (give a file "
                           "in it, e.g. -o %s/%s.h5)",
-                          def->output.file, def->output.file, def->name);
-    if (st == CF_OK && def->output.file[0] && !opt->force &&
-        access(def->output.file, F_OK) == 0 && !cf_h5_is_output(def->output.file))
+                          sc->output.file, sc->output.file, sc->name);
+    if (st == CF_OK && sc->output.file[0] && !opt->force &&
+        access(sc->output.file, F_OK) == 0 && !cf_h5_is_output(sc->output.file))
         st = cf_error_set(err, CF_ERR_OUTPUT,
                           "refusing to overwrite %s: it is not a cohfrac output file (give "
                           "another output file, or --force to overwrite it)",
-                          def->output.file);
-    if (st == CF_OK && def->output.file[0])
-        st = cf_h5_open(def->output.file, def->name, def->resolved, &sim->h5, err);
+                          sc->output.file);
+    if (st == CF_OK && sc->output.file[0])
+        st = cf_h5_open(sc->output.file, sc->name, sc->resolved, &sim->h5, err);
     if (st == CF_OK)
         st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
     if (st == CF_OK)
@@ -375,12 +379,12 @@ cf_status cf_sim_create_text(const char *name, const char *text, const char *con
 {
     *out = NULL;
     const char *mesh_dir = opt && opt->mesh_dir ? opt->mesh_dir : cf_default_mesh_dir();
-    cf_world_def def;
-    cf_status st = cf_scene_load_text(name, text, overrides, n_overrides, mesh_dir, &def, err);
+    cf_scene sc;
+    cf_status st = cf_scene_load_text(name, text, overrides, n_overrides, mesh_dir, &sc, err);
     if (st != CF_OK)
         return st;
-    st = cf_sim_create(&def, opt, out, err);
-    cf_scene_free(&def);
+    st = cf_sim_create(&sc, opt, out, err);
+    cf_scene_free(&sc);
     return st;
 }
 

@@ -11,7 +11,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memcpy(text, data, size);
     text[size] = '\0';
     static const char *const sets[] = {"duration=0.5"};
-    cf_world_def def;
+    cf_scene def;
     cf_error err;
     if (cf_scene_load_text("fuzz.lua", text, sets, 1, fuzz_path("meshes"), &def, &err) == CF_OK)
         cf_scene_free(&def);

@@ -1,5 +1,6 @@
-/* cohfrac — scenes: a Lua 5.4 script that returns a table, read into the
- * engine's world definition (cohfrac/world.h).
+/* cohfrac — scenes: a Lua 5.4 script that returns a table, read into a
+ * cf_scene: the engine's world definition (cohfrac/types.h, the physics)
+ * and what a run does with it (its name, duration and output).
  *
  * The script runs sandboxed (base functions without dofile/loadfile/load of
  * bytecode, plus string, table and math; no io, os, package, debug).  The
@@ -212,6 +213,40 @@
 #include "cohfrac/error.h"
 #include "cohfrac/types.h"
 
+/* Where and what a run writes (the scene's `output` table). */
+typedef struct cf_output_settings {
+    char file[1024];             /* the HDF5 file; "" writes none */
+    double frame_interval;       /* s between frames */
+    int cracks;                  /* write /cracks at frames */
+    int fields;                  /* write /fracture_mode (deformed tets, stress, damage of
+                                    fracture-mode fragments) at frames */
+} cf_output_settings;
+
+/* A run: the world's physics and what the run loop (cohfrac/sim.h) does
+ * with it.  Start from cf_default_scene() and fill in, or load a script. */
+typedef struct cf_scene {
+    char name[128];              /* the run's name: the output file's default name,
+                                    messages, the HDF5 root's attribute */
+    double duration;             /* s of simulated time */
+    cf_world_def world;          /* what cf_world_create builds */
+    cf_output_settings output;
+    char *resolved;              /* the resolved scene as Lua text (every key, defaults
+                                    filled, mesh paths absolute); loading it again gives
+                                    this scene; NULL for a scene built in C */
+} cf_scene;
+
+/* frame_interval 0.01 s, fields on, cracks off, no file. */
+cf_output_settings cf_default_output(void);
+/* The world's defaults (cf_default_world_def), name "scene", duration 1 s,
+ * cf_default_output(). */
+cf_scene cf_default_scene(void);
+
+/* Check what the run adds to the world definition: duration > 0, at
+ * least one regular step (solver.dt_rigid <= duration), frame_interval
+ * > 0.  The world's own values are cf_world_def_check's, at create.
+ * Errors: CF_ERR_SCENE_VALUE naming the key. */
+cf_status cf_scene_check(const cf_scene *s, cf_error *err);
+
 /* Load and validate a scene script.  `overrides` are "key.path=value"
  * strings applied before validation.  Prepared mesh names are looked up in
  * `mesh_dir` as <mesh_dir>/<name>.node.
@@ -221,16 +256,16 @@
  * CF_ERR_SCENE_VALUE (key path, value, allowed range), CF_ERR_SCENE_OVERRIDE.
  * On error `out` is left empty. */
 cf_status cf_scene_load(const char *path, const char *const *overrides, int n_overrides,
-                        const char *mesh_dir, cf_world_def *out, cf_error *err);
+                        const char *mesh_dir, cf_scene *out, cf_error *err);
 
 /* The same for a scene script held in memory: `name` stands for the file in
  * messages, and relative paths start at the working directory.  Errors as
  * cf_scene_load, without CF_ERR_FILE_OPEN for the script itself. */
 cf_status cf_scene_load_text(const char *name, const char *text, const char *const *overrides,
-                             int n_overrides, const char *mesh_dir, cf_world_def *out, cf_error *err);
+                             int n_overrides, const char *mesh_dir, cf_scene *out, cf_error *err);
 
 /* Free what cf_scene_load allocated and zero *s.  NULL and an already
  * freed (zeroed) scene are fine. */
-void cf_scene_free(cf_world_def *s);
+void cf_scene_free(cf_scene *s);
 
 #endif

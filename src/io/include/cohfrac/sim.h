@@ -1,5 +1,6 @@
-/* cohfrac — running a world: the loop that turns a world definition into
- * an HDF5 file, a progress display and a summary.
+/* cohfrac — running a world: the loop that turns a scene (cohfrac/scene.h:
+ * a world definition, a duration and an output) into an HDF5 file, a
+ * progress display and a summary.
  *
  * cf_sim_create makes the meshes the definition names (mesh preparation,
  * cohfrac/surface.h), creates the engine's world (cohfrac/world.h) and
@@ -17,6 +18,7 @@
 #include <stdio.h>
 
 #include "cohfrac/error.h"
+#include "cohfrac/scene.h"
 #include "cohfrac/types.h"
 #include "cohfrac/world.h"
 
@@ -36,10 +38,11 @@ typedef struct cf_run_options {
                              closes the file and returns CF_ERR_INTERRUPTED */
 } cf_run_options;
 
-/* Errors: those of cf_world_meshes_load, cf_world_create, and CF_ERR_OUTPUT
- * (cf_h5_open; or the output file exists and is not a cohfrac output, and
- * opt->force is 0).  `def` is read during the call only. */
-cf_status cf_sim_create(const cf_world_def *def, const cf_run_options *opt, cf_sim **out,
+/* Errors: those of cf_scene_check (before anything is written),
+ * cf_world_meshes_load, cf_world_create, and CF_ERR_OUTPUT (cf_h5_open; or
+ * the output file exists and is not a cohfrac output, and opt->force is
+ * 0).  `sc` is read during the call only. */
+cf_status cf_sim_create(const cf_scene *sc, const cf_run_options *opt, cf_sim **out,
                         cf_error *err);
 
 /* The same from a scene script held in memory (cf_scene_load_text: `name`
