@@ -48,7 +48,7 @@ expect() {
 }
 
 cli_h='bench.h compare.h study.h stability.h'
-io_h='cohfrac/scene.h cohfrac/sim.h cohfrac/h5_output.h cohfrac/cohfrac.h lua.h hdf5.h'
+io_h='cohfrac/scene.h cohfrac/sim.h cohfrac/h5_output.h cohfrac/cohfrac.h lua.h hdf5.h cf_gltf.h'
 mesh_h='cohfrac/mesh.h cohfrac/surface.h'
 for arg in "$@"; do
     module=${arg%%=*}
