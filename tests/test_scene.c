@@ -189,16 +189,16 @@ static void test_defaults_minimal(void **state)
     assert_double_equal(s.world.material.restitution, 0.0, 0);
 
     assert_int_equal(s.world.n_bodies, 1);
-    assert_mesh(s.world.bodies[0].mesh, "cube");
+    assert_mesh(s.sources[0].mesh, "cube");
     assert_double_equal(s.world.bodies[0].scale, 1.0, 0);
     assert_vec(s.world.bodies[0].position, (const double[]){0, 0, 0}, 3);
     assert_vec(s.world.bodies[0].orientation, (const double[]){1, 0, 0, 0}, 4);
     assert_vec(s.world.bodies[0].velocity, (const double[]){0, 0, 0}, 3);
     assert_vec(s.world.bodies[0].angular_velocity, (const double[]){0, 0, 0}, 3);
-    assert_int_equal(s.world.bodies[0].primitive.type, CF_PRIM_NONE);
+    assert_int_equal(s.sources[0].primitive.type, CF_PRIM_NONE);
     assert_vec(s.world.bodies[0].expansion_rate, (const double[]){0, 0, 0}, 3);
     assert_int_equal(s.world.bodies[0].has_expansion_center, 0);
-    assert_int_equal(s.world.bodies[0].hollow_layers, 0);
+    assert_int_equal(s.sources[0].hollow_layers, 0);
     assert_int_equal(s.world.n_boundaries, 0);
     assert_null(s.world.boundaries);
     assert_int_equal(s.world.n_obstacles, 0);
@@ -287,15 +287,15 @@ static void test_full_scene(void **state)
     assert_double_equal(s.world.material.restitution, 0.2, 0);
 
     assert_int_equal(s.world.n_bodies, 3);
-    assert_mesh(s.world.bodies[0].mesh, "cube");
+    assert_mesh(s.sources[0].mesh, "cube");
     assert_double_equal(s.world.bodies[0].scale, 2, 0);
     assert_vec(s.world.bodies[0].position, (const double[]){1, 2, 3}, 3);
     assert_vec(s.world.bodies[0].orientation, (const double[]){0, 0, 0, 1}, 4);
     assert_vec(s.world.bodies[0].velocity, (const double[]){0, 0, -1}, 3);
     assert_vec(s.world.bodies[0].angular_velocity, (const double[]){0.5, 0, 0}, 3);
-    assert_mesh(s.world.bodies[1].mesh, "meshes/bunny");
+    assert_mesh(s.sources[1].mesh, "meshes/bunny");
     assert_vec(s.world.bodies[1].orientation, (const double[]){0.5, 0.5, 0.5, 0.5}, 4);
-    assert_mesh(s.world.bodies[2].mesh, "sub/part");
+    assert_mesh(s.sources[2].mesh, "sub/part");
 
     assert_int_equal(s.world.n_obstacles, 4);
     assert_int_equal(s.world.obstacles[0].type, CF_OBSTACLE_PLANE);
@@ -360,14 +360,14 @@ static void test_mesh_paths(void **state)
         snprintf(text, sizeof text, "return { bodies = { { mesh = '%s%s' } } }",
                  strchr(m, '/') || strchr(m, '.') ? "" : "./", m);
         load_ok(text, NULL, 0, &s);
-        assert_mesh(s.world.bodies[0].mesh, "cube");
+        assert_mesh(s.sources[0].mesh, "cube");
         cf_scene_free(&s);
     }
     {
         cf_scene s;
         snprintf(text, sizeof text, "return { bodies = { { mesh = '%s/sub/part' } } }", tmp);
         load_ok(text, NULL, 0, &s);
-        assert_mesh(s.world.bodies[0].mesh, "sub/part");
+        assert_mesh(s.sources[0].mesh, "sub/part");
         cf_scene_free(&s);
     }
 }
@@ -377,7 +377,7 @@ static void test_prepared_mesh(void **state)
     cf_scene s;
     (void)state;
     load_ok("return { bodies = { { mesh = 'bunny' } } }", NULL, 0, &s);
-    assert_mesh(s.world.bodies[0].mesh, "meshes/bunny");
+    assert_mesh(s.sources[0].mesh, "meshes/bunny");
     cf_scene_free(&s);
 }
 
@@ -420,8 +420,8 @@ static void test_new_keys(void **state)
     load_ok(NEW_KEYS_SCENE, NULL, 0, &s);
 
     assert_int_equal(s.world.n_bodies, 6);
-    p = &s.world.bodies[0].primitive;
-    assert_string_equal(s.world.bodies[0].mesh, "");
+    p = &s.sources[0].primitive;
+    assert_string_equal(s.sources[0].mesh, "");
     assert_int_equal(p->type, CF_PRIM_BOX);
     assert_vec(p->size, (const double[]){1, 2, 3}, 3);
     assert_int_equal(p->cells[0], 2);
@@ -432,34 +432,34 @@ static void test_new_keys(void **state)
     assert_int_equal(s.world.bodies[0].has_expansion_center, 1);
     assert_vec(s.world.bodies[0].expansion_center, (const double[]){1, 0, 0}, 3);
 
-    p = &s.world.bodies[1].primitive;
-    assert_string_equal(s.world.bodies[1].mesh, "");
+    p = &s.sources[1].primitive;
+    assert_string_equal(s.sources[1].mesh, "");
     assert_int_equal(p->type, CF_PRIM_SPHERE);
     assert_double_equal(p->radius, 0.5, 0);
     assert_double_equal(p->mesh_size, 0.1, 0);
     assert_vec(s.world.bodies[1].expansion_rate, (const double[]){1, 2, 3}, 3);
     assert_int_equal(s.world.bodies[1].has_expansion_center, 0);
 
-    p = &s.world.bodies[2].primitive;
+    p = &s.sources[2].primitive;
     assert_int_equal(p->type, CF_PRIM_HOLLOW_SPHERE);
     assert_double_equal(p->radius, 0.5, 0);
     assert_double_equal(p->thickness, 0.1, 0);
     assert_double_equal(p->mesh_size, 0.05, 0);
 
-    p = &s.world.bodies[3].primitive;
+    p = &s.sources[3].primitive;
     assert_int_equal(p->type, CF_PRIM_PLATE);
     assert_vec(p->size, (const double[]){1, 1, 0.01}, 3);
     assert_double_equal(p->mesh_size, 0.02, 0);
 
-    p = &s.world.bodies[4].primitive;
+    p = &s.sources[4].primitive;
     assert_int_equal(p->type, CF_PRIM_NOTCHED_BEAM);
     assert_vec(p->size, (const double[]){2, 0.1, 0.2}, 3);
     assert_vec(p->notch, (const double[]){0.1, 0.02, 0.3}, 3);
     assert_double_equal(p->mesh_size, 0.01, 0);
 
     /* A Gmsh file keeps its extension and becomes absolute. */
-    assert_int_equal(s.world.bodies[5].primitive.type, CF_PRIM_NONE);
-    assert_mesh(s.world.bodies[5].mesh, "beam.msh");
+    assert_int_equal(s.sources[5].primitive.type, CF_PRIM_NONE);
+    assert_mesh(s.sources[5].mesh, "beam.msh");
 
     assert_int_equal(s.world.n_boundaries, 3);
     b = &s.world.boundaries[0];
@@ -515,11 +515,11 @@ static void test_new_defaults(void **state)
             "  solver = { mode = 'fracture', crack_plane = { point = {0,0,0}, normal = {0,0,1} },\n"
             "             constraints = 'none', criterion = 'source', xpbd = {}, guard = {} } }",
             NULL, 0, &s);
-    assert_int_equal(s.world.bodies[0].primitive.type, CF_PRIM_BOX);
-    assert_int_equal(s.world.bodies[0].primitive.cells[0], 1);
-    assert_int_equal(s.world.bodies[0].primitive.cells[1], 1);
-    assert_int_equal(s.world.bodies[0].primitive.cells[2], 1);
-    assert_int_equal(s.world.bodies[0].primitive.tets_per_cell, 6);
+    assert_int_equal(s.sources[0].primitive.type, CF_PRIM_BOX);
+    assert_int_equal(s.sources[0].primitive.cells[0], 1);
+    assert_int_equal(s.sources[0].primitive.cells[1], 1);
+    assert_int_equal(s.sources[0].primitive.cells[2], 1);
+    assert_int_equal(s.sources[0].primitive.tets_per_cell, 6);
     assert_int_equal(s.world.n_boundaries, 1);
     assert_double_equal(s.world.boundaries[0].tolerance, 1e-6, 0);
     assert_int_equal(s.world.boundaries[0].axes, 7);
@@ -540,7 +540,7 @@ static void test_new_defaults(void **state)
                                          "bodies[1].expansion_rate={1, 0, 0}"};
         load_ok("return { bodies = { { mesh = { type = 'sphere', radius = 1, mesh_size = 0.1 } } } }",
                 ov, 3, &s);
-        assert_double_equal(s.world.bodies[0].primitive.radius, 0.25, 0);
+        assert_double_equal(s.sources[0].primitive.radius, 0.25, 0);
         assert_int_equal(s.world.solver.constraints, CF_CONSTRAINTS_XPBD);
         assert_vec(s.world.bodies[0].expansion_rate, (const double[]){1, 0, 0}, 3);
         cf_scene_free(&s);
@@ -570,7 +570,7 @@ static void test_overrides(void **state)
     assert_double_equal(s.world.bodies[0].scale, 3, 0);
     assert_int_equal(s.world.solver.iterations, 7);
     assert_int_equal(s.world.n_bodies, 2);
-    assert_mesh(s.world.bodies[1].mesh, "sub/part");
+    assert_mesh(s.sources[1].mesh, "sub/part");
     assert_string_equal(s.name, "a=b");
     assert_true(s.output.file[0] == '/' && strstr(s.output.file, "/out/a=b.h5") != NULL); /* beside the scene */
     assert_double_equal(s.world.material.E, 2e5, 0);
@@ -614,25 +614,26 @@ static void assert_same_scene(const cf_scene *a, const cf_scene *b)
     assert_int_equal(a->world.n_bodies, b->world.n_bodies);
     for (int i = 0; i < a->world.n_bodies; i++) {
         const cf_body_def *x = &a->world.bodies[i], *y = &b->world.bodies[i];
-        assert_string_equal(x->mesh, y->mesh);
+        const cf_body_source *p = &a->sources[i], *q = &b->sources[i];
+        assert_string_equal(p->mesh, q->mesh);
         assert_memory_equal(&x->scale, &y->scale, sizeof x->scale);
         assert_memory_equal(x->position, y->position, sizeof x->position);
         assert_memory_equal(x->orientation, y->orientation, sizeof x->orientation);
         assert_memory_equal(x->velocity, y->velocity, sizeof x->velocity);
         assert_memory_equal(x->angular_velocity, y->angular_velocity, sizeof x->angular_velocity);
-        assert_int_equal(x->primitive.type, y->primitive.type);
-        assert_memory_equal(x->primitive.size, y->primitive.size, sizeof x->primitive.size);
-        assert_memory_equal(x->primitive.cells, y->primitive.cells, sizeof x->primitive.cells);
-        assert_int_equal(x->primitive.tets_per_cell, y->primitive.tets_per_cell);
-        assert_memory_equal(&x->primitive.radius, &y->primitive.radius, sizeof(double));
-        assert_memory_equal(&x->primitive.thickness, &y->primitive.thickness, sizeof(double));
-        assert_memory_equal(x->primitive.notch, y->primitive.notch, sizeof x->primitive.notch);
-        assert_memory_equal(&x->primitive.mesh_size, &y->primitive.mesh_size, sizeof(double));
+        assert_int_equal(p->primitive.type, q->primitive.type);
+        assert_memory_equal(p->primitive.size, q->primitive.size, sizeof p->primitive.size);
+        assert_memory_equal(p->primitive.cells, q->primitive.cells, sizeof p->primitive.cells);
+        assert_int_equal(p->primitive.tets_per_cell, q->primitive.tets_per_cell);
+        assert_memory_equal(&p->primitive.radius, &q->primitive.radius, sizeof(double));
+        assert_memory_equal(&p->primitive.thickness, &q->primitive.thickness, sizeof(double));
+        assert_memory_equal(p->primitive.notch, q->primitive.notch, sizeof p->primitive.notch);
+        assert_memory_equal(&p->primitive.mesh_size, &q->primitive.mesh_size, sizeof(double));
         assert_memory_equal(x->expansion_rate, y->expansion_rate, sizeof x->expansion_rate);
         assert_int_equal(x->has_expansion_center, y->has_expansion_center);
         assert_memory_equal(x->expansion_center, y->expansion_center,
                             sizeof x->expansion_center);
-        assert_int_equal(x->hollow_layers, y->hollow_layers);
+        assert_int_equal(p->hollow_layers, q->hollow_layers);
     }
     assert_int_equal(a->world.n_boundaries, b->world.n_boundaries);
     for (int i = 0; i < a->world.n_boundaries; i++) {
@@ -766,8 +767,8 @@ static void test_shell_obstacle_keys(void **state)
     const cf_obstacle *o;
     (void)state;
     load_ok(SHELL_KEYS_SCENE, NULL, 0, &s);
-    assert_int_equal(s.world.bodies[0].hollow_layers, 2);
-    assert_int_equal(s.world.bodies[1].hollow_layers, 0);
+    assert_int_equal(s.sources[0].hollow_layers, 2);
+    assert_int_equal(s.sources[1].hollow_layers, 0);
 
     assert_int_equal(s.world.n_obstacles, 5);
     o = &s.world.obstacles[0];
@@ -821,7 +822,7 @@ static void test_shell_obstacle_keys(void **state)
         assert_double_equal(s.world.solver.sleep_linear, 0.5, 0);
         assert_double_equal(s.world.solver.sleep_angular, 0.125, 0);
         assert_int_equal(s.world.solver.ccd, 1);
-        assert_int_equal(s.world.bodies[0].hollow_layers, 1);
+        assert_int_equal(s.sources[0].hollow_layers, 1);
         cf_scene_free(&s);
     }
 }

@@ -49,7 +49,7 @@ static void beam_stays_stable(void **state)
     cf_status st = cf_sim_run(sim, &err);
     if (st != CF_OK)
         printf("mixed_mode_beam: %s\n", err.msg);
-    const cf_primitive *b = &sc.world.bodies[0].primitive;
+    const cf_primitive *b = &sc.sources[0].primitive;
     double xt = b->notch[2], zt = -0.5 * b->size[2] + b->notch[0];
     double angle = fabs(crack_angle(&cf_sim_world(sim)->solid, xt, zt, 20));
     printf("mixed_mode_beam: %ld steps, %d tets, %d cohesive elements\n", cf_sim_world(sim)->steps_fracture,

@@ -1,5 +1,5 @@
 /* cohfrac — world definitions: materials, bodies, obstacles, boundary
- * conditions, solver and output settings, as plain C structs with
+ * conditions and solver settings (the physics), as plain C structs with
  * defaults (cf_default_*).  The engine (cohfrac/world.h) is created from a
  * cf_world_def and copies what it needs; the Lua scene loader
  * (cohfrac/scene.h) only fills these structs.  Units are SI throughout;
@@ -11,28 +11,6 @@
 
 #include "cohfrac/error.h"
 #include "cohfrac/tetmesh.h"
-
-/* Meshed primitives (scene bodies with `mesh = {type = ...}`), m. */
-typedef enum {
-    CF_PRIM_NONE = 0,
-    CF_PRIM_BOX,           /* structured, in-engine: size, cells, tets_per_cell */
-    CF_PRIM_SPHERE,        /* gmsh: radius, mesh_size */
-    CF_PRIM_HOLLOW_SPHERE, /* gmsh: radius (outer), thickness, mesh_size */
-    CF_PRIM_PLATE,         /* gmsh: size (x, y, thickness z), mesh_size */
-    CF_PRIM_NOTCHED_BEAM   /* gmsh: size (length x, width y, height z), notch, mesh_size */
-} cf_primitive_type;
-
-typedef struct cf_primitive {
-    cf_primitive_type type;
-    double size[3];     /* box, plate, notched beam: edge lengths along x, y, z, m */
-    int cells[3];       /* box: cells along x, y, z */
-    int tets_per_cell;  /* box: 5 or 6 */
-    double radius;      /* sphere, hollow sphere: outer radius, m */
-    double thickness;   /* hollow sphere: shell thickness, m */
-    double notch[3];    /* notched beam: depth (from the bottom face, z), width (x),
-                           offset of the notch centre from mid-span (x), m */
-    double mesh_size;   /* gmsh characteristic element length, m */
-} cf_primitive;
 
 typedef struct cf_material {
     double E, nu, rho;             /* Pa, -, kg/m^3 */
@@ -66,11 +44,8 @@ typedef struct cf_material {
 typedef struct cf_body_def {
     const cf_mesh *tet_mesh;   /* the body's Tet4 mesh as made (before scale, orientation
                                   and position); not owned, read only by cf_world_create.
-                                  NULL: mesh preparation makes it from `mesh` or
-                                  `primitive` (cf_world_meshes_load, cohfrac/mesh.h) */
-    char mesh[1024];           /* where a loader finds it: resolved path of a TetGen base
-                                  (no extension) or a .msh file; "" for a primitive */
-    cf_primitive primitive;    /* type CF_PRIM_NONE when `mesh` is a file */
+                                  Mesh preparation makes it from where the scene says
+                                  (cf_body_source, cohfrac/mesh.h; cf_world_meshes_load) */
     double scale;
     double position[3];        /* m, where the bounding-box centre goes */
     double orientation[4];     /* w,x,y,z, normalised */
@@ -79,12 +54,6 @@ typedef struct cf_body_def {
     double expansion_rate[3];  /* 1/s, per axis */
     int has_expansion_center;  /* 0: the body's centre of mass */
     double expansion_center[3];/* m */
-    int hollow_layers;         /* > 0: keep only the tets within this many tet
-                                  layers of the surface (a hollow shell); 0 solid */
-    char visual[1024];         /* resolved path of a finer triangle surface of the same
-                                  object, in the mesh's file units, that the output
-                                  carries for drawing (docs/output.md); "" none.  The
-                                  engine does not read it */
 } cf_body_def;
 
 typedef enum { CF_REGION_BOX, CF_REGION_PLANE, CF_REGION_GROUP } cf_region_type;

@@ -88,7 +88,7 @@ static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_crit
     if (st != CF_OK)
         return st;
     cf_mesh m;
-    st = cf_mesh_load_tetgen(sc->world.bodies[0].mesh, &m, err);
+    st = cf_mesh_load_tetgen(sc->sources[0].mesh, &m, err);
     if (st != CF_OK) {
         cf_scene_free(sc);
         return st;
@@ -152,7 +152,7 @@ static double run_peer(const cf_bench_options *o, const cf_scene *sc, cf_error *
     close(fd);
     snprintf(steps, sizeof steps, "%d", o->steps);
     snprintf(dt, sizeof dt, "%.17g", sc->world.solver.dt_fracture);
-    char *argv[] = {(char *)o->peer, (char *)sc->world.bodies[0].mesh, "--steps", steps, "--dt", dt,
+    char *argv[] = {(char *)o->peer, (char *)sc->sources[0].mesh, "--steps", steps, "--dt", dt,
                     "--iterations", "3", NULL};
     pid_t pid;
     int status = 0;

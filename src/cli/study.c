@@ -122,7 +122,7 @@ static double case_cost(cf_scene *scene, const char *mesh_dir)
     cf_world_def *sc = &scene->world;
     cf_world_meshes wm;
     cf_error e;
-    if (cf_world_meshes_load(sc, mesh_dir, &wm, &e) != CF_OK)
+    if (cf_world_meshes_load(sc, scene->sources, mesh_dir, &wm, &e) != CF_OK)
         return 0;
     double tets = 0, dt_cfl = INFINITY;
     for (int b = 0; b < sc->n_bodies; b++) {

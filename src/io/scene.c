@@ -926,7 +926,9 @@ static cf_status read_primitive(loader *ld, int t, cf_primitive *p)
     return CF_OK;
 }
 
-static cf_status read_body(loader *ld, int t, cf_body_def *b)
+/* Body t into b (its placement and motion) and src (where its mesh comes
+ * from). */
+static cf_status read_body(loader *ld, int t, cf_body_def *b, cf_body_source *src)
 {
     static const double one = 1.0;
     lua_State *L = ld->L;
@@ -935,18 +937,18 @@ static cf_status read_body(loader *ld, int t, cf_body_def *b)
     switch (raw_get(L, t, "mesh")) {
     case LUA_TTABLE: {
         size_t old = path_push_key(ld, "mesh");
-        TRY(read_primitive(ld, lua_gettop(L), &b->primitive));
+        TRY(read_primitive(ld, lua_gettop(L), &src->primitive));
         path_pop(ld, old);
         lua_pop(L, 1);
-        b->mesh[0] = '\0';
+        src->mesh[0] = '\0';
         break;
     }
     case LUA_TNIL:
     case LUA_TSTRING:
         lua_pop(L, 1);
         TRY(get_str(ld, t, "mesh", NULL, mesh, sizeof mesh));
-        TRY(resolve_mesh(ld, "mesh", mesh, b->mesh, sizeof b->mesh));
-        b->primitive.type = CF_PRIM_NONE;
+        TRY(resolve_mesh(ld, "mesh", mesh, src->mesh, sizeof src->mesh));
+        src->primitive.type = CF_PRIM_NONE;
         break;
     default:
         return fail(ld, CF_ERR_SCENE_TYPE,
@@ -965,13 +967,13 @@ static cf_status read_body(loader *ld, int t, cf_body_def *b)
         TRY(get_vec(ld, t, "expansion_center", 3, NULL, b->expansion_center));
     }
     lua_pop(L, 1);
-    TRY(get_int(ld, t, "hollow_layers", 0, &NON_NEGATIVE, &b->hollow_layers));
-    b->visual[0] = '\0';
+    TRY(get_int(ld, t, "hollow_layers", 0, &NON_NEGATIVE, &src->hollow_layers));
+    src->visual[0] = '\0';
     if (raw_get(L, t, "visual") != LUA_TNIL) {
         lua_pop(L, 1);
         char visual[1024];
         TRY(get_str(ld, t, "visual", NULL, visual, sizeof visual));
-        TRY(resolve_surface(ld, "visual", visual, b->visual, sizeof b->visual));
+        TRY(resolve_surface(ld, "visual", visual, src->visual, sizeof src->visual));
     } else {
         lua_pop(L, 1);
     }
@@ -1192,13 +1194,14 @@ static cf_status read_scene(loader *ld, int t)
         return fail(ld, CF_ERR_SCENE_VALUE, "'bodies' is empty; a scene needs at least one body");
     li = lua_gettop(L);
     s->bodies = calloc((size_t)n, sizeof s->bodies[0]);
-    if (!s->bodies)
+    sc->sources = calloc((size_t)n, sizeof sc->sources[0]);
+    if (!s->bodies || !sc->sources)
         return fail(ld, CF_ERR_NOMEM, "out of memory for %d bodies", n);
     for (int i = 0; i < n; i++) {
         size_t old = path_push_key(ld, "bodies");
         path_push_index(ld, i + 1);
         lua_rawgeti(L, li, i + 1);
-        TRY(read_body(ld, lua_gettop(L), &s->bodies[i]));
+        TRY(read_body(ld, lua_gettop(L), &s->bodies[i], &sc->sources[i]));
         lua_pop(L, 1);
         path_pop(ld, old);
         s->n_bodies = i + 1;
@@ -1667,11 +1670,12 @@ static char *resolved_text(const cf_scene *sc)
     put(&b, "  },\n  bodies = {\n");
     for (int i = 0; i < s->n_bodies; i++) {
         const cf_body_def *d = &s->bodies[i];
+        const cf_body_source *src = &sc->sources[i];
         put(&b, "    {\n");
-        if (d->primitive.type != CF_PRIM_NONE)
-            put_primitive(&b, 6, &d->primitive);
+        if (src->primitive.type != CF_PRIM_NONE)
+            put_primitive(&b, 6, &src->primitive);
         else
-            put_str(&b, 6, "mesh", d->mesh);
+            put_str(&b, 6, "mesh", src->mesh);
         put_num(&b, 6, "scale", d->scale);
         put_vec(&b, 6, "position", d->position, 3);
         put_vec(&b, 6, "orientation", d->orientation, 4);
@@ -1682,9 +1686,9 @@ static char *resolved_text(const cf_scene *sc)
             put_vec(&b, 6, "expansion_center", d->expansion_center, 3);
         else
             put(&b, "      -- expansion_center: the body's centre of mass\n");
-        put(&b, "      hollow_layers = %d,\n", d->hollow_layers);
-        if (d->visual[0])
-            put_str(&b, 6, "visual", d->visual);
+        put(&b, "      hollow_layers = %d,\n", src->hollow_layers);
+        if (src->visual[0])
+            put_str(&b, 6, "visual", src->visual);
         put(&b, "    },\n");
     }
     put(&b, "  },\n  boundary = {\n");
@@ -1917,6 +1921,7 @@ void cf_scene_free(cf_scene *s)
     if (!s)
         return;
     free(s->world.bodies);
+    free(s->sources);
     free(s->world.obstacles);
     free(s->world.boundaries);
     free(s->resolved);

@@ -148,7 +148,7 @@ static cf_status write_surfaces(cf_sim *sim, cf_frag_info *info, int first, int 
 }
 
 /* The rest mesh into the file, and what the surfaces need of it. */
-static cf_status write_rest_mesh(cf_sim *sim, const cf_world_def *def, cf_error *err)
+static cf_status write_rest_mesh(cf_sim *sim, const cf_scene *sc, cf_error *err)
 {
     cf_world *w = sim->world;
     int nn = cf_world_rest_node_count(w), nt = cf_world_tet_count(w);
@@ -177,7 +177,7 @@ static cf_status write_rest_mesh(cf_sim *sim, const cf_world_def *def, cf_error 
         st = cf_h5_write_rest_mesh(sim->h5, X, nn, sim->rest_tets, nt, err);
     cf_visual vis = {0}; /* the bodies' finer surfaces, riding on the rest tets */
     if (st == CF_OK)
-        st = cf_visual_embed(def, &sim->meshes, X, nn, sim->rest_tets, nt, &vis, err);
+        st = cf_visual_embed(&sc->world, sc->sources, &sim->meshes, X, nn, sim->rest_tets, nt, &vis, err);
     if (st == CF_OK && vis.n_triangles > 0)
         st = cf_h5_write_visual(sim->h5, vis.vertices, vis.n_vertices, vis.triangles, vis.tet,
                                 vis.n_triangles, err);
@@ -342,7 +342,7 @@ cf_status cf_sim_create(const cf_scene *sc, const cf_run_options *opt, cf_sim **
     if (st == CF_OK && sc->output.file[0])
         st = cf_h5_open(sc->output.file, sc->name, sc->resolved, &sim->h5, err);
     if (st == CF_OK)
-        st = cf_world_meshes_load(&w, opt->mesh_dir, &sim->meshes, err);
+        st = cf_world_meshes_load(&w, sc->sources, opt->mesh_dir, &sim->meshes, err);
     if (st == CF_OK)
         st = cf_world_create(&w, &sim->world, err);
     if (st == CF_OK) {
@@ -359,7 +359,7 @@ cf_status cf_sim_create(const cf_scene *sc, const cf_run_options *opt, cf_sim **
         st = write_initial_bounds(sim, err);
         double t0 = cf_wall_time();
         if (st == CF_OK)
-            st = write_rest_mesh(sim, def, err);
+            st = write_rest_mesh(sim, sc, err);
         sim->output_time += cf_wall_time() - t0;
     }
     if (st == CF_OK)

@@ -142,23 +142,24 @@ static int locate(const grid *g, const double *X, const int *tets, const double 
     return best;
 }
 
-cf_status cf_visual_embed(const cf_world_def *def, const cf_world_meshes *meshes,
+cf_status cf_visual_embed(const cf_world_def *def, const cf_body_source *src,
+                          const cf_world_meshes *meshes,
                           const double *X, int nn, const int *tets, int nt, cf_visual *out,
                           cf_error *err)
 {
     memset(out, 0, sizeof *out);
     cf_status st = CF_OK;
     grid g = {0};
-    for (int b = 0; b < def->n_bodies && st == CF_OK; b++) {
+    for (int b = 0; src && b < def->n_bodies && st == CF_OK; b++) {
         const cf_body_def *bd = &def->bodies[b];
-        if (!bd->visual[0])
+        if (!src[b].visual[0])
             continue;
         if (!g.start && grid_build(&g, X, nn, tets, nt) != 0) {
             st = cf_error_set(err, CF_ERR_NOMEM, "out of memory embedding the visual surface");
             break;
         }
         cf_surface s = {0};
-        if ((st = cf_surface_load(bd->visual, &s, err)) != CF_OK) {
+        if ((st = cf_surface_load(src[b].visual, &s, err)) != CF_OK) {
             char why[sizeof err->msg];
             memcpy(why, err->msg, sizeof why);
             cf_error_set(err, st, "bodies[%d].visual: %s", b + 1, why);

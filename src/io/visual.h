@@ -22,12 +22,14 @@ typedef struct cf_visual {
     int *tet;         /* [n_triangles] rest tet holding the triangle */
 } cf_visual;
 
-/* The visual surfaces of def's bodies, placed and embedded in the rest
+/* The visual surfaces of def's bodies (src[b].visual, "" for none), placed
+ * as def places the bodies and embedded in the rest
  * mesh X [nn][3], tets [nt][4] (the world's, after renumbering).
  * `meshes`: the bodies' meshes as loaded (file units), for the placement.
  * An empty result when no body has one.  Errors: those of cf_surface_load
  * (the message names the body), CF_ERR_NOMEM. */
-cf_status cf_visual_embed(const cf_world_def *def, const cf_world_meshes *meshes,
+cf_status cf_visual_embed(const cf_world_def *def, const cf_body_source *src,
+                          const cf_world_meshes *meshes,
                           const double *X, int nn, const int *tets, int nt, cf_visual *out,
                           cf_error *err);
 void cf_visual_free(cf_visual *v);

@@ -24,7 +24,7 @@ const char *cf_default_mesh_dir(void)
     return dir;
 }
 
-static cf_status body_mesh(const cf_body_def *bd, int b, const char *mesh_dir, cf_mesh *m,
+static cf_status body_mesh(const cf_body_source *bd, int b, const char *mesh_dir, cf_mesh *m,
                            cf_error *err)
 {
     cf_status st = bd->primitive.type != CF_PRIM_NONE
@@ -47,8 +47,8 @@ static cf_status body_mesh(const cf_body_def *bd, int b, const char *mesh_dir, c
     return st;
 }
 
-cf_status cf_world_meshes_load(cf_world_def *def, const char *mesh_dir, cf_world_meshes *out,
-                               cf_error *err)
+cf_status cf_world_meshes_load(cf_world_def *def, const cf_body_source *src, const char *mesh_dir,
+                               cf_world_meshes *out, cf_error *err)
 {
     memset(out, 0, sizeof *out);
     if (!mesh_dir)
@@ -59,9 +59,9 @@ cf_status cf_world_meshes_load(cf_world_def *def, const char *mesh_dir, cf_world
     cf_status st = out->bodies && out->obstacles
                        ? CF_OK
                        : cf_error_set(err, CF_ERR_NOMEM, "out of memory for the scene's meshes");
-    for (int b = 0; b < def->n_bodies && st == CF_OK; b++)
+    for (int b = 0; src && b < def->n_bodies && st == CF_OK; b++)
         if (!def->bodies[b].tet_mesh)
-            st = body_mesh(&def->bodies[b], b, mesh_dir, &out->bodies[b], err);
+            st = body_mesh(&src[b], b, mesh_dir, &out->bodies[b], err);
     for (int j = 0; j < def->n_obstacles && st == CF_OK; j++) {
         const cf_obstacle *o = &def->obstacles[j];
         if (o->type != CF_OBSTACLE_MESH || o->vertices)
@@ -75,7 +75,7 @@ cf_status cf_world_meshes_load(cf_world_def *def, const char *mesh_dir, cf_world
         cf_world_meshes_free(out);
         return st;
     }
-    for (int b = 0; b < def->n_bodies; b++)
+    for (int b = 0; src && b < def->n_bodies; b++)
         if (!def->bodies[b].tet_mesh)
             def->bodies[b].tet_mesh = &out->bodies[b];
     for (int j = 0; j < def->n_obstacles; j++) {

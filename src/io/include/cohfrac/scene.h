@@ -211,6 +211,7 @@
 #define COHFRAC_SCENE_H
 
 #include "cohfrac/error.h"
+#include "cohfrac/mesh.h"
 #include "cohfrac/types.h"
 
 /* Where and what a run writes (the scene's `output` table). */
@@ -229,6 +230,8 @@ typedef struct cf_scene {
                                     messages, the HDF5 root's attribute */
     double duration;             /* s of simulated time */
     cf_world_def world;          /* what cf_world_create builds */
+    cf_body_source *sources;     /* [world.n_bodies]: where each body's mesh comes from
+                                    (mesh preparation makes world.bodies[i].tet_mesh) */
     cf_output_settings output;
     char *resolved;              /* the resolved scene as Lua text (every key, defaults
                                     filled, mesh paths absolute); loading it again gives

@@ -12,6 +12,43 @@
 #include "cohfrac/tetmesh.h"
 #include "cohfrac/types.h"
 
+/* Meshed primitives (scene bodies with `mesh = {type = ...}`), m. */
+typedef enum {
+    CF_PRIM_NONE = 0,
+    CF_PRIM_BOX,           /* structured, in-engine: size, cells, tets_per_cell */
+    CF_PRIM_SPHERE,        /* gmsh: radius, mesh_size */
+    CF_PRIM_HOLLOW_SPHERE, /* gmsh: radius (outer), thickness, mesh_size */
+    CF_PRIM_PLATE,         /* gmsh: size (x, y, thickness z), mesh_size */
+    CF_PRIM_NOTCHED_BEAM   /* gmsh: size (length x, width y, height z), notch, mesh_size */
+} cf_primitive_type;
+
+typedef struct cf_primitive {
+    cf_primitive_type type;
+    double size[3];     /* box, plate, notched beam: edge lengths along x, y, z, m */
+    int cells[3];       /* box: cells along x, y, z */
+    int tets_per_cell;  /* box: 5 or 6 */
+    double radius;      /* sphere, hollow sphere: outer radius, m */
+    double thickness;   /* hollow sphere: shell thickness, m */
+    double notch[3];    /* notched beam: depth (from the bottom face, z), width (x),
+                           offset of the notch centre from mid-span (x), m */
+    double mesh_size;   /* gmsh characteristic element length, m */
+} cf_primitive;
+
+/* Where mesh preparation finds or makes a body's Tet4 mesh, and the finer
+ * surface that the output draws: a scene's bodies[i].mesh, hollow_layers
+ * and visual.  The engine's cf_body_def holds the mesh made from it. */
+typedef struct cf_body_source {
+    char mesh[1024];           /* where a loader finds it: resolved path of a TetGen base
+                                  (no extension) or a .msh file; "" for a primitive */
+    cf_primitive primitive;    /* type CF_PRIM_NONE when `mesh` is a file */
+    int hollow_layers;         /* > 0: keep only the tets within this many tet
+                                  layers of the surface (a hollow shell); 0 solid */
+    char visual[1024];         /* resolved path of a finer triangle surface of the same
+                                  object, in the mesh's file units, that the output
+                                  carries for drawing (docs/output.md); "" none */
+} cf_body_source;
+
+
 /* Load TetGen files `<base>.node` and `<base>.ele` (`base` may also be given
  * with either extension).  Accepts 0- or 1-based numbering (taken from the
  * first node index), `#` comments, blank lines, attributes and boundary

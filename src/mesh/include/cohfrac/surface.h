@@ -177,24 +177,25 @@ typedef struct cf_mesh_prep_opts {
 cf_status cf_mesh_prepare(const cf_mesh_prep_opts *opts, cf_error *err);
 
 /* The meshes a world definition names, made by mesh preparation: each
- * body's Tet4 mesh (a prepared mesh or file, or a primitive meshed and
- * cached in `mesh_dir`; then hollowed when bodies[i].hollow_layers > 0) and
- * each mesh obstacle's surface.  Owns them; cf_world_meshes_free releases. */
+ * body's Tet4 mesh from its source (a prepared mesh or file, or a
+ * primitive meshed and cached in `mesh_dir`; then hollowed when
+ * hollow_layers > 0) and each mesh obstacle's surface.  Owns them; cf_world_meshes_free releases. */
 typedef struct cf_world_meshes {
     int n_bodies, n_obstacles;
     cf_mesh *bodies;        /* [n_bodies] */
     cf_surface *obstacles;  /* [n_obstacles], empty for other types */
 } cf_world_meshes;
 
-/* Make what `def` needs and point def->bodies[i].tet_mesh and the mesh
- * obstacles' vertices/triangles at it (those already set are kept).
+/* Make what `def` needs and point def->bodies[i].tet_mesh (from src[i],
+ * src[def->n_bodies]; NULL makes no body mesh) and the mesh obstacles'
+ * vertices/triangles at it (those already set are kept).
  * `mesh_dir`: where primitives are meshed and cached (NULL: the user's
  * mesh cache, cf_default_mesh_dir).  Errors: those of cf_mesh_load,
  * cf_mesh_primitive, cf_mesh_hollow (the message names the body) and
  * cf_surface_load; CF_ERR_SCENE_VALUE for a surface with no triangle.
  * On error `out` is left empty and `def` unchanged. */
-cf_status cf_world_meshes_load(cf_world_def *def, const char *mesh_dir, cf_world_meshes *out,
-                               cf_error *err);
+cf_status cf_world_meshes_load(cf_world_def *def, const cf_body_source *src, const char *mesh_dir,
+                               cf_world_meshes *out, cf_error *err);
 void cf_world_meshes_free(cf_world_meshes *m);
 
 /* Where prepared meshes and meshed primitives live when no directory is
