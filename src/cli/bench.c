@@ -63,43 +63,62 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/* The bench scene for `mesh` under `criterion`: the half height of the
- * mesh along its y axis (z once rotated) puts its lowest point on the plane. */
-static cf_status make_scene(const cf_bench_options *o, const char *mesh, cf_criterion criterion,
-                            cf_scene *sc, cf_error *err)
+/* The bench scene for the prepared mesh `name` under `criterion`, built in
+ * C: the source's bunny drop (its material and PBD settings, Table 6.1),
+ * in fracture mode from the first step, the body turned onto its side
+ * with its lowest point on the floor, falling at 4.43 m/s.  The mesh is
+ * loaded once, here, and kept in *mesh for every world made from the
+ * scene (the engine copies it; cf_mesh_free releases it).  Errors: those
+ * of cf_mesh_load_tetgen, named with the advice to prepare the mesh;
+ * CF_ERR_NOMEM. */
+static cf_status make_scene(const cf_bench_options *o, const char *name, cf_criterion criterion,
+                            cf_scene *sc, cf_mesh *mesh, cf_error *err)
 {
-    static const char *fmt =
-        "return {\n"
-        "  name = 'bench', duration = 1, gravity = {0, 0, -9.81},\n"
-        "  material = {E = 0.6, nu = 0.23, rho = 2400, G_I = 22, sigma_max = 1e-4, alpha = 2,\n"
-        "              friction = 0.5, restitution = 0},\n"
-        "  bodies = {{mesh = [==[%s]==], orientation = {0.7071067811865476, 0.7071067811865476, 0, "
-        "0},\n"
-        "             position = {0, 0, 0}, velocity = {0, 0, -4.43}}},\n"
-        "  obstacles = {{type = 'plane', point = {0, 0, %.17g}, normal = {0, 0, 1}}},\n"
-        "  solver = {mode = 'fracture', dt_rigid = 5e-6, dt_fracture = 5e-6, criterion = '%s',\n"
-        "            pbd = {k_stiffness = 0.9, iterations = 3, k_damping = 1}},\n"
-        "  output = {file = ''},\n"
-        "}\n";
-    /* The scene's mesh lookup first, then the mesh itself for its extent. */
-    char text[4096];
-    snprintf(text, sizeof text, fmt, mesh, 0.0, criterion_name[criterion]);
-    cf_status st = cf_scene_load_text("bench scene", text, NULL, 0, o->mesh_dir, sc, err);
-    if (st != CF_OK)
-        return st;
-    cf_mesh m;
-    st = cf_mesh_load_tetgen(sc->sources[0].mesh, &m, err);
+    *sc = cf_default_scene();
+    memset(mesh, 0, sizeof *mesh);
+    snprintf(sc->name, sizeof sc->name, "bench");
+    sc->duration = 1;
+    sc->output.file[0] = '\0';
+    cf_world_def *w = &sc->world;
+    cf_material *mat = &w->material;
+    mat->E = 0.6, mat->nu = 0.23, mat->rho = 2400;
+    mat->G_I = mat->G_II = 22, mat->sigma_max = mat->tau_max = 1e-4, mat->alpha = mat->beta = 2;
+    mat->friction = 0.5, mat->restitution = 0;
+    cf_solver_settings *so = &w->solver;
+    so->mode = CF_RUN_FRACTURE, so->criterion = criterion;
+    so->dt_rigid = so->dt_fracture = 5e-6;
+    so->k_stiffness = 0.9, so->iterations = 3, so->k_damping = 1;
+    w->bodies = calloc(1, sizeof *w->bodies);
+    w->obstacles = calloc(1, sizeof *w->obstacles);
+    sc->sources = calloc(1, sizeof *sc->sources);
+    if (!w->bodies || !w->obstacles || !sc->sources) {
+        cf_scene_free(sc);
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for the bench scene");
+    }
+    w->n_bodies = w->n_obstacles = 1;
+    snprintf(sc->sources[0].mesh, sizeof sc->sources[0].mesh, "%s/%s", o->mesh_dir, name);
+    cf_error why = {0};
+    cf_status st = cf_mesh_load_tetgen(sc->sources[0].mesh, mesh, &why);
     if (st != CF_OK) {
         cf_scene_free(sc);
-        return st;
+        return cf_error_set(err, st, "bench mesh '%s': %s (prepare it with `make meshes`, or "
+                                     "`cohfrac mesh SURFACE -o %s/%s`)",
+                            name, why.msg, o->mesh_dir, name);
     }
+    /* Turned a quarter about x (the mesh's y axis up becomes z), so the
+     * half height along y puts the lowest point on the plane z = 0. */
     double lo = INFINITY, hi = -INFINITY;
-    for (int i = 0; i < m.n_nodes; i++)
-        lo = fmin(lo, m.x[3 * i + 1]), hi = fmax(hi, m.x[3 * i + 1]);
-    cf_mesh_free(&m);
-    cf_scene_free(sc);
-    snprintf(text, sizeof text, fmt, mesh, -0.5 * (hi - lo), criterion_name[criterion]);
-    return cf_scene_load_text("bench scene", text, NULL, 0, o->mesh_dir, sc, err);
+    for (int i = 0; i < mesh->n_nodes; i++)
+        lo = fmin(lo, mesh->x[3 * i + 1]), hi = fmax(hi, mesh->x[3 * i + 1]);
+    cf_body_def *b = &w->bodies[0];
+    *b = cf_default_body();
+    b->tet_mesh = mesh;
+    b->orientation[0] = b->orientation[1] = 0.7071067811865476;
+    b->orientation[2] = b->orientation[3] = 0;
+    b->velocity[2] = -4.43;
+    w->obstacles[0] = cf_default_obstacle(CF_OBSTACLE_PLANE);
+    w->obstacles[0].point[2] = -0.5 * (hi - lo);
+    return CF_OK;
 }
 
 typedef struct sample {
@@ -208,7 +227,8 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
     int reps = o->repeats < 1 ? 1 : o->repeats > 64 ? 64 : o->repeats;
     FILE *log = o->log;
     cf_scene sc;
-    cf_status st = make_scene(o, o->mesh, o->criterion, &sc, err);
+    cf_mesh mesh;
+    cf_status st = make_scene(o, o->mesh, o->criterion, &sc, &mesh, err);
     if (st != CF_OK)
         return st;
     r->threads = nt;
@@ -244,7 +264,7 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
         }
     }
     if (st != CF_OK) {
-        cf_scene_free(&sc);
+        cf_scene_free(&sc), cf_mesh_free(&mesh);
         return st;
     }
     cf_step_stats *z = &sn[0].stats;
@@ -295,7 +315,7 @@ cf_status cf_bench_run(const cf_bench_options *o, cf_bench_result *r, cf_error *
             fprintf(log, " peer_ratio=%.2f", r->peer_ratio);
         fputc('\n', log);
     }
-    cf_scene_free(&sc);
+    cf_scene_free(&sc), cf_mesh_free(&mesh);
     return CF_OK;
 }
 
@@ -307,17 +327,18 @@ cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes,
     FILE *log = o->log;
     *bytes_per_tet = 0;
     cf_scene *sc = calloc((size_t)(n > 0 ? n : 1), sizeof *sc);
+    cf_mesh *mesh = calloc((size_t)(n > 0 ? n : 1), sizeof *mesh);
     sample *last = calloc((size_t)(n > 0 ? n : 1), sizeof *last);
     double *best = malloc((size_t)(n > 0 ? n : 1) * sizeof *best);
-    if (!sc || !last || !best) {
-        free(sc), free(last), free(best);
+    if (!sc || !mesh || !last || !best) {
+        free(sc), free(mesh), free(last), free(best);
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for the scaling bench");
     }
     int made = 0; /* scenes made (a failed one holds nothing) */
     cf_status st = CF_OK;
     while (made < n && st == CF_OK) {
         best[made] = INFINITY;
-        st = make_scene(o, meshes[made], CF_CRITERION_NONE, &sc[made], err);
+        st = make_scene(o, meshes[made], CF_CRITERION_NONE, &sc[made], &mesh[made], err);
         made += st == CF_OK;
     }
     if (st == CF_OK && log)
@@ -353,8 +374,8 @@ cf_status cf_bench_scaling(const cf_bench_options *o, const char *const *meshes,
                     best[i], 1e6 * best[i] / tets, bpt);
     }
     for (int i = 0; i < made; i++)
-        cf_scene_free(&sc[i]);
-    free(sc), free(last), free(best);
+        cf_scene_free(&sc[i]), cf_mesh_free(&mesh[i]);
+    free(sc), free(mesh), free(last), free(best);
     if (st != CF_OK)
         return st;
     *exponent = n > 1 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 1;
