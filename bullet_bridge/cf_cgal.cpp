@@ -19,6 +19,7 @@
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/stitch_borders.h>
@@ -343,6 +344,42 @@ int cfc_wrap_surface(const double *verts, int nv, const int *tris, int nt, doubl
         set_error("out of memory in CGAL's alpha wrapping");
     } catch (...) {
         set_error("CGAL's alpha wrapping failed");
+    }
+    return -1;
+}
+
+int cfc_remesh_surface(const double *verts, int nv, const int *tris, int nt, double edge,
+                       double **v_out, int *nv_out, int **tri_out, int *nt_out)
+{
+    if (!verts || !tris || !v_out || !nv_out || !tri_out || !nt_out || nv < 3 || nt < 1 ||
+        !(edge > 0) || !std::isfinite(edge)) {
+        set_error("cfc_remesh_surface: no surface, or an edge length that is not positive");
+        return -1;
+    }
+    try {
+        std::vector<Ki::Point_3> p;
+        p.reserve((std::size_t)nv);
+        for (int i = 0; i < nv; i++)
+            p.emplace_back(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
+        std::vector<std::array<std::size_t, 3>> f((std::size_t)nt);
+        for (int t = 0; t < nt; t++)
+            for (int k = 0; k < 3; k++)
+                f[(std::size_t)t][(std::size_t)k] = (std::size_t)tris[3 * t + k];
+        Mesh_inexact m;
+        if (!CGAL::Polygon_mesh_processing::is_polygon_soup_a_polygon_mesh(f)) {
+            set_error("cfc_remesh_surface: the surface is not a manifold mesh");
+            return -1;
+        }
+        CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(p, f, m);
+        CGAL::Polygon_mesh_processing::isotropic_remeshing(
+            faces(m), edge, m,
+            CGAL::parameters::number_of_iterations(CFC_REMESH_ITERATIONS));
+        m.collect_garbage();
+        return copy_out(m, v_out, nv_out, tri_out, nt_out);
+    } catch (const std::bad_alloc &) {
+        set_error("out of memory in CGAL's isotropic remeshing");
+    } catch (...) {
+        set_error("CGAL's isotropic remeshing failed");
     }
     return -1;
 }

@@ -77,6 +77,19 @@ int cfc_repair_surface(const double *verts, int nv, const int *tris, int nt, dou
 int cfc_wrap_surface(const double *verts, int nv, const int *tris, int nt, double alpha,
                      double offset, double **v_out, int *nv_out, int **tri_out, int *nt_out);
 
+/* CGAL's isotropic remeshing (Polygon Mesh Processing,
+ * isotropic_remeshing; Botsch and Kobbelt, SGP 2004) of a closed
+ * manifold triangle surface: edges split, collapsed and flipped towards
+ * `edge` (input units, > 0) and vertices smoothed tangentially and
+ * projected back onto the input, CFC_REMESH_ITERATIONS times.  Its
+ * triangles are near equilateral, which the skinny ones of a decimation
+ * are not: a tet with a sliver face on the surface sets the explicit
+ * step (docs/physics.md §3.1).  The result may intersect itself: the
+ * caller checks.  Outputs and errors as cfc_repair_surface. */
+#define CFC_REMESH_ITERATIONS 5
+int cfc_remesh_surface(const double *verts, int nv, const int *tris, int nt, double edge,
+                       double **v_out, int *nv_out, int **tri_out, int *nt_out);
+
 /* Message of the last failure of this thread. */
 const char *cfc_last_error(void);
 

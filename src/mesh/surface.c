@@ -1145,6 +1145,14 @@ cf_status cf_surface_wrap(cf_surface *s, double alpha, double offset, cf_error *
     return run_repair(s, args, ignored, sizeof ignored, err);
 }
 
+cf_status cf_surface_remesh(cf_surface *s, double edge, cf_error *err)
+{
+    char e[32], ignored[8];
+    snprintf(e, sizeof e, "%.17g", edge);
+    const char *const args[] = {"remesh", e, NULL};
+    return run_repair(s, args, ignored, sizeof ignored, err);
+}
+
 /* ====================================================================== */
 /* Decimation (meshoptimizer)                                             */
 /* ====================================================================== */

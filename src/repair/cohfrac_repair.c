@@ -5,6 +5,7 @@
  *
  *   cohfrac-repair repair IN OUT
  *   cohfrac-repair wrap ALPHA OFFSET IN OUT
+ *   cohfrac-repair remesh EDGE IN OUT
  *
  * IN and OUT are surface hand-over files (src/mesh/surface_raw.h: doubles,
  * so nothing is rounded on the way).  On success writes OUT and, for
@@ -28,9 +29,11 @@ int main(int argc, char **argv)
 {
     int repair = argc == 4 && strcmp(argv[1], "repair") == 0;
     int wrap = argc == 6 && strcmp(argv[1], "wrap") == 0;
-    if (!repair && !wrap) {
+    int remesh = argc == 5 && strcmp(argv[1], "remesh") == 0;
+    if (!repair && !wrap && !remesh) {
         fprintf(stderr, "usage: cohfrac-repair repair IN OUT\n"
-                        "       cohfrac-repair wrap ALPHA OFFSET IN OUT\n");
+                        "       cohfrac-repair wrap ALPHA OFFSET IN OUT\n"
+                        "       cohfrac-repair remesh EDGE IN OUT\n");
         return 2;
     }
     const char *in = argv[argc - 2], *out = argv[argc - 1];
@@ -43,6 +46,14 @@ int main(int argc, char **argv)
     cfc_repair_report r = {0};
     if (repair) {
         rc = cfc_repair_surface(s.v, s.n_verts, s.tri, s.n_tris, &v, &nv, &tri, &nt, &r);
+    } else if (remesh) {
+        char *e;
+        double edge = strtod(argv[2], &e);
+        if (*e || !(edge > 0)) {
+            fprintf(stderr, "error: EDGE must be a number > 0\n");
+            return 2;
+        }
+        rc = cfc_remesh_surface(s.v, s.n_verts, s.tri, s.n_tris, edge, &v, &nv, &tri, &nt);
     } else {
         char *e1, *e2;
         double alpha = strtod(argv[2], &e1), offset = strtod(argv[3], &e2);

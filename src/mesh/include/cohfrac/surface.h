@@ -100,6 +100,13 @@ cf_status cf_surface_repair(cf_surface *s, char *report, size_t len, cf_error *e
  * CF_ERR_MESH_PARSE when CGAL fails, CF_ERR_NOMEM. */
 cf_status cf_surface_wrap(cf_surface *s, double alpha, double offset, cf_error *err);
 
+/* Replace the closed manifold `s` by its isotropic remeshing towards edge
+ * length `edge` (file units; CGAL, bullet_bridge/cf_cgal.h, run in
+ * cohfrac-repair): near-equilateral triangles on the same shape, so that
+ * no tet with a face on the surface is a sliver (docs/physics.md §3.1).
+ * The result may intersect itself: check it.  Errors as cf_surface_wrap. */
+cf_status cf_surface_remesh(cf_surface *s, double edge, cf_error *err);
+
 /* Reduce to about `target_tris` triangles with meshoptimizer's
  * topology-preserving edge collapse (meshopt_simplify, Debian
  * libmeshoptimizer-dev: quadric error, no flipped triangles, the kept
