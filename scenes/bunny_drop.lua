@@ -14,21 +14,20 @@
 -- crushing at 3.75 MPa (7.5 sigma_max, as the plaster).
 -- Method: the explicit fracture mode of the plaster drop
 -- (plaster_bunny_drop.lua): constraints "none" at 0.5 dt_cfl, penalty floor.
--- Mesh: the bunny at about 4,000 tets (`bunny_4k`, 3,858 tets once its
--- boundary caps are peeled; dt_cfl 2.8 us).  `bunny_small` (14,390 tets)
--- has slivers: dt_cfl 0.45 us, and the run takes 7 minutes.
+-- Mesh: the bunny at about 4,000 tets (`bunny_4k`, 3,867 tets on its
+-- remeshed surface; dt_cfl 10.6 us, docs/physics.md §3.1).
 -- The chapter's own values, on the chapter's PBD fracture mode:
 --   --set material.E=0.6 --set material.sigma_max=1e-4 --set material.G_I=22
 --   --set material.compressive_strength=0 --set solver.constraints="pbd"
 --   --set solver.cfl_fraction=0 --set solver.dt_fracture=5e-6
 --   --set solver.obstacle_contact="kinematic" --set solver.debris_size=0
 -- (it lands whole; scenes/source/bunny_drop.lua runs it on bunny_small).
--- Expected (2026-11-25, seed 1): 191 fragments, 3 pieces of at least 5 %
--- (33.5 % the body, 12.4 % the head and ears, 8.7 % between them), 12 of
--- at least 1 %, no chip, 1.5 % of the mass as debris; of the 41.9 kJ it
--- lands with, 30.4 kJ go into crushing the base and 0.34 kJ into the
--- cracks; the fastest piece 5.2 m/s against the bound 8.8 m/s; about 30 s.
--- Seeds 2 and 3 give 2 pieces (45.0, 10.9 %) and 3 (27.6, 23.6, 14.0 %).
+-- Expected (2026-11-25, seed 1): 198 fragments, 3 pieces of at least 5 %
+-- (23.4, 13.6, 7.8 %), 13 of at least 1 %, no chip, 0.1 % of the mass as
+-- debris; 29.1 kJ go into crushing the base and 0.34 kJ into the cracks;
+-- the fastest piece 5.9 m/s against the bound 8.8 m/s; about 9 s on two
+-- threads.  Seeds 2 and 3 give 5 pieces (13.0, 12.5, 8.8, 6.1, 5.3 %) and
+-- 3 (18.2, 10.2, 9.4 %).
 return {
   name = "bunny_drop",
   duration = 0.6,               -- 0.15 s after the impact

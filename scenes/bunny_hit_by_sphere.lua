@@ -12,7 +12,7 @@
 -- and G_I 2.5 N/m, so the cohesive length E G_I / sigma^2 is 0.12 m, as in
 -- Fig 6.3.
 -- Hollow: hollow_layers = 1 keeps the tets within one tet layer of the
--- surface (3,142 of `bunny_4k`'s 3,858).  The sphere is a kinematic
+-- surface (2,883 of `bunny_4k`'s 3,867).  The sphere is a kinematic
 -- obstacle (radius 0.3 m, ours) moving along +x at 10 m/s through the
 -- bunny at z = 0.8 m; it cannot be slowed.  The bunny is 2 m tall (the
 -- mesh's own units); it starts 2 cm above the plane and settles by
@@ -27,11 +27,11 @@
 --   --set solver.cfl_fraction=0 --set solver.dt_fracture=3e-6
 --   --set solver.obstacle_contact="kinematic" --set solver.debris_size=0
 -- Expected (2026-11-25, seed 1): the shell shatters where the sphere
--- passes and the rest is driven ahead of it: 286 fragments, the largest
--- 15.3 %, 3 pieces of at least 5 % (15.3, 6.4, 6.2 %), 14 of at least 1 %,
--- no chip, 2.7 % of the mass as debris; the fastest piece 13.3 m/s against
--- the bound 29.1 m/s; about 40 s.  Seeds 2 and 3 shatter finer: the
--- largest piece 11.3 % and under 5 % (docs/scenes.md).
+-- passes and the rest is driven ahead of it: 168 fragments, the largest
+-- 12.4 %, 3 pieces of at least 5 % (12.4, 12.0, 7.8 %), 12 of at least 1 %,
+-- no chip, no debris to speak of; the fastest piece 12.7 m/s against the
+-- bound 29.0 m/s; about 10 s on two threads.  Seeds 2 and 3 leave 3
+-- pieces of at least 5 % too, the largest 8.6 and 11.1 % (docs/scenes.md).
 -- plausibility: --set duration=0.2
 return {
   name = "bunny_hit_by_sphere",
