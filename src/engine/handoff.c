@@ -162,6 +162,16 @@ static void place_rigid(cf_solid *s, const cf_fragment *f, const double com[3], 
             s->v[3 * a + k] = v[k] + wr[k];
         }
     }
+    /* Every tet's corotational rotation is now R exactly: its warm start.
+     * The one it kept is the pose it left fracture mode in, and the body
+     * may have turned by anything since; from far off, the polar
+     * iteration's ten turns stop short of R, and the tets start with a
+     * strain no motion made (a tumbling 14-tet piece re-entering fracture
+     * mode booked 4.7 J of plastic work, docs/physics.md §14.22). */
+    double q[4];
+    mat_to_quat(R, q);
+    for (int i = 0; i < f->nt; i++)
+        memcpy(&s->rq[4 * f->tets[i]], q, sizeof q);
 }
 
 /* How deep fragment f's nodes reach into obstacle j (m, <= 0), and the
