@@ -27,11 +27,10 @@
 --   --set solver.cfl_fraction=0 --set solver.dt_fracture=3e-6
 --   --set solver.obstacle_contact="kinematic" --set solver.debris_size=0
 -- Expected (2026-11-25, seed 1): the shell shatters where the sphere
--- passes and the rest is driven ahead of it: 168 fragments, the largest
--- 12.4 %, 3 pieces of at least 5 % (12.4, 12.0, 7.8 %), 12 of at least 1 %,
+-- passes and the rest is driven ahead of it: 178 fragments, the largest
+-- 12.0 %, 3 pieces of at least 5 % (12.0, 8.2, 7.8 %), 12 of at least 1 %,
 -- no chip, no debris to speak of; the fastest piece 12.7 m/s against the
--- bound 29.0 m/s; about 10 s on two threads.  Seeds 2 and 3 leave 3
--- pieces of at least 5 % too, the largest 8.6 and 11.1 % (docs/scenes.md).
+-- bound 29.0 m/s; about 10 s on two threads (docs/scenes.md).
 -- plausibility: --set duration=0.2
 return {
   name = "bunny_hit_by_sphere",
