@@ -284,6 +284,20 @@ int repair(const double *verts, int nv, const int *tris, int nt, double **v_out,
 
 }  // namespace
 
+// The surface as a soup of points and triangles (inexact kernel): what
+// alpha wrapping and remeshing start from.
+static void triangle_soup(const double *verts, int nv, const int *tris, int nt,
+                          std::vector<Ki::Point_3> &p, std::vector<std::array<std::size_t, 3>> &f)
+{
+    p.reserve((std::size_t)nv);
+    for (int i = 0; i < nv; i++)
+        p.emplace_back(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
+    f.resize((std::size_t)nt);
+    for (int t = 0; t < nt; t++)
+        for (int k = 0; k < 3; k++)
+            f[(std::size_t)t][(std::size_t)k] = (std::size_t)tris[3 * t + k];
+}
+
 extern "C" {
 
 int cfc_repair_surface(const double *verts, int nv, const int *tris, int nt, double **v_out,
@@ -330,13 +344,8 @@ int cfc_wrap_surface(const double *verts, int nv, const int *tris, int nt, doubl
     }
     try {
         std::vector<Ki::Point_3> p;
-        p.reserve((std::size_t)nv);
-        for (int i = 0; i < nv; i++)
-            p.emplace_back(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
-        std::vector<std::array<std::size_t, 3>> f((std::size_t)nt);
-        for (int t = 0; t < nt; t++)
-            for (int k = 0; k < 3; k++)
-                f[(std::size_t)t][(std::size_t)k] = (std::size_t)tris[3 * t + k];
+        std::vector<std::array<std::size_t, 3>> f;
+        triangle_soup(verts, nv, tris, nt, p, f);
         Mesh_inexact w;
         CGAL::alpha_wrap_3(p, f, alpha, offset, w);
         return copy_out(w, v_out, nv_out, tri_out, nt_out);
@@ -358,13 +367,8 @@ int cfc_remesh_surface(const double *verts, int nv, const int *tris, int nt, dou
     }
     try {
         std::vector<Ki::Point_3> p;
-        p.reserve((std::size_t)nv);
-        for (int i = 0; i < nv; i++)
-            p.emplace_back(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]);
-        std::vector<std::array<std::size_t, 3>> f((std::size_t)nt);
-        for (int t = 0; t < nt; t++)
-            for (int k = 0; k < 3; k++)
-                f[(std::size_t)t][(std::size_t)k] = (std::size_t)tris[3 * t + k];
+        std::vector<std::array<std::size_t, 3>> f;
+        triangle_soup(verts, nv, tris, nt, p, f);
         Mesh_inexact m;
         if (!CGAL::Polygon_mesh_processing::is_polygon_soup_a_polygon_mesh(f)) {
             set_error("cfc_remesh_surface: the surface is not a manifold mesh");

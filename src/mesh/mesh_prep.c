@@ -540,6 +540,22 @@ static int more_tris(int tris)
     return n > tris ? n : tris + 2;
 }
 
+/* A coarsened surface `out` with n self-intersecting pairs and closed
+ * (cf_surface_check_closed's answer): 1 when it is clean and kept;
+ * otherwise freed, and 0, or -1 with `err` set when a check ran out of
+ * memory. */
+static int keep_if_clean(cf_surface *out, int n, int closed, cf_error *err)
+{
+    if (n == 0 && closed == 1)
+        return 1;
+    cf_surface_free(out);
+    if (n < 0 || closed < 0) {
+        cf_error_set(err, CF_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
 /* Decimate a copy of `full` to about `tris` triangles, without
  * self-intersections or folds: retried with 15 % more triangles each time
  * (meshoptimizer does not promise either) while the count stays below
@@ -567,13 +583,9 @@ static int decimate_clean(const cf_surface *full, int tris, int limit, cf_surfac
                     "%.9g; %d intersecting pairs%s\n",
                     got, out->n_verts, tris, cf_wall_time() - t0, cf_surface_volume(out), n,
                     closed == 0 ? "; folded (not a closed manifold)" : "");
-        if (n == 0 && closed == 1)
-            return 1;
-        cf_surface_free(out);
-        if (n < 0 || closed < 0) {
-            cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-            return -1;
-        }
+        int kept = keep_if_clean(out, n, closed, err);
+        if (kept != 0)
+            return kept;
     }
     return 0;
 }
@@ -621,14 +633,7 @@ static int remesh_clean(const cf_surface *full, int tris, cf_surface *out, int v
                 cf_surface_volume(out), n, closed == 0 ? "; not a closed manifold" : "");
     else if (verbose)
         fprintf(stderr, "  no remeshing (%s): decimating instead\n", why.msg);
-    if (st == CF_OK && n == 0 && closed == 1)
-        return 1;
-    cf_surface_free(out);
-    if (n < 0 || closed < 0) {
-        cf_error_set(err, CF_ERR_NOMEM, "out of memory");
-        return -1;
-    }
-    return 0;
+    return keep_if_clean(out, n, closed, err);
 }
 
 /* A clean decimation that needs more than WRAP_AFTER times the triangles
