@@ -74,11 +74,9 @@ static double median(double *v, int n)
 static cf_status make_scene(const cf_bench_options *o, const char *name, cf_criterion criterion,
                             cf_scene *sc, cf_mesh *mesh, cf_error *err)
 {
-    *sc = cf_default_scene();
+    *sc = cf_default_scene(); /* 1 s, no output file */
     memset(mesh, 0, sizeof *mesh);
     snprintf(sc->name, sizeof sc->name, "bench");
-    sc->duration = 1;
-    sc->output.file[0] = '\0';
     cf_world_def *w = &sc->world;
     cf_material *mat = &w->material;
     mat->E = 0.6, mat->nu = 0.23, mat->rho = 2400;

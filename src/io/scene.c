@@ -102,9 +102,6 @@ static const range NON_NEGATIVE = {0.0, INFINITY, 1, 0, NULL};
 static const range ANY = {-INFINITY, INFINITY, 0, 0, NULL};
 
 static const double ZERO3[3] = {0.0, 0.0, 0.0};
-static const double GRAVITY[3] = {0.0, 0.0, -9.81};
-static const double UP[3] = {0.0, 0.0, 1.0};
-static const double IDENTITY_QUAT[4] = {1.0, 0.0, 0.0, 0.0};
 
 /* ---------------------------------------------------------------- loader */
 
@@ -930,7 +927,7 @@ static cf_status read_primitive(loader *ld, int t, cf_primitive *p)
  * from). */
 static cf_status read_body(loader *ld, int t, cf_body_def *b, cf_body_source *src)
 {
-    static const double one = 1.0;
+    const cf_body_def d = cf_default_body(); /* a key left out takes its value */
     lua_State *L = ld->L;
     char mesh[1024];
     TRY(check_keys(ld, t, body_keys, COUNT(body_keys)));
@@ -955,9 +952,9 @@ static cf_status read_body(loader *ld, int t, cf_body_def *b, cf_body_source *sr
                     "'%s' must be a string (a mesh name or path) or a table (a primitive), got %s",
                     kp(ld, "mesh"), luaL_typename(L, -1));
     }
-    TRY(get_num(ld, t, "scale", &one, &POSITIVE, &b->scale));
-    TRY(get_vec(ld, t, "position", 3, ZERO3, b->position));
-    TRY(get_vec(ld, t, "orientation", 4, IDENTITY_QUAT, b->orientation));
+    TRY(get_num(ld, t, "scale", &d.scale, &POSITIVE, &b->scale));
+    TRY(get_vec(ld, t, "position", 3, d.position, b->position));
+    TRY(get_vec(ld, t, "orientation", 4, d.orientation, b->orientation));
     TRY(normalise(ld, "orientation", b->orientation, 4, "quaternion"));
     TRY(get_vec(ld, t, "velocity", 3, ZERO3, b->velocity));
     TRY(get_vec(ld, t, "angular_velocity", 3, ZERO3, b->angular_velocity));
@@ -1072,15 +1069,15 @@ static cf_status read_boundary(loader *ld, int t, int n_bodies, cf_boundary *b)
 
 static cf_status read_obstacle(loader *ld, int t, cf_obstacle *o)
 {
-    static const double one = 1.0;
     int type = 0;
     TRY(get_enum(ld, t, "type", obstacle_names, COUNT(obstacle_names), -1, &type));
     o->type = (cf_obstacle_type)type;
+    const cf_obstacle d = cf_default_obstacle(o->type); /* a key left out takes its value */
     switch (o->type) {
     case CF_OBSTACLE_PLANE:
         TRY(check_keys(ld, t, plane_keys, COUNT(plane_keys)));
         TRY(get_vec(ld, t, "point", 3, ZERO3, o->point));
-        TRY(get_vec(ld, t, "normal", 3, UP, o->normal));
+        TRY(get_vec(ld, t, "normal", 3, d.normal, o->normal));
         TRY(normalise(ld, "normal", o->normal, 3, "vector"));
         break;
     case CF_OBSTACLE_SPHERE:
@@ -1106,8 +1103,8 @@ static cf_status read_obstacle(loader *ld, int t, cf_obstacle *o)
         TRY(check_keys(ld, t, mesh_obstacle_keys, COUNT(mesh_obstacle_keys)));
         TRY(get_str(ld, t, "file", NULL, file, sizeof file));
         TRY(resolve_surface(ld, "file", file, o->file, sizeof o->file));
-        TRY(get_num(ld, t, "scale", &one, &POSITIVE, &o->scale));
-        TRY(get_vec(ld, t, "orientation", 4, IDENTITY_QUAT, o->orientation));
+        TRY(get_num(ld, t, "scale", &d.scale, &POSITIVE, &o->scale));
+        TRY(get_vec(ld, t, "orientation", 4, d.orientation, o->orientation));
         TRY(normalise(ld, "orientation", o->orientation, 4, "quaternion"));
         TRY(get_vec(ld, t, "position", 3, ZERO3, o->position));
         break;
@@ -1115,8 +1112,8 @@ static cf_status read_obstacle(loader *ld, int t, cf_obstacle *o)
     }
     /* Factors on the material's values: the pair's coefficient is their
      * product (Bullet multiplies the two bodies' coefficients). */
-    TRY(get_num(ld, t, "friction", &one, &NON_NEGATIVE, &o->friction));
-    TRY(get_num(ld, t, "restitution", &one, &NON_NEGATIVE, &o->restitution));
+    TRY(get_num(ld, t, "friction", &d.friction, &NON_NEGATIVE, &o->friction));
+    TRY(get_num(ld, t, "restitution", &d.restitution, &NON_NEGATIVE, &o->restitution));
     return CF_OK;
 }
 
@@ -1135,7 +1132,7 @@ static cf_status read_crack_plane(loader *ld, int t, cf_solver_settings *s)
 static cf_status read_output(loader *ld, int t, const char *name, int fracture_only,
                              cf_output_settings *o)
 {
-    static const double frame_interval = 0.01;
+    const cf_output_settings d = cf_default_output(); /* a key left out takes its value */
     lua_State *L = ld->L;
     char def[sizeof o->file];
     TRY(check_keys(ld, t, output_keys, COUNT(output_keys)));
@@ -1166,24 +1163,24 @@ static cf_status read_output(loader *ld, int t, const char *name, int fracture_o
                             kp(ld, "file"), o->file, ld->dir);
         }
     }
-    TRY(get_num(ld, t, "frame_interval", &frame_interval, &POSITIVE, &o->frame_interval));
+    TRY(get_num(ld, t, "frame_interval", &d.frame_interval, &POSITIVE, &o->frame_interval));
     TRY(get_bool(ld, t, "cracks", fracture_only, &o->cracks));
-    TRY(get_bool(ld, t, "fields", 1, &o->fields));
+    TRY(get_bool(ld, t, "fields", d.fields, &o->fields));
     return CF_OK;
 }
 
 static cf_status read_scene(loader *ld, int t)
 {
-    static const double duration = 1.0;
+    const cf_scene d = cf_default_scene(); /* a key left out takes its value */
     lua_State *L = ld->L;
     cf_scene *sc = ld->sc;
     cf_world_def *s = ld->s;
     int n, li;
 
     TRY(check_keys(ld, t, top_keys, COUNT(top_keys)));
-    TRY(get_str(ld, t, "name", "scene", sc->name, sizeof sc->name));
-    TRY(get_num(ld, t, "duration", &duration, &POSITIVE, &sc->duration));
-    TRY(get_vec(ld, t, "gravity", 3, GRAVITY, s->gravity));
+    TRY(get_str(ld, t, "name", d.name, sc->name, sizeof sc->name));
+    TRY(get_num(ld, t, "duration", &d.duration, &POSITIVE, &sc->duration));
+    TRY(get_vec(ld, t, "gravity", 3, d.world.gravity, s->gravity));
     WITH_TABLE(ld, t, "material", read_settings(ld, lua_gettop(L), "material"));
 
     if (raw_get(L, t, "bodies") == LUA_TNIL)
