@@ -33,6 +33,8 @@ run: meshes
 	/usr/bin/python3 tests/checks/check_physics.py out/plaster_bunny_drop.h5
 	/usr/bin/python3 tests/checks/check_geometry.py out/plaster_bunny_drop.h5
 	$(BUILD)/cohfrac render out/plaster_bunny_drop.h5 --to 0.06 --slow-motion 30
+	$(BUILD)/cohfrac export out/plaster_bunny_drop.h5 --slow-motion 30
+	-$(BUILD)/cohfrac blender-setup
 
 # The source chapter's fracture figures (Fig 6.3, 6.11-6.14) at their
 # defaults, checked against what the chapter's text says each shows: the

@@ -119,6 +119,13 @@ static const struct {
      "                                      pvd: the directory (default OUT minus .h5, _pvd)\n"
      "          --slow-motion F             gltf: play F times slower than the run (default 1;\n"
      "                                      100 makes a 2 ms break last 0.2 s)\n"},
+    {"blender-setup",
+     "  cohfrac blender-setup [--check]     let Debian 12's Blender 3.4 import glTF with its\n"
+     "                                      default options: a startup script in Blender's\n"
+     "                                      user scripts gives numpy 1.24 back the np.bool\n"
+     "                                      alias its importer uses (never overwrites; writes\n"
+     "                                      nothing where numpy still has it)\n"
+     "          --check                     only say whether it is needed and there\n"},
     {"bench",
      "  cohfrac bench [options]             time the fracture-mode step (a mesh hit at 4.43 m/s)\n"
      "                                      against the memory floor, 1 against N threads\n"
@@ -785,6 +792,26 @@ static int cmd_export(int argc, char **argv)
     return 0;
 }
 
+/* Where Debian's Blender 3.4 cannot import glTF with its default options,
+ * a startup script of its own mends it (python/cohfrac/blender_setup.py). */
+static int cmd_blender_setup(int argc, char **argv)
+{
+    static const struct option lo[] = {{"check", no_argument, 0, 'c'}, {0, 0, 0, 0}};
+    int c, check = 0;
+    while ((c = getopt_long(argc, argv, "", lo, NULL)) != -1) {
+        if (c != 'c')
+            return usage_error("bad option for 'blender-setup'");
+        check = 1;
+    }
+    if (optind != argc)
+        return usage_error("'blender-setup' takes no file");
+    const char *args[] = {check ? "--check" : NULL, NULL};
+    int status = cf_run_helper("blender_setup.py", NULL, args);
+    if (status == 4)
+        return cf_status_exit_code(CF_ERR_OUTPUT);
+    return status == 0 ? 0 : cf_status_exit_code(CF_ERR_EXTERNAL);
+}
+
 /* --help / -h or --version among a subcommand's arguments (before "--"). */
 static int asks(int argc, char **argv, const char *a, const char *b)
 {
@@ -904,7 +931,8 @@ static int dispatch(int argc, char **argv)
 {
     static const cli_command table[] = {{"run", cmd_run},         {"compare", cmd_compare},     {"mesh", cmd_mesh},
                  {"study", cmd_study},     {"stability", cmd_stability}, {"bench", cmd_bench},
-                 {"render", cmd_render},   {"export", cmd_export}};
+                 {"render", cmd_render},   {"export", cmd_export},
+                 {"blender-setup", cmd_blender_setup}};
     if (argc < 2)
         return usage_error("no command given");
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {

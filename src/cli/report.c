@@ -75,15 +75,14 @@ static int find_script(const char *script, const char *given, char *out, size_t 
     return access(out, R_OK) == 0;
 }
 
-int cf_report_plot(const char *script, const char *script_path, const char *const *args,
-                   const char *others)
+int cf_run_helper(const char *script, const char *script_path, const char *const *args)
 {
     char path[1024];
     if (!find_script(script, script_path, path, sizeof path)) {
         fprintf(stderr, "cohfrac: warning: %s not found (looked beside the program in %s and "
-                        "in %s): no plot (%s are written)\n",
-                script, COHFRAC_INSTALLED_PYTHON, COHFRAC_TOOLS_DIR, others);
-        return 0;
+                        "in %s)\n",
+                script, COHFRAC_INSTALLED_PYTHON, COHFRAC_TOOLS_DIR);
+        return -1;
     }
     const char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
     char *argv[24];
@@ -99,19 +98,27 @@ int cf_report_plot(const char *script, const char *script_path, const char *cons
     if (rc == 0 && cf_wait(pid, &status, NULL) < 0)
         rc = errno;
     if (rc != 0) {
-        fprintf(stderr, "cohfrac: warning: cannot run python3 (%s): no plot; install python3 "
-                        "and python3-matplotlib\n", strerror(rc));
-        return 0;
+        fprintf(stderr, "cohfrac: warning: cannot run python3 (%s): install python3\n",
+                strerror(rc));
+        return -1;
     }
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+int cf_report_plot(const char *script, const char *script_path, const char *const *args,
+                   const char *others)
+{
+    int status = cf_run_helper(script, script_path, args);
+    if (status == 0)
         return 1;
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 3)
+    if (status < 0)
+        fprintf(stderr, "cohfrac: warning: no plot; %s are written\n", others);
+    else if (status == 3)
         fprintf(stderr, "cohfrac: warning: matplotlib is missing (install the Debian package "
                         "python3-matplotlib): no plot; %s are written\n", others);
     else
-        fprintf(stderr, "cohfrac: warning: %s %s failed (status %d): no plot (needs "
-                        "python3-matplotlib)\n", py, path,
-                WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+        fprintf(stderr, "cohfrac: warning: %s failed (status %d): no plot (needs "
+                        "python3-matplotlib); %s are written\n", script, status, others);
     return 0;
 }
 

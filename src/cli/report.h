@@ -24,9 +24,13 @@ cf_status cf_out_close(cf_outfile *o, cf_error *err);
 /* Run the package's <script> (or `script_path` when not NULL; else the
  * installed package found from the executable's bin/, then the source
  * tree's python/cohfrac) with /usr/bin/python3 and the NULL-ended
- * `args`.  Returns 1 when it exited with 0; otherwise warns on stderr (exit
- * status 3 from the script means matplotlib is missing) that only `others`
- * were written, and returns 0. */
+ * `args`.  Returns the script's exit status, or -1 (with a warning on
+ * stderr) when it was not found, could not start or was killed. */
+int cf_run_helper(const char *script, const char *script_path, const char *const *args);
+
+/* cf_run_helper for a plot: returns 1 when it exited with 0; otherwise
+ * warns on stderr (exit status 3 from the script means matplotlib is
+ * missing) that only `others` were written, and returns 0. */
 int cf_report_plot(const char *script, const char *script_path, const char *const *args,
                    const char *others);
 

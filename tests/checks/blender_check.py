@@ -1,5 +1,5 @@
 """Inside Blender (headless): import a cohfrac glTF export and print what
-Blender sees, for tests/output_gltf_blender.sh to compare with the HDF5.
+Blender sees, for tests/output_viewers.sh to compare with the HDF5.
 
     blender -b --python tests/checks/blender_check.py -- OUT.glb FRAGMENT T_END
 
@@ -12,9 +12,9 @@ import bpy
 
 glb, fragment, t_end = sys.argv[sys.argv.index("--") + 1:][:3]
 bpy.ops.wm.read_factory_settings(use_empty=True)
-# Flat shading: the importer's default ("NORMALS") guesses smoothing with
-# np.bool, which Debian 12's numpy 1.24 no longer has.
-bpy.ops.import_scene.gltf(filepath=glb, import_shading="FLAT")
+# The importer's default options, as File > Import does it: on Debian 12
+# they need `cohfrac blender-setup` first (np.bool, numpy 1.24).
+bpy.ops.import_scene.gltf(filepath=glb)
 scene = bpy.context.scene
 meshes = [o for o in scene.objects if o.type == "MESH"]
 print("objects", len(meshes))
