@@ -62,7 +62,9 @@ PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)
 
+# Set-up, as for run: Debian's Blender 3.4 imports glTF with its defaults.
 test: build
+	-$(BUILD)/cohfrac blender-setup
 	cd $(BUILD) && ctest --output-on-failure
 
 # The fast tests (label unit) built with AddressSanitizer and
