@@ -150,11 +150,25 @@ static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
  * than CF_NODES_PARALLEL_MIN's loops. */
 enum { STAR_PARALLEL_MIN = 256 };
 
+/* The lowest threshold of the source's rule among the facets on node n's
+ * original vertex, Pa: `lowest`, the weakest facet's of the solid, where
+ * the strength is uniform.  A nodal value below it passes no facet there
+ * (source_threshold grows with the strength, rounding included). */
+static double vertex_floor(const cf_solid *s, int n, double lowest)
+{
+    return s->vert_wmin ? source_threshold(s->mat.sigma_max, s->vert_wmin[s->origin[n]])
+                        : lowest;
+}
+
 /* The source's nodal values at the marked nodes (each node writes its
- * own), exact from `lowest` (Pa) up; then the nodes whose value lies
- * below it, which no facet's rule can take, unmarked and dropped from the
- * list, in order.  Only the tets the rest own can then qualify: the same
- * facets, from fewer stars. */
+ * own), exact from `lowest` (Pa, the weakest facet's threshold) up; then
+ * the nodes whose value lies below their vertex's floor (vertex_floor),
+ * which no facet's rule can take, unmarked and dropped from the list, in
+ * order.  Only the tets the rest own can then qualify: the same facets,
+ * from fewer stars.  With a strength field the floor of a vertex is its
+ * own weakest facet's, where the solid's weakest would keep most stressed
+ * nodes.  The values stay exact from `lowest` up all the same: a facet's
+ * rank reads all three of its nodes' (facet_ratio). */
 static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowest)
 {
     CF_PARALLEL(marked->n >= STAR_PARALLEL_MIN, "omp parallel for schedule(static)",
@@ -163,7 +177,7 @@ static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowe
     int kept = 0;
     for (int i = 0; i < marked->n; i++) {
         int n = marked->v[i];
-        if (s->nodal[n] < lowest) /* a NaN stays, as source_rule lets it pass */
+        if (s->nodal[n] < vertex_floor(s, n, lowest)) /* a NaN stays, as source_rule lets it pass */
             s->node_mark[n] = 0;
         else
             marked->v[kept++] = n;

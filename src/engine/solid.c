@@ -272,6 +272,18 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
             s->strength_min = fmin(s->strength_min, s->strength[f]);
             s->strength_max = fmax(s->strength_max, s->strength[f]);
         }
+        s->vert_wmin = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
+        if (!s->vert_wmin)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for facet strengths");
+        for (int o = 0; o < s->n_verts0; o++)
+            s->vert_wmin[o] = INFINITY;
+        for (int f = 0; f < s->n_facets; f++) {
+            if (s->facet[4 * f + 2] < 0) /* a boundary face never cracks */
+                continue;
+            const int *T = &s->tet0[4 * s->facet[4 * f]], *k = CF_TET_FACE[s->facet[4 * f + 1]];
+            for (int j = 0; j < 3; j++)
+                s->vert_wmin[T[k[j]]] = fminf(s->vert_wmin[T[k[j]]], s->strength[f]);
+        }
     }
     return CF_OK;
 }
@@ -440,7 +452,7 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->crack_time, s->candidate, s->strength, s->vt_start, s->vt_slot, s->coh,
+                    s->cracked, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vt_start, s->vt_slot, s->coh,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
