@@ -236,7 +236,8 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     s->hot = calloc((size_t)s->n_tets, 1);
     s->qualify = calloc((size_t)s->n_tets, 1);
     s->node_mark = calloc((size_t)s->cap_nodes, 1);
-    s->nodal = malloc((size_t)s->cap_nodes * sizeof(double));
+    s->nodal = calloc((size_t)s->cap_nodes, sizeof(double)); /* a facet's rank may read a
+                                                                 node not valued yet */
     s->piece = malloc((size_t)s->n_tets * sizeof(int));
     s->piece_mark = calloc((size_t)s->n_tets, sizeof(unsigned));
     s->piece_stamp = 0;
@@ -488,8 +489,10 @@ int cf_solid_copy_node(cf_solid *s, int n)
         if (s->node_mark && (grow((void **)&s->node_mark, 1, cap) ||
                              grow((void **)&s->nodal, sizeof(double), cap)))
             return -1;
-        if (s->node_mark)
+        if (s->node_mark) {
             memset(s->node_mark + s->cap_nodes, 0, (size_t)(cap - s->cap_nodes));
+            memset(s->nodal + s->cap_nodes, 0, (size_t)(cap - s->cap_nodes) * sizeof(double));
+        }
         s->cap_nodes = cap;
     }
     int k = s->n_nodes++;
