@@ -36,8 +36,8 @@
 -- (20.7, 9.0 and 8.2%), 21 more of 1-5% and no chip of 4 tets or fewer;
 -- of the 305 J it lands with, about 208 J go into crushing and 5.0 J into
 -- the cracks, and 44 J of strain energy are dropped (and booked) at the
--- hand-offs; the fastest piece leaves at 10.1 m/s against the bound
--- 15.0 m/s of tests/checks/check_physics.py; about 6 s.  Seeds 2-5 give 1, 2, 1
+-- hand-offs; the fastest piece leaves at 6.6 m/s against the bound
+-- 20.0 m/s of tests/checks/check_physics.py; about 3.5 s.  Seeds 2-5 give 1, 2, 1
 -- and 4 pieces of at least 5% (docs/physics.md §14.17).
 return {
   name = "plaster_bunny_drop",

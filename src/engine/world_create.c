@@ -341,6 +341,8 @@ static void initial_bounds(cf_world *w)
     if (s->facet) /* an insertion criterion: facets can be held up to their strength */
         b->release_speed = s->strength_max * fmax(m->sigma_max / sqrt(m->rho * m->E),
                                                   m->tau_max / sqrt(m->rho * s->mu));
+    if (s->facet && m->compressive_strength > 0) /* or crushed, held at sigma_c */
+        b->release_speed = fmax(b->release_speed, m->compressive_strength / sqrt(m->rho * m->E));
 }
 
 /* A copy of n items of `size` bytes (NULL for none; *fail set when out

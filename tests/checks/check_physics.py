@@ -14,7 +14,8 @@ ledger in /observables:
             t = 0 (initial_upper) above the lowest centre any fragment ever
             reaches, along gravity; v_r the release speed (release_speed,
             0 in files without it): a piece cut free from material held at
-            its strength springs back at about sigma / (rho c);
+            its strength (or crushed, at its compressive strength) springs
+            back at about sigma / (rho c);
   energy    kinetic energy at every frame <= the input: initial (kinetic +
             strain at t = 0) + gravity's work + the prescribed nodes' work
             (when positive) + 1/2 M (2U)^2 for kinematic impactors;
