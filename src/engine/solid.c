@@ -252,8 +252,11 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     s->strength_min = s->strength_max = 1.0;
     if (s->mat.weibull) {
         s->strength = malloc((size_t)(s->n_facets > 0 ? s->n_facets : 1) * sizeof(float));
-        if (!s->strength)
+        s->vert_wmin = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
+        if (!s->strength || !s->vert_wmin)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory for facet strengths");
+        for (int o = 0; o < s->n_verts0; o++)
+            s->vert_wmin[o] = INFINITY;
         /* A strength field of the material, not of the mesh (docs/physics.md
          * §5.1): the factor at the facet's rest centroid, correlated over
          * L = sqrt(A0), so two meshes of one body see the same weak regions
@@ -272,18 +275,9 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
                 (float)(size * strength_field(mt->strength_seed, L, mt->weibull_modulus, x));
             s->strength_min = fmin(s->strength_min, s->strength[f]);
             s->strength_max = fmax(s->strength_max, s->strength[f]);
-        }
-        s->vert_wmin = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
-        if (!s->vert_wmin)
-            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for facet strengths");
-        for (int o = 0; o < s->n_verts0; o++)
-            s->vert_wmin[o] = INFINITY;
-        for (int f = 0; f < s->n_facets; f++) {
-            if (s->facet[4 * f + 2] < 0) /* a boundary face never cracks */
-                continue;
-            const int *T = &s->tet0[4 * s->facet[4 * f]], *k = CF_TET_FACE[s->facet[4 * f + 1]];
-            for (int j = 0; j < 3; j++)
-                s->vert_wmin[T[k[j]]] = fminf(s->vert_wmin[T[k[j]]], s->strength[f]);
+            if (s->facet[4 * f + 2] >= 0) /* a boundary face never cracks */
+                for (int j = 0; j < 3; j++)
+                    s->vert_wmin[T[k[j]]] = fminf(s->vert_wmin[T[k[j]]], s->strength[f]);
         }
     }
     return CF_OK;

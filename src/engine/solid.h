@@ -111,11 +111,11 @@ typedef struct cf_solid {
     float *strength;          /* [nf] facet strength / sigma_max (material.strength;
                                  NULL: 1 everywhere) */
     double strength_min;      /* the smallest of them (1 when uniform) */
+    double strength_max;      /* the largest (1 when uniform) */
     float *vert_wmin;         /* [n_verts0] the smallest strength of the interior
                                  facets on each original vertex (INFINITY where
                                  none; NULL when uniform): below its threshold a
                                  nodal value passes no facet there */
-    double strength_max;      /* the largest (1 when uniform) */
     unsigned char *node_mark; /* [cap_nodes] scratch of the insertion check: the
                                  nodes of hot tets; all 0 between checks
                                  (fracture state) */

@@ -338,11 +338,12 @@ static void initial_bounds(cf_world *w)
     b->energy = w->e0;
     const cf_material *m = &s->mat;
     b->release_speed = 0;
-    if (s->facet) /* an insertion criterion: facets can be held up to their strength */
-        b->release_speed = s->strength_max * fmax(m->sigma_max / sqrt(m->rho * m->E),
-                                                  m->tau_max / sqrt(m->rho * s->mu));
-    if (s->facet && m->compressive_strength > 0) /* or crushed, held at sigma_c */
-        b->release_speed = fmax(b->release_speed, m->compressive_strength / sqrt(m->rho * m->E));
+    if (s->facet) { /* an insertion criterion: facets can be held up to their strength, */
+        double bar = sqrt(m->rho * m->E); /* and crushed material at sigma_c */
+        b->release_speed = fmax(s->strength_max * fmax(m->sigma_max / bar,
+                                                       m->tau_max / sqrt(m->rho * s->mu)),
+                                m->compressive_strength / bar);
+    }
 }
 
 /* A copy of n items of `size` bytes (NULL for none; *fail set when out

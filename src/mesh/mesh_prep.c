@@ -55,8 +55,8 @@
 /* Bump when the pipeline changes in a way that changes its output, so old
  * cached meshes are rebuilt. */
 #define PREP_VERSION                                                                          \
-    "cohfrac-mesh 6 (assimp; repair valence3, CGAL; CGAL isotropic remeshing, of slivers too, else "           \
-    "meshoptimizer, alpha wrap past 2x; tetgen -pYq2.0 [-a]; peel 0.25)"
+    "cohfrac-mesh 6 (assimp; repair valence3, CGAL; CGAL isotropic remeshing, of slivers "     \
+    "too, else meshoptimizer, alpha wrap past 2x; tetgen -pYq2.0 [-a]; peel 0.25)"
 #define TETS_PER_TRI 2.4 /* tetgen -pYq2.0 tets per surface triangle (bunny: 2.3-2.5) */
 #define BASE_OPTS "pYq2.0"
 #define TOL 0.05
@@ -603,11 +603,13 @@ static double edge_for(const cf_surface *s, int tris)
 /* `full` remeshed isotropically (cf_surface_remesh) to about `tris`
  * triangles, near equilateral, so that no tet with a face on the surface
  * is a sliver that sets the explicit step (docs/physics.md §3.1).  1 with
- * `out` set when the result is closed and does not intersect itself, 0
- * when it is not or CGAL failed (the caller decimates instead), -1 with
- * `err` set when memory ran out. */
-static int remesh_clean(const cf_surface *full, int tris, cf_surface *out, int verbose,
-                        cf_error *err)
+ * `out` set when the result is closed, does not intersect itself and
+ * encloses `volume` within the relative `tol` (the surface it would
+ * replace, named `what` in the verbose lines); 0 with `out` freed when it
+ * does not or CGAL failed (the caller keeps that surface), -1 with `err`
+ * set when memory ran out. */
+static int remesh_clean(const cf_surface *full, int tris, double volume, double tol,
+                        const char *what, cf_surface *out, int verbose, cf_error *err)
 {
     double edge = edge_for(full, tris), t0 = cf_wall_time();
     if (copy_surface(full, out, err) != CF_OK)
@@ -632,8 +634,18 @@ static int remesh_clean(const cf_surface *full, int tris, cf_surface *out, int v
                 out->n_tris, out->n_verts, edge, tris, cf_wall_time() - t0,
                 cf_surface_volume(out), n, closed == 0 ? "; not a closed manifold" : "");
     else if (verbose)
-        fprintf(stderr, "  no remeshing (%s): decimating instead\n", why.msg);
-    return keep_if_clean(out, n, closed, err);
+        fprintf(stderr, "  no remeshing (%s): the %s surface kept\n", why.msg, what);
+    int kept = keep_if_clean(out, n, closed, err);
+    if (kept <= 0)
+        return kept;
+    double vr = cf_surface_volume(out);
+    if (fabs(vr - volume) <= tol * fabs(volume))
+        return 1;
+    if (verbose)
+        fprintf(stderr, "  the remeshed surface's volume is %.2f %% off the %s one's: the %s "
+                        "surface kept\n", 100 * (vr - volume) / volume, what, what);
+    cf_surface_free(out);
+    return 0;
 }
 
 /* A surface triangle with an angle below this makes the tets on it thin:
@@ -681,17 +693,8 @@ static int even_out(const cf_surface *s, cf_surface *out, int verbose, cf_error 
     if (verbose)
         fprintf(stderr, "  a surface triangle has an angle of %.3g degrees: remeshing it at "
                         "%d triangles\n", least, s->n_tris);
-    int ok = remesh_clean(s, s->n_tris, out, verbose, err);
-    if (ok <= 0)
-        return ok;
-    double vs = cf_surface_volume(s), vr = cf_surface_volume(out);
-    if (fabs(vr - vs) <= FULL_REMESH_VOLUME_TOL * fabs(vs))
-        return 1;
-    if (verbose)
-        fprintf(stderr, "  the remeshed surface's volume is %.2f %% off: the surface kept\n",
-                100 * (vr - vs) / vs);
-    cf_surface_free(out);
-    return 0;
+    return remesh_clean(s, s->n_tris, cf_surface_volume(s), FULL_REMESH_VOLUME_TOL, "full",
+                        out, verbose, err);
 }
 
 /* A clean decimation that needs more than WRAP_AFTER times the triangles
@@ -723,21 +726,14 @@ static cf_status coarsen(const cf_surface *full, int tris, cf_surface *out, int 
          * a surface too coarse for its curvature, near-equilateral
          * triangles cut across it (the 1,000-tet bunny loses 7 % more). */
         cf_surface r = {0};
-        int ok = remesh_clean(full, tris, &r, verbose, err);
-        if (ok < 0) {
+        int ok = remesh_clean(full, tris, cf_surface_volume(out), REMESH_VOLUME_TOL,
+                              "decimated", &r, verbose, err);
+        if (ok != 0)
             cf_surface_free(out);
+        if (ok < 0)
             return err->code;
-        }
-        double vd = cf_surface_volume(out), vr = ok ? cf_surface_volume(&r) : 0;
-        if (ok && fabs(vr - vd) <= REMESH_VOLUME_TOL * fabs(vd)) {
-            cf_surface_free(out);
+        if (ok > 0)
             *out = r;
-        } else {
-            if (ok && verbose)
-                fprintf(stderr, "  the remeshed surface's volume is %.2f %% off the decimated "
-                                "one's: decimated kept\n", 100 * (vr - vd) / vd);
-            cf_surface_free(&r);
-        }
     }
     if (got != 0)
         return got > 0 ? CF_OK : err->code;
