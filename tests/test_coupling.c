@@ -870,18 +870,22 @@ static void test_handback_in_flight_stays_rigid(void **state)
     cf_scene_free(&sc);
 }
 
-/* scenes/expanding_bar.lua (fracture mode only): pieces alive at the end
- * and the state hash, for a strength setting and a thread count. */
-static int expanding_bar(const char *strength, int threads, uint64_t *hash)
+/* scenes/expanding_bar.lua (fracture mode only) at twice its length, the
+ * same cells (1,920 tets, so that its pieces are enough work to step side
+ * by side): pieces alive at the end and the state hash, for a strength
+ * setting and a thread count; *side: the fragment steps taken side by
+ * side, one per thread (NULL: not asked). */
+static int expanding_bar(const char *strength, int threads, uint64_t *hash, long *side)
 {
     char path[1024], set_strength[256], set_threads[64];
     snprintf(path, sizeof path, "%s/scenes/expanding_bar.lua", COHFRAC_SOURCE_DIR);
     snprintf(set_strength, sizeof set_strength, "material.strength=%s", strength);
     snprintf(set_threads, sizeof set_threads, "solver.threads=%d", threads);
-    const char *sets[] = {set_strength, set_threads, "output.file=\"\""};
+    const char *sets[] = {set_strength, set_threads, "output.file=\"\"",
+                          "bodies[1].mesh.size={0.4,0.01,0.01}", "bodies[1].mesh.cells={80,2,2}"};
     cf_scene sc;
     cf_error err = {0};
-    if (cf_scene_load(path, sets, 3, COHFRAC_MESH_DIR, &sc, &err) != CF_OK)
+    if (cf_scene_load(path, sets, 5, COHFRAC_MESH_DIR, &sc, &err) != CF_OK)
         fail_msg("scene: %s", err.msg);
     cf_run_options opt = {.mesh_dir = COHFRAC_MESH_DIR};
     cf_sim *sim = NULL;
@@ -892,25 +896,30 @@ static int expanding_bar(const char *strength, int threads, uint64_t *hash)
     for (int i = 0; i < cf_sim_world(sim)->n_frag; i++)
         alive += cf_sim_world(sim)->frag[i].mode != CF_MODE_DEAD;
     *hash = cf_world_state_hash(cf_sim_world(sim));
+    if (side)
+        *side = cf_sim_world(sim)->steps_side_by_side;
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
     return alive;
 }
 
 /* A fracture-only run falls into fragments; Weibull strength changes how
- * many, the same for a seed on 1 and 2 threads. */
+ * many, the same for a seed on 1 and 2 threads: on 2 the pieces step side
+ * by side, one per thread (cf_fracture_pass), with the bits of 1. */
 static void test_fracture_only_fragments_and_weibull(void **state)
 {
     (void)state;
     uint64_t h1, h2, hu, hs;
+    long side1, side2;
     const char *w1 = "{distribution='weibull', modulus=6, seed=1}";
-    int n1 = expanding_bar(w1, 1, &h1), n2 = expanding_bar(w1, 2, &h2);
-    int nu = expanding_bar("{distribution='uniform'}", 2, &hu);
-    int ns = expanding_bar("{distribution='weibull', modulus=6, seed=2}", 2, &hs);
+    int n1 = expanding_bar(w1, 1, &h1, &side1), n2 = expanding_bar(w1, 2, &h2, &side2);
+    int nu = expanding_bar("{distribution='uniform'}", 2, &hu, NULL);
+    int ns = expanding_bar("{distribution='weibull', modulus=6, seed=2}", 2, &hs, NULL);
     printf("FIGURE expanding bar: fragments uniform %d, Weibull seed 1 %d (1 thread) %d (2 "
-           "threads), seed 2 %d\n", nu, n1, n2, ns);
+           "threads, %ld fragment steps side by side), seed 2 %d\n", nu, n1, n2, side2, ns);
     assert_true(nu > 1 && n1 > 1);
     assert_int_equal(n1, n2);
+    assert_true(side1 == 0 && side2 > 0);
     assert_true(h1 == h2);
     assert_true(n1 != nu && h1 != hu);
     assert_true(h1 != hs);

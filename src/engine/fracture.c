@@ -474,7 +474,8 @@ static int update_velocities(const cf_step_ctx *ctx, cf_fragment *f, double dt, 
         for (int k = 0; k < 3; k++)
             w_bc += s->m[a] * (s->v[3 * a + k] - vfree[k]) * 0.5 * (vo[k] + s->v[3 * a + k]);
     }
-    ctx->flow->boundary += w_bc;
+    if (n_bc > 0) /* the world's flows: fragments with prescribed nodes step alone */
+        ctx->flow->boundary += w_bc;
     if (!fracture) {
         /* Global damping D is linear, keeps momentum, and leaves the uniform
          * kick dt g as it is, so D(v_old + dt g) = D(v_old) + dt g: it acts
@@ -721,34 +722,50 @@ static void velocity_update(const cf_step_ctx *ctx, cf_fragment *f, const cf_con
         f->pending.contact += removed + w_obs + w_bc;
 }
 
-/* One step of the in-house solver on fragment fi (fracture.h), stage by
- * stage, each stage's time charged to its timer as it ends. */
-cf_status cf_solver_step(const cf_step_ctx *ctx, cf_fragment *f, int fi, double t, double dt,
-                         int fracture)
+/* Stages elasticity (part one) of a fracture step: e_strain restarts from
+ * the tets' strain energy.  *check: whether the criterion is checked at
+ * this step (every check_interval steps).  Returns the hot tets' count. */
+static int fracture_stress(const cf_step_ctx *ctx, cf_fragment *f, int *check)
+{
+    const cf_solver_settings *set = &ctx->def->solver;
+    *check = set->criterion != CF_CRITERION_NONE && (f->steps % set->check_interval) == 0;
+    f->e_strain = 0;
+    int n_hot = elasticity(ctx, f, *check);
+    cf_profile_lap(ctx->prof, CF_STAGE_ELASTICITY);
+    return n_hot;
+}
+
+/* Stages insertion_check and node_duplication of a fracture step, with the
+ * energy the last step left pending booked into the world's flows.  They
+ * grow the solid's shared tables (node copies, cohesive elements, the
+ * crack grid), so fragments take them one at a time, in their order. */
+static cf_status fracture_insert(const cf_step_ctx *ctx, cf_fragment *f, double t, double dt,
+                                 int check, int n_hot)
+{
+    cf_fragment_book_pending(f, ctx->flow);
+    int inserted = 0;
+    if (check) {
+        int nc = insertion_check(ctx, f, t, n_hot);
+        cf_profile_lap(ctx->prof, CF_STAGE_INSERTION_CHECK);
+        cf_status st = nc < 0 ? CF_ERR_NOMEM : node_duplication(ctx, f, t, dt, nc, &inserted);
+        cf_profile_lap(ctx->prof, CF_STAGE_NODE_DUPLICATION);
+        if (st != CF_OK)
+            return st;
+    }
+    f->quiet = inserted ? 0 : f->quiet + 1;
+    return CF_OK;
+}
+
+/* The rest of a step, from the forces at the nodes on: it reads and writes
+ * fragment f's own nodes, cohesive elements and contact cache (number fi,
+ * reserved by the caller) only, and the world's flows only through
+ * prescribed nodes. */
+static cf_status solver_advance(const cf_step_ctx *ctx, cf_fragment *f, int fi, double t,
+                                double dt, int fracture)
 {
     cf_profile *prof = ctx->prof;
     const cf_solver_settings *set = &ctx->def->solver;
     int penalty = penalty_step(set, fracture), bars = !explicit_step(set, fracture);
-    cf_fragment_book_pending(f, ctx->flow);
-    f->e_strain = 0;
-    if (fracture) {
-        /* Stresses only when the criterion is checked at this step. */
-        int check = set->criterion != CF_CRITERION_NONE && (f->steps % set->check_interval) == 0;
-        int n_hot = elasticity(ctx, f, check), inserted = 0;
-        cf_profile_lap(prof, CF_STAGE_ELASTICITY);
-        if (check) {
-            int nc = insertion_check(ctx, f, t, n_hot);
-            cf_profile_lap(prof, CF_STAGE_INSERTION_CHECK);
-            cf_status st = nc < 0 ? CF_ERR_NOMEM : node_duplication(ctx, f, t, dt, nc, &inserted);
-            cf_profile_lap(prof, CF_STAGE_NODE_DUPLICATION);
-            if (st != CF_OK)
-                return st;
-        }
-        f->quiet = inserted ? 0 : f->quiet + 1;
-    }
-    /* Fragment fi's contact cache (contact.h), in the world's table. */
-    if (cf_contact_caches_reserve(ctx->contact, ctx->n_frag))
-        return CF_ERR_NOMEM;
     cf_contact_cache *cc = &ctx->contact->v[fi];
     if (ensure_scratch(f, cc))
         return CF_ERR_NOMEM;
@@ -794,6 +811,125 @@ cf_status cf_solver_step(const cf_step_ctx *ctx, cf_fragment *f, int fi, double 
     cf_profile_lap(prof, CF_STAGE_COLLISION);
     f->steps++;
     return CF_OK;
+}
+
+/* One step of the in-house solver on fragment fi (fracture.h), stage by
+ * stage, each stage's time charged to its timer as it ends. */
+cf_status cf_solver_step(const cf_step_ctx *ctx, cf_fragment *f, int fi, double t, double dt,
+                         int fracture)
+{
+    if (cf_contact_caches_reserve(ctx->contact, ctx->n_frag))
+        return CF_ERR_NOMEM;
+    if (!fracture) {
+        cf_fragment_book_pending(f, ctx->flow);
+        f->e_strain = 0;
+        return solver_advance(ctx, f, fi, t, dt, 0);
+    }
+    int check, n_hot = fracture_stress(ctx, f, &check);
+    cf_status st = fracture_insert(ctx, f, t, dt, check, n_hot);
+    return st != CF_OK ? st : solver_advance(ctx, f, fi, t, dt, 1);
+}
+
+/* One stage of a pass (cf_fracture_pass) over the fracture-mode fragments
+ * list[0..n): their stresses (STAGE_STRESS, into check[] and n_hot[] by
+ * list entry) or the rest of their step (STAGE_ADVANCE). */
+typedef struct {
+    cf_fragment *frag;
+    const int *list;
+    int *check, *n_hot;
+    double t, dt;
+} pass;
+
+enum { PASS_STRESS, PASS_ADVANCE };
+
+static cf_status pass_one(const cf_step_ctx *ctx, const pass *p, int stage, int i)
+{
+    int fi = p->list[i];
+    if (stage == PASS_STRESS) {
+        p->n_hot[i] = fracture_stress(ctx, &p->frag[fi], &p->check[i]);
+        return CF_OK;
+    }
+    return solver_advance(ctx, &p->frag[fi], fi, p->t, p->dt, 1);
+}
+
+/* Small fragments step side by side from this many tets in all: on fewer
+ * (a few crumbs of tens of tets) the team's fork and join cost more than
+ * they save (make run's drop ran 3 % slower on two threads). */
+#define CF_SIDE_BY_SIDE_MIN 1024
+
+/* Whether fragment f steps beside others, one per thread: its Tet4 kernel
+ * would run on one thread anyway (tet4.h). */
+static int steps_alone(const cf_fragment *f) { return f->nt < CF_TET4_PARALLEL_MIN; }
+
+/* Stage `stage` of the pass on every listed fragment.  The large ones go
+ * one after another, each loop on all threads; with `side_by_side` the
+ * small ones then go one per thread, each on its own, so that a split body
+ * of hundreds of pieces keeps every thread busy instead of stepping them
+ * in turn on one.  Each thread times its stages on its own clock; the
+ * section's wall time is charged to the stages in proportion. */
+static cf_status pass_stage(const cf_step_ctx *ctx, const pass *p, int n, int stage,
+                            int side_by_side)
+{
+    cf_status st = CF_OK;
+    for (int i = 0; i < n && st == CF_OK; i++)
+        if (!side_by_side || !steps_alone(&p->frag[p->list[i]]))
+            st = pass_one(ctx, p, stage, i);
+    if (st != CF_OK || !side_by_side)
+        return st;
+    double busy[CF_STAGE_COUNT] = {0};
+    int failed = 0;
+#pragma omp parallel
+    {
+        cf_profile mine = {{0}, 0};
+        cf_step_ctx own = *ctx;
+        own.prof = &mine;
+        omp_set_num_threads(1); /* this thread's fragments run their loops on it alone */
+        cf_profile_start(&mine);
+#pragma omp for schedule(dynamic, 1)
+        for (int i = 0; i < n; i++) {
+            int stop;
+#pragma omp atomic read
+            stop = failed;
+            if (stop || !steps_alone(&p->frag[p->list[i]]) || pass_one(&own, p, stage, i) == CF_OK)
+                continue;
+#pragma omp atomic write
+            failed = 1;
+        }
+#pragma omp critical(cf_pass_profile)
+        for (int k = 0; k < CF_STAGE_COUNT; k++)
+            busy[k] += mine.stage[k];
+    }
+    double total = 0, wall = cf_wall_time() - ctx->prof->mark;
+    for (int k = 0; k < CF_STAGE_COUNT; k++)
+        total += busy[k];
+    for (int k = 0; total > 0 && k < CF_STAGE_COUNT; k++)
+        ctx->prof->stage[k] += wall * busy[k] / total;
+    ctx->prof->mark += wall;
+    return failed ? CF_ERR_NOMEM : CF_OK;
+}
+
+cf_status cf_fracture_pass(const cf_step_ctx *ctx, cf_fragment *frag, const int *list, int n,
+                           int *work, double t, double dt, int *side_by_side)
+{
+    if (cf_contact_caches_reserve(ctx->contact, ctx->n_frag))
+        return CF_ERR_NOMEM;
+    int small = 0, small_tets = 0;
+    for (int i = 0; i < n; i++)
+        if (steps_alone(&frag[list[i]]))
+            small++, small_tets += frag[list[i]].nt;
+    /* Explicit steps only: the bars' sweep keeps a team's barriers
+     * (pbd.c).  FCL's queries (mesh obstacles) take one thread; prescribed
+     * nodes book their work straight into the world's flows
+     * (update_velocities). */
+    int side = small > 1 && small_tets >= CF_SIDE_BY_SIDE_MIN && omp_get_max_threads() > 1 &&
+               explicit_step(&ctx->def->solver, 1) &&
+               !mesh_obstacles(ctx) && ctx->def->n_boundaries == 0;
+    *side_by_side = side ? small : 0;
+    pass p = {frag, list, work, work + n, t, dt};
+    cf_status st = pass_stage(ctx, &p, n, PASS_STRESS, side);
+    for (int i = 0; st == CF_OK && i < n; i++)
+        st = fracture_insert(ctx, &frag[list[i]], t, dt, p.check[i], p.n_hot[i]);
+    return st != CF_OK ? st : pass_stage(ctx, &p, n, PASS_ADVANCE, side);
 }
 
 int cf_pbd_impact(const cf_step_ctx *ctx, const cf_fragment *f, double t, double dt)

@@ -42,6 +42,18 @@ typedef struct cf_step_ctx {
 cf_status cf_solver_step(const cf_step_ctx *c, cf_fragment *f, int fi, double t, double dt,
                          int fracture);
 
+/* One fracture step of length dt from time t (s) of the fracture-mode
+ * fragments frag[list[0..n)]: the same as cf_solver_step on each in list
+ * order, with the same bits, but stage by stage over all of them (their
+ * nodes and elements are disjoint; only insertion, which grows the solid's
+ * shared tables, takes them one at a time, in list order).  Fragments
+ * below the Tet4 kernel's parallel size step side by side, one per thread
+ * (docs/performance.md, "Fragments side by side").  work: 2 n ints of
+ * scratch.  *side_by_side: how many stepped so.  Returns CF_OK or
+ * CF_ERR_NOMEM. */
+cf_status cf_fracture_pass(const cf_step_ctx *c, cf_fragment *frag, const int *list, int n,
+                           int *work, double t, double dt, int *side_by_side);
+
 /* Whether rigid fragment f (nodes in the in-house solver) would hit an
  * obstacle during the next step of length dt from time t faster than the
  * impact threshold (normal approach speed). */

@@ -400,7 +400,7 @@ void cf_tet4_scatter(cf_solid *s, const int *tets, int nt, const int *nodes, int
      * test is a long run of the same answer. */
     CF_PARALLEL(nt >= CF_TET4_PARALLEL_MIN, "omp parallel",
         {
-            long span = (long)hi - lo + 1, nth = omp_get_num_threads(), me = omp_get_thread_num();
+            long span = (long)hi - lo + 1, nth = CF_TEAM_SIZE, me = CF_TEAM_RANK;
             int a0 = lo + (int)(span * me / nth), a1 = lo + (int)(span * (me + 1) / nth);
             for (int i = 0; i < nn; i++) {
                 int a = nodes[i];

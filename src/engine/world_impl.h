@@ -45,6 +45,7 @@ struct cf_world {
     cf_arena arena;          /* the step's scratch, empty between steps (arena.h) */
     long steps_rigid, steps_fracture;
     long long tet_steps_fracture; /* sum over fracture steps of the tets stepped */
+    long steps_side_by_side;      /* of the fracture steps, those taken one per thread */
     double t_fracture;       /* s of simulated time with a fragment in fracture mode */
     cf_energy_flows flow;
     double e0;               /* J, initial kinetic + strain energy */

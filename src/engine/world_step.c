@@ -262,20 +262,32 @@ static cf_status fracture_steps(cf_world *w, double dt, long n_sub, double h, cf
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory gathering contact hulls");
     cf_profile_lap(&w->prof, CF_STAGE_COLLISION);
     cf_step_ctx ctx = cf_world_step_ctx(w);
+    /* The fracture-mode fragments, and the pass's scratch (3 ints each). */
+    size_t mark = cf_arena_mark(&w->arena);
+    int *list = cf_arena_take(&w->arena, (size_t)n * 3 * sizeof *list), m = 0;
+    if (!list)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
+    for (int fi = 0; fi < n; fi++)
+        if (w->frag[fi].mode == CF_MODE_FRACTURE)
+            list[m++] = fi;
     for (long k = 0; k < n_sub; k++) {
-        for (int fi = 0; fi < n; fi++) {
-            if (w->frag[fi].mode != CF_MODE_FRACTURE)
-                continue;
-            if (cf_solver_step(&ctx, &w->frag[fi], fi, w->t + (double)k * h, h, 1) != CF_OK)
-                return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
-            w->steps_fracture++;
-            w->tet_steps_fracture += w->frag[fi].nt;
+        int side;
+        if (cf_fracture_pass(&ctx, w->frag, list, m, list + m, w->t + (double)k * h, h, &side) !=
+            CF_OK) {
+            cf_arena_release(&w->arena, mark);
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory in fracture mode");
         }
+        for (int i = 0; i < m; i++)
+            w->tet_steps_fracture += w->frag[list[i]].nt;
+        w->steps_fracture += m;
+        w->steps_side_by_side += side;
         if (bodies) {
             double removed;
-            if (cf_body_contact(&cx, h, &removed))
+            if (cf_body_contact(&cx, h, &removed)) {
+                cf_arena_release(&w->arena, mark);
                 return cf_error_set(err, CF_ERR_NOMEM, "contact between bodies failed: %s",
                                     cff_last_error());
+            }
             w->flow.contact += removed;
             cf_profile_lap(&w->prof, CF_STAGE_COLLISION);
         }
@@ -284,6 +296,7 @@ static cf_status fracture_steps(cf_world *w, double dt, long n_sub, double h, cf
             cf_profile_lap(&w->prof, CF_STAGE_BOOKKEEPING);
         }
     }
+    cf_arena_release(&w->arena, mark);
     for (int fi = 0; fi < n; fi++) {
         cf_fragment *f = &w->frag[fi];
         if (f->mode != CF_MODE_FRACTURE)
