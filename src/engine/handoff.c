@@ -120,16 +120,22 @@ static void record_handoff(cf_world *sim, int fi, int direction, const double P0
     sim->total_handoff_loss += loss;
 }
 
-/* Fragment's cohesive elements: those whose two tets both belong to it. */
-static int collect_cohesive(cf_world *sim, cf_fragment *f)
+/* Fragment f's cohesive elements, those whose two tets both belong to it,
+ * in ascending order: from the ascending list from[0..n) (a split piece's
+ * are among its parent's), or from NULL, the whole solid's (a body that
+ * enters fracture mode; scanning them all for each piece of a split made
+ * a shattering bar's splits cost pieces times elements). */
+static int collect_cohesive(cf_world *sim, cf_fragment *f, const int *from, int n)
 {
     const cf_solid *s = &sim->solid;
     int id = (int)(f - sim->frag);
     f->coh.n = 0;
-    for (int c = 0; c < s->n_coh; c++)
+    for (int i = 0, count = from ? n : s->n_coh; i < count; i++) {
+        int c = from ? from[i] : i;
         if (s->tet_frag[s->coh[c].tet[0]] == id && s->tet_frag[s->coh[c].tet[1]] == id &&
             cf_int_list_push(&f->coh, c))
             return -1;
+    }
     return 0;
 }
 
@@ -328,7 +334,7 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     f->t_enter = sim->t;
     cf_fragment_ledger_reset(f, &sim->solid, &sim->flow);
     f->e_enter = f->e_kin;
-    if (collect_cohesive(sim, f) || cf_bars_build(&f->bars, s, f->tets, f->nt))
+    if (collect_cohesive(sim, f, NULL, 0) || cf_bars_build(&f->bars, s, f->tets, f->nt))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
     cf_fragment_momenta(f, &sim->solid, sim->bullet, P1, L1);
     record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, rec);
@@ -376,9 +382,9 @@ static int take_component(cf_world *sim, int ci, const int *tets, int count, uns
         for (int j = 0; j < 4; j++) {
             int a = s->tet[4 * t + j];
             if (!seen[a]) {
-                seen[a] = 1;
                 if (cf_int_list_push(&f->nodes, a))
                     return -1;
+                seen[a] = 1; /* only the listed nodes: the split clears them by the list */
             }
         }
     }
@@ -413,7 +419,12 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
     cf_fragment_book_pending(f, &sim->flow);
     /* The parent's per-node leapfrog kinetic energy terms, by node id. */
     int *index = malloc((size_t)s->n_nodes * sizeof(int));
-    unsigned char *seen = calloc((size_t)s->n_nodes, 1);
+    /* The nodes taken, marked in the insertion check's scratch (all 0 here,
+     * and cleared again below; a run without a criterion has none): a
+     * split paid a clear array of all the solid's nodes, thousands of
+     * times over for a shattering body. */
+    unsigned char *own = s->node_mark ? NULL : calloc((size_t)s->n_nodes, 1);
+    unsigned char *seen = s->node_mark ? s->node_mark : own;
     int *cstart = NULL, *grouped = group_by_component(tets, comp, nt, k, &cstart);
     int rc = -(!index || !seen || !grouped);
     for (int i = 0; rc == 0 && i < f->nodes.n; i++)
@@ -442,8 +453,13 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
             g->e_kin += 0.5 * s->m[a] * v3_dot(&p->v_old[3 * index[a]], &s->v[3 * a]);
             v3_axpy(s->m[a], &s->x[3 * a], g->mx);
         }
-        if (collect_cohesive(sim, g))
+        if (collect_cohesive(sim, g, p->coh.v, p->coh.n))
             rc = -1;
+    }
+    for (int c = 0; seen && !own && c < k && *first + c < sim->n_frag; c++) {
+        const cf_fragment *g = &sim->frag[*first + c];
+        for (int i = 0; i < g->nodes.n; i++)
+            seen[g->nodes.v[i]] = 0;
     }
     /* The parent's bars go to the pieces (index now gives a node's piece). */
     cf_bars **dst = rc ? NULL : malloc((size_t)k * sizeof *dst);
@@ -464,7 +480,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         cf_bars_free(&f->bars);
         free(tets);
     }
-    free(comp), free(index), free(seen), free(grouped), free(cstart);
+    free(comp), free(index), free(own), free(grouped), free(cstart);
     return rc ? -1 : k;
 }
 

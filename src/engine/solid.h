@@ -116,9 +116,9 @@ typedef struct cf_solid {
                                  facets on each original vertex (INFINITY where
                                  none; NULL when uniform): below its threshold a
                                  nodal value passes no facet there */
-    unsigned char *node_mark; /* [cap_nodes] scratch of the insertion check: the
-                                 nodes of hot tets; all 0 between checks
-                                 (fracture state) */
+    unsigned char *node_mark; /* [cap_nodes] scratch of the insertion check (the
+                                 nodes of hot tets) and of a split (the nodes
+                                 taken); all 0 between uses (fracture state) */
     double *nodal;            /* [cap_nodes] the source criterion's nodal values, Pa
                                  (fracture state) */
     int *piece;               /* [nt] scratch of the small-piece search: tets reached */
