@@ -26,7 +26,9 @@
 -- pass with no insertion and its landing is over, and goes back to rigid
 -- mode as the pieces still held by a cohesive element.  Pieces of 4 tets
 -- or fewer, or narrower than l_ch, are debris (docs/physics.md §9.2):
--- spheres in Bullet that break no more.
+-- spheres in Bullet that break no more; pieces of fewer than 10 tets,
+-- which no crack can split into two of 5 or more, go back to rigid mode
+-- at once and break no more either.
 -- Mesh: the bunny at about 1,000 tets (`bunny_1k`, 979 tets once its
 -- boundary caps are peeled, prepared by `make run`).
 -- Floor: a penalty contact (docs/physics.md §7.1) that neither takes nor
@@ -34,11 +36,11 @@
 -- begins at the engine's impact threshold (0.2 m/s).
 -- Expected (seed 1): 64 fragments, three pieces of at least 5% of the mass
 -- (20.7, 9.0 and 8.2%), 21 more of 1-5% and no chip of 4 tets or fewer;
--- of the 305 J it lands with, about 208 J go into crushing and 5.0 J into
--- the cracks, and 44 J of strain energy are dropped (and booked) at the
--- hand-offs; the fastest piece leaves at 6.6 m/s against the bound
--- 20.0 m/s of tests/checks/check_physics.py; about 3.5 s.  Seeds 2-5 give 1, 2, 1
--- and 4 pieces of at least 5% (docs/physics.md §14.17).
+-- of the 305 J it lands with, about 206 J go into crushing and 5.4 J into
+-- the cracks, and 41 J of strain energy are dropped (and booked) at the
+-- hand-offs; the fastest piece leaves at 5.1 m/s against the bound
+-- 20.0 m/s of tests/checks/check_physics.py; about 3.3 s.  Seeds 2-5 give 2, 2, 1
+-- and 4 pieces of at least 5% (docs/physics.md §14.22).
 return {
   name = "plaster_bunny_drop",
   duration = 0.15,

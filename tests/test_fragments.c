@@ -7,6 +7,7 @@
 #include "check.h"
 
 #include "fixtures.h"
+#include "fragment.h"
 #include "pieces.h"
 #include "linalg.h"
 
@@ -125,12 +126,45 @@ static void test_global_damping_preserves_momenta(void **state)
     free(nodes), free(all), cf_solid_free(&s);
 }
 
+/* Which pieces can split no further (docs/physics.md §9.2): with cracks
+ * from fronts, a split leaves pieces of more than min_piece_tets tets and
+ * at least the volume of a sphere of min_piece_size each, so a fragment
+ * of fewer than twice that cannot split; crushing that cuts tets free, or
+ * the source's rule (no piece bound), can still break it. */
+static void test_pieces_too_small_to_split(void **state)
+{
+    (void)state;
+    cf_solver_settings set = cf_default_solver();
+    cf_material mat = cf_default_material();
+    set.crack_growth = CF_GROWTH_FRONTS, set.min_piece_tets = 4;
+    set.debris_tets = 0, set.debris_size = 0, set.min_piece_size = 0;
+    mat.crushing_strain = 0;
+    cf_fragment f = {.parent = 0, .volume = 1e-3};
+    f.nt = 9; /* 4 + 5: one side would close a piece of 4 */
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 1);
+    f.nt = 10; /* 5 + 5 */
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 0);
+    set.min_piece_size = 0.1; /* pieces of at least pi/6 (0.1)^3 = 5.24e-4 m^3 each */
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 1);
+    f.volume = 1.1e-3;
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 0);
+    f.nt = 9;
+    mat.crushing_strain = 0.05; /* crushing cuts single tets free */
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 0);
+    mat.crushing_strain = 0;
+    set.crack_growth = CF_GROWTH_ALL; /* the source's rule closes any piece */
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 0);
+    set.debris_tets = 9; /* debris, whatever the rule */
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_box_inertia_matches_analytic),
         cmocka_unit_test(test_shape_matching_recovers_rotation),
         cmocka_unit_test(test_global_damping_preserves_momenta),
+        cmocka_unit_test(test_pieces_too_small_to_split),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

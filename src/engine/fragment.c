@@ -49,6 +49,17 @@ int cf_fragment_is_debris(const cf_fragment *f, const cf_solver_settings *set)
            (set->debris_size > 0 && cbrt(6 * f->volume / PI) < set->debris_size);
 }
 
+int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set,
+                             const cf_material *m)
+{
+    if (cf_fragment_is_debris(f, set))
+        return 1;
+    if (set->crack_growth != CF_GROWTH_FRONTS || m->crushing_strain > 0)
+        return 0;
+    double d = set->min_piece_size, least = PI / 6 * d * d * d;
+    return f->nt < 2 * (set->min_piece_tets + 1) || f->volume < 2 * least;
+}
+
 /* Mass and centre of mass from the tets (identical to the lumped ones); the
  * inertia of the lumped masses, the solver's own discretisation, so that a
  * hand-off preserves linear and angular momentum and never adds kinetic

@@ -91,6 +91,15 @@ int cf_fragment_root(const cf_fragment *frag, int fi);
 /* Whether fragment f is debris (docs/physics.md §9.2): 1 or 0. */
 int cf_fragment_is_debris(const cf_fragment *f, const cf_solver_settings *set);
 
+/* Whether fragment f cannot split any further (docs/physics.md §9.2): it
+ * is debris, or, where cracks grow from fronts, every piece a crack may
+ * close has more than min_piece_tets tets and at least the volume of a
+ * sphere of min_piece_size (§5.1 rule 4), and f has fewer than twice that
+ * on either count, with no crushing that cuts tets free (crushing_strain
+ * of material m).  1 or 0. */
+int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set,
+                             const cf_material *m);
+
 /* Computes f's rest-shape mass properties from its tets and nodes on the
  * solid s: mass (kg), volume (m^3), centre of mass (m), principal axes Q and
  * moments (kg m^2). */

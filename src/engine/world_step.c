@@ -46,13 +46,14 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
     return insane == 0;
 }
 
-/* Debris, and a fragment with no uncracked interior facet (a single tet,
- * say), cannot break further: an impact leaves it in rigid mode. */
+/* A fragment that cannot split (cf_fragment_cannot_split), and one with no
+ * uncracked interior facet, cannot break further: an impact leaves it in
+ * rigid mode. */
 static int can_break(const cf_world *w, const cf_fragment *f)
 {
     const cf_solid *s = &w->solid;
     const cf_solver_settings *set = &w->def.solver;
-    if (set->criterion == CF_CRITERION_NONE || cf_fragment_is_debris(f, set))
+    if (set->criterion == CF_CRITERION_NONE || cf_fragment_cannot_split(f, set, &s->mat))
         return 0;
     for (int i = 0; i < f->nt; i++)
         for (int k = 0; k < 4; k++) {
@@ -412,8 +413,9 @@ static int impact_unfinished(cf_world *w, int fi)
 }
 
 /* Fracture-mode fragments that have been quiet long enough, and no longer
- * drive into an obstacle, go back to rigid mode; debris at once, as it
- * cannot break further. */
+ * drive into an obstacle, go back to rigid mode; those that cannot split
+ * any further at once (a split's pieces of a few tets stepped in fracture
+ * mode until they were quiet, with nothing left to break). */
 static cf_status return_to_rigid(cf_world *w, cf_error *err)
 {
     const cf_solver_settings *set = &w->def.solver;
@@ -423,7 +425,7 @@ static cf_status return_to_rigid(cf_world *w, cf_error *err)
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         int timed_out = w->t - f->t_enter >= set->max_fracture_time - 1e-12;
-        if (!timed_out && !cf_fragment_is_debris(f, &w->def.solver) &&
+        if (!timed_out && !cf_fragment_cannot_split(f, set, &w->solid.mat) &&
             (f->quiet < set->quiet_steps || impact_unfinished(w, fi)))
             continue;
         int first_new = w->n_frag;
