@@ -831,8 +831,8 @@ cf_status cf_solver_step(const cf_step_ctx *ctx, cf_fragment *f, int fi, double 
 }
 
 /* One stage of a pass (cf_fracture_pass) over the fracture-mode fragments
- * list[0..n): their stresses (STAGE_STRESS, into check[] and n_hot[] by
- * list entry) or the rest of their step (STAGE_ADVANCE). */
+ * list[0..n): their stresses (PASS_STRESS, into check[] and n_hot[] by
+ * list entry) or the rest of their step (PASS_ADVANCE). */
 typedef struct {
     cf_fragment *frag;
     const int *list;
