@@ -156,6 +156,9 @@ static void test_pieces_too_small_to_split(void **state)
     assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 0);
     set.debris_tets = 9; /* debris, whatever the rule */
     assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 1);
+    set.crack_growth = CF_GROWTH_FRONTS, set.debris_tets = 0;
+    f.parent = -1; /* an initial body keeps its impact in fracture mode */
+    assert_int_equal(cf_fragment_cannot_split(&f, &set, &mat), 0);
 }
 
 int main(void)

@@ -54,7 +54,8 @@ int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set
 {
     if (cf_fragment_is_debris(f, set))
         return 1;
-    if (set->crack_growth != CF_GROWTH_FRONTS || m->crushing_strain > 0)
+    /* An initial body is the user's: it keeps its impact in fracture mode. */
+    if (f->parent < 0 || set->crack_growth != CF_GROWTH_FRONTS || m->crushing_strain > 0)
         return 0;
     double d = set->min_piece_size, least = PI / 6 * d * d * d;
     return f->nt < 2 * (set->min_piece_tets + 1) || f->volume < 2 * least;

@@ -92,11 +92,11 @@ int cf_fragment_root(const cf_fragment *frag, int fi);
 int cf_fragment_is_debris(const cf_fragment *f, const cf_solver_settings *set);
 
 /* Whether fragment f cannot split any further (docs/physics.md §9.2): it
- * is debris, or, where cracks grow from fronts, every piece a crack may
- * close has more than min_piece_tets tets and at least the volume of a
- * sphere of min_piece_size (§5.1 rule 4), and f has fewer than twice that
- * on either count, with no crushing that cuts tets free (crushing_strain
- * of material m).  1 or 0. */
+ * is debris, or it is a piece (not an initial body), cracks grow from
+ * fronts, every piece a crack may close has more than min_piece_tets tets
+ * and at least the volume of a sphere of min_piece_size (§5.1 rule 4),
+ * and f has fewer than twice that on either count, with no crushing that
+ * cuts tets free (crushing_strain of material m).  1 or 0. */
 int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set,
                              const cf_material *m);
 
