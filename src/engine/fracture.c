@@ -145,9 +145,8 @@ static int insertion_check(const cf_step_ctx *ctx, const cf_fragment *f, double 
     cf_solid *s = ctx->solid;
     const cf_solver_settings *set = &ctx->def->solver;
     int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, ctx->cand);
-    double d = set->min_piece_size; /* a sphere of diameter d */
     cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets,
-                        0.5235987755982988 * d * d * d /* pi d^3 / 6 */, t};
+                        cf_min_piece_volume(set), t};
     if (nc > 0)
         nc = cf_insertion_select(s, ctx->cand, set->criterion, &growth);
     return nc;

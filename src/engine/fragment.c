@@ -49,6 +49,12 @@ int cf_fragment_is_debris(const cf_fragment *f, const cf_solver_settings *set)
            (set->debris_size > 0 && cbrt(6 * f->volume / PI) < set->debris_size);
 }
 
+double cf_min_piece_volume(const cf_solver_settings *set)
+{
+    double d = set->min_piece_size;
+    return 0.5235987755982988 * d * d * d; /* pi d^3 / 6 */
+}
+
 int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set,
                              const cf_material *m)
 {
@@ -57,8 +63,7 @@ int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set
     /* An initial body is the user's: it keeps its impact in fracture mode. */
     if (f->parent < 0 || set->crack_growth != CF_GROWTH_FRONTS || m->crushing_strain > 0)
         return 0;
-    double d = set->min_piece_size, least = PI / 6 * d * d * d;
-    return f->nt < 2 * (set->min_piece_tets + 1) || f->volume < 2 * least;
+    return f->nt < 2 * (set->min_piece_tets + 1) || f->volume < 2 * cf_min_piece_volume(set);
 }
 
 /* Mass and centre of mass from the tets (identical to the lumped ones); the

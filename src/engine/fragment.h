@@ -91,6 +91,10 @@ int cf_fragment_root(const cf_fragment *frag, int fi);
 /* Whether fragment f is debris (docs/physics.md §9.2): 1 or 0. */
 int cf_fragment_is_debris(const cf_fragment *f, const cf_solver_settings *set);
 
+/* The least volume of a piece a crack may close (§5.1 rule 4), m^3: a
+ * sphere of diameter solver.min_piece_size (0: no bound). */
+double cf_min_piece_volume(const cf_solver_settings *set);
+
 /* Whether fragment f cannot split any further (docs/physics.md §9.2): it
  * is debris, or it is a piece (not an initial body), cracks grow from
  * fronts, every piece a crack may close has more than min_piece_tets tets

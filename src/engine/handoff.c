@@ -456,7 +456,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         if (collect_cohesive(sim, g, p->coh.v, p->coh.n))
             rc = -1;
     }
-    for (int c = 0; seen && !own && c < k && *first + c < sim->n_frag; c++) {
+    for (int c = 0; s->node_mark && c < k && *first + c < sim->n_frag; c++) {
         const cf_fragment *g = &sim->frag[*first + c];
         for (int i = 0; i < g->nodes.n; i++)
             seen[g->nodes.v[i]] = 0;
