@@ -812,21 +812,15 @@ static cf_status solver_advance(const cf_step_ctx *ctx, cf_fragment *f, int fi, 
     return CF_OK;
 }
 
-/* One step of the in-house solver on fragment fi (fracture.h), stage by
+/* One step of the pbd rigid backend on fragment fi (fracture.h), stage by
  * stage, each stage's time charged to its timer as it ends. */
-cf_status cf_solver_step(const cf_step_ctx *ctx, cf_fragment *f, int fi, double t, double dt,
-                         int fracture)
+cf_status cf_pbd_rigid_step(const cf_step_ctx *ctx, cf_fragment *f, int fi, double t, double dt)
 {
     if (cf_contact_caches_reserve(ctx->contact, ctx->n_frag))
         return CF_ERR_NOMEM;
-    if (!fracture) {
-        cf_fragment_book_pending(f, ctx->flow);
-        f->e_strain = 0;
-        return solver_advance(ctx, f, fi, t, dt, 0);
-    }
-    int check, n_hot = fracture_stress(ctx, f, &check);
-    cf_status st = fracture_insert(ctx, f, t, dt, check, n_hot);
-    return st != CF_OK ? st : solver_advance(ctx, f, fi, t, dt, 1);
+    cf_fragment_book_pending(f, ctx->flow);
+    f->e_strain = 0;
+    return solver_advance(ctx, f, fi, t, dt, 0);
 }
 
 /* One stage of a pass (cf_fracture_pass) over the fracture-mode fragments

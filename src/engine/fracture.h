@@ -33,18 +33,18 @@ typedef struct cf_step_ctx {
     cf_bars_scratch *bar_scratch;
 } cf_step_ctx;
 
-/* One step of the in-house solver on fragment f, number fi of the world's
- * (its contact cache's index): with `fracture` set, stresses every
- * check_interval steps, cohesive insertion, internal and cohesive forces;
- * otherwise (pbd rigid mode) global damping instead.  Then prediction, PBD
- * bars + collision constraints, velocity update, friction and restitution.
- * t: time at the start of the step (s).  Returns CF_OK or CF_ERR_NOMEM. */
-cf_status cf_solver_step(const cf_step_ctx *c, cf_fragment *f, int fi, double t, double dt,
-                         int fracture);
+/* One step of the pbd rigid backend (source Table 6.1) on rigid fragment
+ * f, number fi of the world's (its contact cache's index): gravity and
+ * global damping, then prediction, PBD bars + collision constraints,
+ * velocity update, friction and restitution.  t: time at the start of the
+ * step (s).  Returns CF_OK or CF_ERR_NOMEM. */
+cf_status cf_pbd_rigid_step(const cf_step_ctx *c, cf_fragment *f, int fi, double t, double dt);
 
 /* One fracture step of length dt from time t (s) of the fracture-mode
- * fragments frag[list[0..n)]: the same as cf_solver_step on each in list
- * order, with the same bits, but stage by stage over all of them (their
+ * fragments frag[list[0..n)] (source Table 6.2): stresses every
+ * check_interval steps, cohesive insertion, internal and cohesive forces,
+ * then what cf_pbd_rigid_step does after its damping.  The same bits as
+ * stepping each in list order, but stage by stage over all of them (their
  * nodes and elements are disjoint; only insertion, which grows the solid's
  * shared tables, takes them one at a time, in list order).  Fragments
  * below the Tet4 kernel's parallel size step side by side, one per thread

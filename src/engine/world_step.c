@@ -165,7 +165,7 @@ static cf_status rigid_step(cf_world *w, double dt, cf_error *err)
             continue;
         }
         /* The damped step's own stages are timed as the solver's. */
-        if (cf_solver_step(&ctx, &w->frag[fi], fi, w->t, dt, 0) != CF_OK)
+        if (cf_pbd_rigid_step(&ctx, &w->frag[fi], fi, w->t, dt) != CF_OK)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory in the pbd rigid step");
     }
     w->steps_rigid++;
