@@ -677,7 +677,7 @@ static void test_fronts_close_no_small_piece(void **state)
         for (int t = 0; t < s.n_tets; t++) /* hydrostatic tension: every normal */
             s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
         cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4,
-                       rule == 2 ? two_cells : 0, 0};
+                       rule == 2 ? two_cells : 0, 0, 0};
         cracked[rule] = grow(&s, all, g, 1.0, 200);
         least[rule] = smallest_closed_piece(&s, &least_vol[rule]);
         free(all);
@@ -720,7 +720,7 @@ static void test_contact_memo_changes_nothing(void **state)
             if (scene == 0)
                 for (int t = 0; t < s.n_tets; t++)
                     s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
-            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0};
             n[forget] = grow_memo(&s, all, g, scene == 0 ? 1.0 : 0.01, 200, forget);
             nf = s.n_facets;
             cracked[forget] = malloc((size_t)nf), when[forget] = malloc((size_t)nf * sizeof(double));
@@ -757,7 +757,7 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid s;
     int *all = stressed_box(&s, &m, 1.4, 1.0, 100.0);
     double speed = 10.0, dt = 0.01, cell = sqrt(3.0);
-    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0};
     cf_int_list cand = {0}, nodes = {0}, touched = {0};
     double first[3] = {0, 0, 0}, worst = -INFINITY;
     int nuclei = 0, total = 0;
@@ -906,7 +906,7 @@ static void test_fronts_do_not_branch(void **state)
         c[k] = (s.X[3 * o0[0] + k] + s.X[3 * o0[1] + k] + s.X[3 * o0[2] + k]) / 3;
     assert_int_equal(cf_crack_grid_add(&s.cracks, c), 0);
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0};
     cf_int_list cand = {0};
     int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, &cand);
     assert_true(n > 0);
@@ -930,6 +930,59 @@ static void test_fronts_do_not_branch(void **state)
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
     free(cand.v), free(all);
     cf_solid_free(&s), cf_mesh_free(&m);
+}
+
+/* The maximum tangential stress criterion at a front (docs/physics.md §5.1
+ * rule 3, solver.front_direction "stress"): in a box under a uniaxial
+ * tension sy along y of 1.5 times the threshold, a crack of one facet
+ * normal to y, checked once, takes across its edges only facets whose
+ * normal stress sy n_y^2 reaches the threshold, and some; the source's
+ * front rule ("any"), which reads the principal stress at the vertex
+ * ahead (sy everywhere), also takes facets whose normal stress does not.
+ * The nucleation radius is longer than the box: every facet taken is a
+ * front. */
+static void test_fronts_run_across_the_tension(void **state)
+{
+    (void)state;
+    double thr = 0.9, sy = 1.5 * thr; /* threshold of a facet of strength 1 */
+    int taken[2], below[2];
+    for (int along = 0; along < 2; along++) {
+        cf_mesh m;
+        fixture_box(&m, 4, 4, 4, 1, 1, 1);
+        cf_solid s;
+        int *all = stressed_box(&s, &m, sy, 1.0, 1e9), f0 = middle_facet(&s), o0[3];
+        assert_true(f0 >= 0);
+        facet_vertices(&s, f0, o0);
+        cf_mark_cracked(&s, f0, 1);
+        s.crack_time[f0] = -1e9;
+        double c[3];
+        for (int k = 0; k < 3; k++)
+            c[k] = (s.X[3 * o0[0] + k] + s.X[3 * o0[1] + k] + s.X[3 * o0[2] + k]) / 3;
+        assert_int_equal(cf_crack_grid_add(&s.cracks, c), 0);
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along};
+        cf_int_list cand = {0};
+        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &cand);
+        assert_true(n > 0);
+        n = cf_insertion_select(&s, &cand, CF_CRITERION_SOURCE, &g);
+        taken[along] = n, below[along] = 0;
+        for (int i = 0; i < n; i++) {
+            int o[3];
+            double e1[3], e2[3], nrm[3];
+            facet_vertices(&s, cand.v[i], o);
+            v3_sub(&s.X[3 * o[1]], &s.X[3 * o[0]], e1), v3_sub(&s.X[3 * o[2]], &s.X[3 * o[0]], e2);
+            v3_cross(e1, e2, nrm);
+            double ny = nrm[1] / v3_norm(nrm);
+            below[along] += sy * ny * ny < thr;
+        }
+        free(cand.v), free(all);
+        cf_solid_free(&s), cf_mesh_free(&m);
+    }
+    printf("FIGURE fronts along the stress: %d facets taken, %d of them with a normal stress "
+           "below the threshold (any facet: %d, %d)\n",
+           taken[1], below[1], taken[0], below[0]);
+    assert_true(taken[1] >= 1);
+    assert_int_equal(below[1], 0);
+    assert_true(below[0] >= 1);
 }
 
 /* The size-free strength factor of facet f of area A_f on the box of
@@ -1051,6 +1104,7 @@ int main(void)
         cmocka_unit_test(test_front_moves_no_faster_than_its_speed),
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
         cmocka_unit_test(test_fronts_do_not_branch),
+        cmocka_unit_test(test_fronts_run_across_the_tension),
         cmocka_unit_test(test_contact_memo_changes_nothing),
         cmocka_unit_test(test_strength_is_a_field_of_the_material),
     };

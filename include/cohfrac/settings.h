@@ -129,6 +129,9 @@ typedef enum {
       "", "insertion criterion (docs/physics.md 5): facet traction, the source's, none")      \
     X("solver", "crack_growth", ENUM, solver.crack_growth, 0, NULL, cf_names_growth,          \
       CF_R_NONE, "", "fronts and nuclei (docs/physics.md 5.1), or every qualifying facet")    \
+    X("solver", "front_direction", ENUM, solver.front_direction, 0, NULL, cf_names_front,     \
+      CF_R_NONE, "",                                                                           \
+      "fronts: onto any facet, or one whose normal stress reaches it (docs/physics.md 5.1)")  \
     X("solver", "obstacle_contact", ENUM, solver.obstacle_contact, 0, NULL,                   \
       cf_names_obstacle_contact, CF_R_NONE, "",                                                \
       "explicit runs: project nodes onto obstacles, or a penalty force (docs/physics.md 7.1)") \

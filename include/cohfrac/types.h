@@ -118,6 +118,11 @@ typedef enum { CF_CONSTRAINTS_PBD, CF_CONSTRAINTS_XPBD, CF_CONSTRAINTS_NONE } cf
  * (docs/physics.md §5.1): those that extend a crack front or nucleate one
  * at a local maximum, or every one (the source's rule). */
 typedef enum { CF_GROWTH_FRONTS, CF_GROWTH_ALL } cf_crack_growth;
+/* Which facet a crack front may extend onto (docs/physics.md §5.1): any
+ * facet across a front edge whose vertex ahead reaches the threshold, or
+ * only one whose own normal stress does (the maximum tangential stress
+ * criterion; criterion "source"). */
+typedef enum { CF_FRONT_ANY, CF_FRONT_STRESS } cf_front_direction;
 /* How fracture-mode nodes meet obstacles in explicit runs (docs/physics.md §7.1). */
 typedef enum { CF_OBSTACLE_CONTACT_KINEMATIC, CF_OBSTACLE_CONTACT_PENALTY } cf_obstacle_contact;
 
@@ -137,6 +142,7 @@ typedef struct cf_solver_settings {
     cf_elasticity elasticity;
     cf_criterion criterion;
     cf_crack_growth crack_growth;
+    cf_front_direction front_direction;
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
     double min_piece_size;        /* m: nor one whose equal-volume sphere is narrower;

@@ -146,7 +146,8 @@ static int insertion_check(const cf_step_ctx *ctx, const cf_fragment *f, double 
     const cf_solver_settings *set = &ctx->def->solver;
     int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, ctx->cand);
     cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets,
-                        cf_min_piece_volume(set), t};
+                        cf_min_piece_volume(set), t,
+                        set->front_direction == CF_FRONT_STRESS};
     if (nc > 0)
         nc = cf_insertion_select(s, ctx->cand, set->criterion, &growth);
     return nc;

@@ -63,8 +63,9 @@ static double max_principal(const double A[9])
  * tets on one side, and its average would read the stress of one tet
  * instead of the material's around the vertex (docs/physics.md §5.1).
  * Where a bound shows it to lie below `lowest` (Pa) the bound is returned
- * instead (still below it), without the eigenvalue's trigonometry. */
-static double nodal_principal(const cf_solid *s, int n, int frag, double lowest)
+ * instead (still below it), without the eigenvalue's trigonometry.  The
+ * mean stress itself goes to s->nodal_stress[n], stamped with this check. */
+static double nodal_principal(cf_solid *s, int n, int frag, double lowest)
 {
     int o = s->origin[n];
     double a[10] = {0};
@@ -76,9 +77,12 @@ static double nodal_principal(const cf_solid *s, int n, int frag, double lowest)
             a[k] += s->vol[t] * s->sigma[9 * t + k];
         a[9] += s->vol[t];
     }
-    double sig[9];
+    double sig[9], *out = &s->nodal_stress[6 * n];
     for (int k = 0; k < 9; k++)
         sig[k] = a[k] / a[9];
+    out[0] = sig[0], out[1] = sig[4], out[2] = sig[8], out[3] = sig[1], out[4] = sig[2],
+    out[5] = sig[5];
+    s->nodal_check[n] = s->check_stamp;
     double bound = cf_tet4_max_principal_bound(sig);
     return bound < lowest ? bound : max_principal(sig);
 }
@@ -347,6 +351,10 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
                 first = i < first ? i : first, last = i;);
     if (mark_hot_nodes(s, tets, first, last, out))
         return -1;
+    if (++s->check_stamp == 0) { /* wrapped: no node was valued in check 0 */
+        memset(s->nodal_check, 0, (size_t)s->cap_nodes * sizeof(unsigned));
+        s->check_stamp = 1;
+    }
     if (rule == CF_CRITERION_SOURCE) /* no facet threshold lies below the bound's s1 */
         nodal_values(s, out, s->tet_frag[tets[0]], cf_insertion_bound(s, rule).s1);
     /* The faces of the tets that may have a qualifying one, then those
@@ -533,6 +541,31 @@ static double facet_ratio(const cf_solid *s, int f, cf_criterion rule)
     return r == r ? r : INFINITY;
 }
 
+/* A front facet's rank under the maximum tangential stress criterion
+ * (Erdogan and Sih, J Basic Eng 85:519, 1963; docs/physics.md §5.1): the
+ * normal stress across facet f's current normal, from the mean stress of
+ * each of its nodes valued in this check (nodal_principal), the largest of
+ * them, over the facet's threshold.  The node ahead of the front gives it:
+ * the two on the cracked edge read the unloaded wake, as the front rule
+ * says.  A NaN reads as infinitely far (the divergence guard stops the
+ * run); -INFINITY when no node was valued. */
+static double front_stress_ratio(const cf_solid *s, int f)
+{
+    const int *F = &s->facet[4 * f];
+    double n[3], sn = -INFINITY, w = s->strength ? s->strength[f] : 1.0;
+    face_normal(s, F[0], F[1], n);
+    for (int j = 0; j < 3; j++) {
+        int a = s->tet[4 * F[0] + CF_TET_FACE[F[1]][j]];
+        if (s->nodal_check[a] != s->check_stamp)
+            continue;
+        const double *q = &s->nodal_stress[6 * a];
+        double t = q[0] * n[0] * n[0] + q[1] * n[1] * n[1] + q[2] * n[2] * n[2] +
+                   2 * (q[3] * n[0] * n[1] + q[4] * n[0] * n[2] + q[5] * n[1] * n[2]);
+        sn = t == t ? fmax(sn, t) : INFINITY;
+    }
+    return sn / source_threshold(s->mat.sigma_max, w);
+}
+
 /* The original vertices of face k of tet t. */
 static void face_vertices(const cf_solid *s, int t, int k, int o[3])
 {
@@ -681,7 +714,8 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
     /* A facet that touches a crack and is not a front of it (CF_TOUCH)
      * stays so through the check, as the facets it takes are not yet old
      * enough to be fronts: those, nine in ten of the candidates in a
-     * cracked body, are dropped first, in parallel, before the ranking. */
+     * cracked body, are dropped first, in parallel, before the ranking,
+     * with the fronts that along_stress refuses. */
     ranked *r = malloc((size_t)nc * sizeof *r);
     if (!r)
         return -1;
@@ -691,9 +725,14 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
             double c[3];
             face_vertices(s, s->facet[4 * f], s->facet[4 * f + 1], o);
             centroid(s, o, c);
-            int touch = crack_contact(s, f, o, c, g->t, g->front_speed) == CF_TOUCH;
-            r[i].facet = touch ? -1 : f;
-            r[i].ratio = touch ? 0 : facet_ratio(s, f, rule);
+            int kind = crack_contact(s, f, o, c, g->t, g->front_speed);
+            double q = 0;
+            if (kind == CF_FRONT && g->along_stress && rule == CF_CRITERION_SOURCE)
+                q = front_stress_ratio(s, f), kind = q >= 1 ? kind : CF_TOUCH;
+            else if (kind != CF_TOUCH)
+                q = facet_ratio(s, f, rule);
+            r[i].facet = kind == CF_TOUCH ? -1 : f;
+            r[i].ratio = kind == CF_TOUCH ? 0 : q;
         });
     int nr = 0;
     for (int i = 0; i < nc; i++)

@@ -57,6 +57,9 @@ typedef struct cf_growth {
     int min_piece_tets;    /* no insertion closes a piece of at most this many tets */
     double min_piece_volume; /* m^3: nor one of less volume (0: no bound) */
     double t;              /* s: now */
+    int along_stress;      /* a front takes only a facet whose normal stress reaches its
+                              threshold (solver.front_direction "stress"; criterion
+                              source) */
 } cf_growth;
 
 /* The facets of `cand` (cf_insertion_candidates) that a check inserts,
@@ -68,7 +71,9 @@ typedef struct cf_growth {
  * inserted at least d / front_speed before (a front) or touches no cracked
  * facet and lies farther than s->nucleation_radius / ratio^2 from every
  * one (a nucleus, the largest ratio around it), and when it closes no piece of at
- * most min_piece_tets tets.  Returns how many, or -1 out of memory (nothing
+ * most min_piece_tets tets.  With along_stress (criterion source) a front
+ * ranks by its normal stress over its threshold instead, and is taken only
+ * where that reaches 1 (docs/physics.md §5.1 rule 3).  Returns how many, or -1 out of memory (nothing
  * marked; the crack grid may hold the centroids of facets it refused). */
 int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const cf_growth *g);
 

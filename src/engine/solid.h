@@ -121,6 +121,10 @@ typedef struct cf_solid {
                                  taken); all 0 between uses (fracture state) */
     double *nodal;            /* [cap_nodes] the source criterion's nodal values, Pa
                                  (fracture state) */
+    double *nodal_stress;     /* [cap_nodes][6] the volume-mean stress behind each
+                                 nodal value (xx yy zz xy xz yz), Pa */
+    unsigned *nodal_check;    /* [cap_nodes] the check that last valued each node */
+    unsigned check_stamp;     /* the last check's number (cf_insertion_candidates) */
     int *piece;               /* [nt] scratch of the small-piece search: tets reached */
     unsigned *piece_mark;     /* [nt] the search's stamp of each tet reached */
     unsigned piece_stamp;     /* the last stamp used */

@@ -152,6 +152,12 @@
  *       crack and no other facet inserted in that check (a local maximum of
  *       the criterion's ratio); "all" inserts every qualifying facet (the
  *       source's rule)
+ *     front_direction ["any"] | "stress": with "fronts" and criterion
+ *       "source", which facet across a front edge the crack may take: any
+ *       whose vertex ahead reaches the threshold (the source's value at that
+ *       vertex), or only one whose own normal stress (the nodal stress ahead
+ *       across the facet's normal) reaches its threshold, the highest first:
+ *       the maximum tangential stress criterion (docs/physics.md §5.1)
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
