@@ -59,8 +59,8 @@ SCENE = os.path.join(HERE, "..", "..", "scenes", "plaster_sphere_drop.lua")
 L_CH = 0.0125  # m, E G_I / sigma_max^2 of the scene's plaster
 SIZES = {
     # ladder element size, speeds (m/s), convergence element sizes
-    "ci": (L_CH / 2, [5, 6, 7, 8, 9, 10], [L_CH, L_CH / 2, L_CH / 3]),
-    "full": (L_CH / 2, [4, 5, 6, 7, 7.5, 8, 8.5, 9, 10, 11, 12], [L_CH, L_CH / 2, L_CH / 4]),
+    "ci": (L_CH / 2, [5, 6, 7, 8, 9, 10, 11, 12, 13], [L_CH, L_CH / 2, L_CH / 3]),
+    "full": (L_CH / 2, [4, 5, 6, 7, 7.5, 8, 8.5, 9, 10, 11, 12, 13, 14], [L_CH, L_CH / 2, L_CH / 4]),
 }
 DIAMETERS = (0.050, 0.075)  # m
 
