@@ -853,6 +853,20 @@ static void test_front_rule_reads_the_stress_ahead(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* Facet f cracked long ago (a front at once, whatever the front speed),
+ * its rest centroid in the crack grid. */
+static void old_crack(cf_solid *s, int f)
+{
+    int o[3];
+    double c[3];
+    facet_vertices(s, f, o);
+    cf_mark_cracked(s, f, 1);
+    s->crack_time[f] = -1e9;
+    for (int k = 0; k < 3; k++)
+        c[k] = (s->X[3 * o[0] + k] + s->X[3 * o[1] + k] + s->X[3 * o[2] + k]) / 3;
+    assert_int_equal(cf_crack_grid_add(&s->cracks, c), 0);
+}
+
 /* Cracked facets holding the edge of original vertices a and b. */
 static int cracked_on_edge(const cf_solid *s, int a, int b)
 {
@@ -899,12 +913,9 @@ static void test_fronts_do_not_branch(void **state)
     for (int j = 0, k = 0; j < 3; j++)
         if (o0[j] == o1[0] || o0[j] == o1[1] || o0[j] == o1[2])
             e[k++] = o0[j];
-    cf_mark_cracked(&s, f0, 1), cf_mark_cracked(&s, f1, 1);
-    s.crack_time[f0] = s.crack_time[f1] = -1e9;
-    double c[3];
-    for (int k = 0; k < 3; k++)
-        c[k] = (s.X[3 * o0[0] + k] + s.X[3 * o0[1] + k] + s.X[3 * o0[2] + k]) / 3;
-    assert_int_equal(cf_crack_grid_add(&s.cracks, c), 0);
+    old_crack(&s, f0);
+    cf_mark_cracked(&s, f1, 1);
+    s.crack_time[f1] = -1e9;
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
     cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0};
     cf_int_list cand = {0};
@@ -950,15 +961,9 @@ static void test_fronts_run_across_the_tension(void **state)
         cf_mesh m;
         fixture_box(&m, 4, 4, 4, 1, 1, 1);
         cf_solid s;
-        int *all = stressed_box(&s, &m, sy, 1.0, 1e9), f0 = middle_facet(&s), o0[3];
+        int *all = stressed_box(&s, &m, sy, 1.0, 1e9), f0 = middle_facet(&s);
         assert_true(f0 >= 0);
-        facet_vertices(&s, f0, o0);
-        cf_mark_cracked(&s, f0, 1);
-        s.crack_time[f0] = -1e9;
-        double c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = (s.X[3 * o0[0] + k] + s.X[3 * o0[1] + k] + s.X[3 * o0[2] + k]) / 3;
-        assert_int_equal(cf_crack_grid_add(&s.cracks, c), 0);
+        old_crack(&s, f0);
         cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along};
         cf_int_list cand = {0};
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &cand);

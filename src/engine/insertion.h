@@ -73,8 +73,9 @@ typedef struct cf_growth {
  * one (a nucleus, the largest ratio around it), and when it closes no piece of at
  * most min_piece_tets tets.  With along_stress (criterion source) a front
  * ranks by its normal stress over its threshold instead, and is taken only
- * where that reaches 1 (docs/physics.md §5.1 rule 3).  Returns how many, or -1 out of memory (nothing
- * marked; the crack grid may hold the centroids of facets it refused). */
+ * where that reaches 1 (docs/physics.md §5.1 rule 3).  Returns how many, or
+ * -1 out of memory (nothing marked; the crack grid may hold the centroids
+ * of facets it refused). */
 int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const cf_growth *g);
 
 /* Crack facet f: mark it, duplicate the nodes whose star it disconnects
