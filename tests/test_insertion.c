@@ -943,6 +943,39 @@ static void test_fronts_do_not_branch(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
+/* The 4-cell unit box under a uniaxial tension sy (Pa) along y, of unit
+ * strength, with an old crack at its middle facet (every facet taken
+ * beside it is a front: the nucleation radius is longer than the box).
+ * Returns the list of its tets. */
+static int *box_with_crack(cf_mesh *m, cf_solid *s, double sy)
+{
+    fixture_box(m, 4, 4, 4, 1, 1, 1);
+    int *all = stressed_box(s, m, sy, 1.0, 1e9), f0 = middle_facet(s);
+    assert_true(f0 >= 0);
+    old_crack(s, f0);
+    return all;
+}
+
+/* One check of the source's criterion with fronts (across the tension
+ * when `along`); the facets taken, in cand. */
+static int check_fronts(cf_solid *s, const int *all, int along, cf_int_list *cand)
+{
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along};
+    int n = cf_insertion_candidates(s, all, s->n_tets, CF_CRITERION_SOURCE, s->n_tets, cand);
+    return n > 0 ? cf_insertion_select(s, cand, CF_CRITERION_SOURCE, &g) : n;
+}
+
+/* The y component of facet f's unit rest normal. */
+static double facet_normal_y(const cf_solid *s, int f)
+{
+    int o[3];
+    double e1[3], e2[3], nrm[3];
+    facet_vertices(s, f, o);
+    v3_sub(&s->X[3 * o[1]], &s->X[3 * o[0]], e1), v3_sub(&s->X[3 * o[2]], &s->X[3 * o[0]], e2);
+    v3_cross(e1, e2, nrm);
+    return nrm[1] / v3_norm(nrm);
+}
+
 /* The maximum tangential stress criterion at a front (docs/physics.md §5.1
  * rule 3, solver.front_direction "stress"): in a box under a uniaxial
  * tension sy along y of 1.5 times the threshold, a crack of one facet
@@ -959,24 +992,13 @@ static void test_fronts_run_across_the_tension(void **state)
     int taken[2], below[2];
     for (int along = 0; along < 2; along++) {
         cf_mesh m;
-        fixture_box(&m, 4, 4, 4, 1, 1, 1);
         cf_solid s;
-        int *all = stressed_box(&s, &m, sy, 1.0, 1e9), f0 = middle_facet(&s);
-        assert_true(f0 >= 0);
-        old_crack(&s, f0);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along};
+        int *all = box_with_crack(&m, &s, sy);
         cf_int_list cand = {0};
-        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &cand);
-        assert_true(n > 0);
-        n = cf_insertion_select(&s, &cand, CF_CRITERION_SOURCE, &g);
+        int n = check_fronts(&s, all, along, &cand);
         taken[along] = n, below[along] = 0;
         for (int i = 0; i < n; i++) {
-            int o[3];
-            double e1[3], e2[3], nrm[3];
-            facet_vertices(&s, cand.v[i], o);
-            v3_sub(&s.X[3 * o[1]], &s.X[3 * o[0]], e1), v3_sub(&s.X[3 * o[2]], &s.X[3 * o[0]], e2);
-            v3_cross(e1, e2, nrm);
-            double ny = nrm[1] / v3_norm(nrm);
+            double ny = facet_normal_y(&s, cand.v[i]);
             below[along] += sy * ny * ny < thr;
         }
         free(cand.v), free(all);
@@ -988,6 +1010,47 @@ static void test_fronts_run_across_the_tension(void **state)
     assert_true(taken[1] >= 1);
     assert_int_equal(below[1], 0);
     assert_true(below[0] >= 1);
+}
+
+/* A front's threshold from the toughness (solver.front_threshold
+ * "toughness", docs/physics.md §5.1).  A box of 0.25 m cells under a
+ * uniaxial tension sy of 0.6 of a facet's threshold, with one crack normal
+ * to it: no facet reaches its strength, so with the strength's threshold
+ * the crack takes nothing.  With K_IC = 0.4 Pa m^1/2 the field of a tip at
+ * the toughness a facet's height ahead (r <= 0.25 sqrt(2) m) is
+ * K_IC / sqrt(2 pi r) >= 0.27 Pa, and the crack grows: every facet it takes
+ * is a front whose normal stress reaches at least that, and none is
+ * enclosed by nuclei (sy passes no facet's strength). */
+static void test_front_threshold_from_the_toughness(void **state)
+{
+    (void)state;
+    double thr = 0.9, sy = 0.6 * thr, K = 0.4, r_max = 0.25 * sqrt(2.0);
+    int taken[2], below = 0;
+    for (int tough = 0; tough < 2; tough++) {
+        cf_mesh m;
+        cf_solid s;
+        int *all = box_with_crack(&m, &s, sy);
+        if (tough) {
+            s.mat.G_I = K * K / s.mat.E;
+            assert_int_equal(cf_solid_init_front_toughness(&s, NULL), CF_OK);
+            assert_float_equal(s.front_K, K, 1e-12);
+            assert_true(s.front_floor_min <= K / sqrt(2 * acos(-1.0) * r_max));
+        }
+        cf_int_list cand = {0};
+        int n = check_fronts(&s, all, 1, &cand);
+        taken[tough] = n;
+        for (int i = 0; i < n; i++) {
+            double ny = facet_normal_y(&s, cand.v[i]);
+            below += sy * ny * ny < K / sqrt(2 * acos(-1.0) * r_max);
+        }
+        free(cand.v), free(all);
+        cf_solid_free(&s), cf_mesh_free(&m);
+    }
+    printf("FIGURE front threshold from the toughness: %d facets taken at 0.6 of the "
+           "strength's threshold (%d with the strength's)\n", taken[1], taken[0]);
+    assert_int_equal(taken[0], 0);
+    assert_true(taken[1] >= 1);
+    assert_int_equal(below, 0);
 }
 
 /* The size-free strength factor of facet f of area A_f on the box of
@@ -1110,6 +1173,7 @@ int main(void)
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
         cmocka_unit_test(test_fronts_do_not_branch),
         cmocka_unit_test(test_fronts_run_across_the_tension),
+        cmocka_unit_test(test_front_threshold_from_the_toughness),
         cmocka_unit_test(test_contact_memo_changes_nothing),
         cmocka_unit_test(test_strength_is_a_field_of_the_material),
     };

@@ -132,6 +132,9 @@ typedef enum {
     X("solver", "front_direction", ENUM, solver.front_direction, 0, NULL, cf_names_front,     \
       CF_R_NONE, "",                                                                           \
       "fronts: onto any facet, or one whose normal stress reaches it (docs/physics.md 5.1)")  \
+    X("solver", "front_threshold", ENUM, solver.front_threshold, 0, NULL, cf_names_front_threshold, \
+      CF_R_NONE, "",                                                                           \
+      "a front's threshold: the strength's, or at most the toughness's (docs/physics.md 5.1)") \
     X("solver", "obstacle_contact", ENUM, solver.obstacle_contact, 0, NULL,                   \
       cf_names_obstacle_contact, CF_R_NONE, "",                                                \
       "explicit runs: project nodes onto obstacles, or a penalty force (docs/physics.md 7.1)") \

@@ -123,6 +123,7 @@ typedef enum { CF_GROWTH_FRONTS, CF_GROWTH_ALL } cf_crack_growth;
  * only one whose own normal stress does (the maximum tangential stress
  * criterion; criterion "source"). */
 typedef enum { CF_FRONT_ANY, CF_FRONT_STRESS } cf_front_direction;
+typedef enum { CF_FRONT_STRENGTH, CF_FRONT_TOUGHNESS } cf_front_threshold;
 /* How fracture-mode nodes meet obstacles in explicit runs (docs/physics.md §7.1). */
 typedef enum { CF_OBSTACLE_CONTACT_KINEMATIC, CF_OBSTACLE_CONTACT_PENALTY } cf_obstacle_contact;
 
@@ -143,6 +144,7 @@ typedef struct cf_solver_settings {
     cf_criterion criterion;
     cf_crack_growth crack_growth;
     cf_front_direction front_direction;
+    cf_front_threshold front_threshold;
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
     double min_piece_size;        /* m: nor one whose equal-volume sphere is narrower;

@@ -156,12 +156,14 @@ enum { STAR_PARALLEL_MIN = 256 };
 
 /* The lowest threshold of the source's rule among the facets on node n's
  * original vertex, Pa: `lowest`, the weakest facet's of the solid, where
- * the strength is uniform.  A nodal value below it passes no facet there
+ * the strength is uniform; with a front threshold from the toughness, no
+ * more than the vertex's lowest as the vertex ahead of a front.  A nodal value below it passes no facet there
  * (source_threshold grows with the strength, rounding included). */
 static double vertex_floor(const cf_solid *s, int n, double lowest)
 {
-    return s->vert_wmin ? source_threshold(s->mat.sigma_max, s->vert_wmin[s->origin[n]])
-                        : lowest;
+    int o = s->origin[n];
+    double floor = s->vert_wmin ? source_threshold(s->mat.sigma_max, s->vert_wmin[o]) : lowest;
+    return s->vert_front_floor ? fmin(floor, s->vert_front_floor[o]) : floor;
 }
 
 /* The source's nodal values at the marked nodes (each node writes its
@@ -217,6 +219,23 @@ static int edge_cracked(const cf_solid *s, int f, int a, int b)
     return 0;
 }
 
+/* The threshold of the vertex at corner j of face k of tet ta as the vertex
+ * ahead of a front, Pa: the facet's `threshold`, or with
+ * solver.front_threshold "toughness" at most the field of a crack tip at
+ * the toughness, K_IC / sqrt(2 pi r), r the vertex's rest distance from
+ * the line of the face's other two vertices, the front's edge (linear
+ * elastic fracture mechanics: the stress a distance r ahead of a tip of
+ * stress intensity K is K / sqrt(2 pi r); docs/physics.md §5.1). */
+static double front_threshold(const cf_solid *s, int ta, int k, int j, double threshold)
+{
+    if (s->front_K <= 0)
+        return threshold;
+    const int *T = &s->tet0[4 * ta], *F = CF_TET_FACE[k];
+    double r = cf_point_line_distance(&s->X[3 * T[F[j]]], &s->X[3 * T[F[(j + 1) % 3]]],
+                                      &s->X[3 * T[F[(j + 2) % 3]]]);
+    return fmin(threshold, cf_front_toughness_threshold(s->front_K, r));
+}
+
 /* The source's rule at a crack front (docs/physics.md §5.1): face k of tet
  * ta shares an edge with a cracked facet, and its vertex off that edge,
  * the one ahead of the front, reaches the threshold.  The two vertices on
@@ -228,7 +247,7 @@ static int front_rule(const cf_solid *s, int ta, int k, double threshold)
     int f = s->tet_facet[4 * ta + k];
     for (int j = 0; j < 3; j++) {
         int n = s->tet[4 * ta + CF_TET_FACE[k][j]];
-        if (!s->node_mark[n] || s->nodal[n] < threshold)
+        if (!s->node_mark[n] || s->nodal[n] < front_threshold(s, ta, k, j, threshold))
             continue;
         if (edge_cracked(s, f, s->tet0[4 * ta + CF_TET_FACE[k][(j + 1) % 3]],
                          s->tet0[4 * ta + CF_TET_FACE[k][(j + 2) % 3]]))
@@ -275,8 +294,9 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule)
 {
     cf_stress_check c = {INFINITY, INFINITY};
     double w = s->strength ? s->strength_min : 1.0; /* the weakest facet */
-    if (rule == CF_CRITERION_SOURCE)
-        c.s1 = source_threshold(s->mat.sigma_max, w);
+    if (rule == CF_CRITERION_SOURCE) /* and no front's below the weakest vertex's */
+        c.s1 = fmin(source_threshold(s->mat.sigma_max, w),
+                    s->vert_front_floor ? s->front_floor_min : INFINITY);
     else if (rule == CF_CRITERION_TRACTION)
         c.s1 = s->mat.sigma_max * w, c.tau = s->mat.tau_max * w;
     return c;
@@ -553,6 +573,7 @@ static double front_stress_ratio(const cf_solid *s, int f)
 {
     const int *F = &s->facet[4 * f];
     double n[3], sn = -INFINITY, w = s->strength ? s->strength[f] : 1.0;
+    double th = source_threshold(s->mat.sigma_max, w), ratio = -INFINITY;
     face_normal(s, F[0], F[1], n);
     for (int j = 0; j < 3; j++) {
         int a = s->tet[4 * F[0] + CF_TET_FACE[F[1]][j]];
@@ -561,9 +582,16 @@ static double front_stress_ratio(const cf_solid *s, int f)
         const double *q = &s->nodal_stress[6 * a];
         double t = q[0] * n[0] * n[0] + q[1] * n[1] * n[1] + q[2] * n[2] * n[2] +
                    2 * (q[3] * n[0] * n[1] + q[4] * n[0] * n[2] + q[5] * n[1] * n[2]);
-        sn = t == t ? fmax(sn, t) : INFINITY;
+        if (t != t)
+            return INFINITY;
+        sn = fmax(sn, t);
+        /* With the toughness each vertex ahead of a cracked edge has a
+         * threshold of its own: the largest ratio among those. */
+        const int *T = &s->tet0[4 * F[0]], *K = CF_TET_FACE[F[1]];
+        if (s->front_K > 0 && edge_cracked(s, f, T[K[(j + 1) % 3]], T[K[(j + 2) % 3]]))
+            ratio = fmax(ratio, t / front_threshold(s, F[0], F[1], j, th));
     }
-    return sn / source_threshold(s->mat.sigma_max, w);
+    return s->front_K > 0 ? fmax(ratio, sn / th) : sn / th;
 }
 
 /* The original vertices of face k of tet t. */

@@ -287,6 +287,45 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     return CF_OK;
 }
 
+double cf_front_toughness_threshold(double K, double r) { return K / sqrt(2 * acos(-1.0) * r); }
+
+double cf_point_line_distance(const double p[3], const double a[3], const double b[3])
+{
+    double e[3], d[3], c[3];
+    for (int k = 0; k < 3; k++)
+        e[k] = b[k] - a[k], d[k] = p[k] - a[k];
+    c[0] = e[1] * d[2] - e[2] * d[1], c[1] = e[2] * d[0] - e[0] * d[2],
+    c[2] = e[0] * d[1] - e[1] * d[0];
+    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) /
+           sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+}
+
+cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
+{
+    s->front_K = sqrt(s->mat.E * s->mat.G_I);
+    s->vert_front_floor = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
+    if (!s->vert_front_floor)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for front thresholds");
+    for (int o = 0; o < s->n_verts0; o++)
+        s->vert_front_floor[o] = INFINITY;
+    s->front_floor_min = INFINITY;
+    for (int f = 0; f < s->n_facets; f++) {
+        if (s->facet[4 * f + 2] < 0) /* a boundary face never cracks */
+            continue;
+        const int *T = &s->tet0[4 * s->facet[4 * f]], *k = CF_TET_FACE[s->facet[4 * f + 1]];
+        for (int j = 0; j < 3; j++) {
+            int o = T[k[j]];
+            double r = cf_point_line_distance(&s->X[3 * o], &s->X[3 * T[k[(j + 1) % 3]]],
+                                              &s->X[3 * T[k[(j + 2) % 3]]]);
+            /* rounded down, so that the float never lies above a threshold */
+            float th = nextafterf((float)cf_front_toughness_threshold(s->front_K, r), 0.0f);
+            s->vert_front_floor[o] = fminf(s->vert_front_floor[o], th);
+            s->front_floor_min = fmin(s->front_floor_min, th);
+        }
+    }
+    return CF_OK;
+}
+
 double cf_solid_crack_area(const cf_solid *s)
 {
     double area = 0;
@@ -451,7 +490,7 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->nodal_stress, s->nodal_check, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vt_start, s->vt_slot, s->coh,
+                    s->cracked, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_floor, s->vt_start, s->vt_slot, s->coh,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);

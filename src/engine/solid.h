@@ -116,6 +116,12 @@ typedef struct cf_solid {
                                  facets on each original vertex (INFINITY where
                                  none; NULL when uniform): below its threshold a
                                  nodal value passes no facet there */
+    double front_K;           /* Pa m^1/2: K_IC = sqrt(E G_I) of a front's threshold
+                                 (solver.front_threshold "toughness"), 0 off */
+    float *vert_front_floor;  /* [n_verts0] Pa, with front_K: the lowest front
+                                 threshold K_IC / sqrt(2 pi r) over the interior
+                                 facets with the vertex ahead (INFINITY where none) */
+    double front_floor_min;   /* Pa, the smallest of them (INFINITY when off) */
     unsigned char *node_mark; /* [cap_nodes] scratch of the insertion check (the
                                  nodes of hot tets) and of a split (the nodes
                                  taken); all 0 between uses (fracture state) */
@@ -169,6 +175,21 @@ cf_status cf_solid_scale_mass(cf_solid *s, double floor, cf_error *err);
  * crack flags and the stress of the checks: the fracture state, built only for a scene that may insert
  * cohesive elements (criterion other than "none").  Errors: CF_ERR_NOMEM. */
 cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
+
+/* A crack front's threshold from the toughness (solver.front_threshold
+ * "toughness", docs/physics.md §5.1): s->front_K = K_IC = sqrt(E G_I) (Pa
+ * m^1/2), and each original vertex's lowest threshold K_IC / sqrt(2 pi r)
+ * as the vertex ahead of a front, r (m) its rest distance from the line of
+ * the opposite edge of an interior facet.  After cf_solid_init_facets.
+ * Errors: CF_ERR_NOMEM. */
+cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err);
+
+/* A front threshold at the toughness, Pa: K_IC / sqrt(2 pi r) for a vertex
+ * ahead at rest distance r (m) from the front's edge. */
+double cf_front_toughness_threshold(double K, double r);
+
+/* Rest distance (m) of point p from the line through a and b. */
+double cf_point_line_distance(const double p[3], const double a[3], const double b[3]);
 
 /* Crack area, m^2: the rest area of every facet whose cohesive element has
  * failed completely (all three node pairs), one side counted. */

@@ -441,6 +441,10 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
             st = cf_solid_scale_mass(&w->solid, scene->solver.mass_scaling, err);
         if (st == CF_OK && scene->solver.criterion != CF_CRITERION_NONE)
             st = cf_solid_init_facets(&w->solid, err);
+        if (st == CF_OK && scene->solver.criterion == CF_CRITERION_SOURCE &&
+            scene->solver.crack_growth == CF_GROWTH_FRONTS &&
+            scene->solver.front_threshold == CF_FRONT_TOUGHNESS)
+            st = cf_solid_init_front_toughness(&w->solid, err);
         cf_mesh_free(&all);
     }
     free(bc);

@@ -158,6 +158,11 @@
  *       vertex), or only one whose own normal stress (the nodal stress ahead
  *       across the facet's normal) reaches its threshold, the highest first:
  *       the maximum tangential stress criterion (docs/physics.md §5.1)
+ *     front_threshold ["strength"] | "toughness": with "fronts" and
+ *       criterion "source", the stress a front needs ahead of it: its facet's
+ *       threshold, or at most K_IC / sqrt(2 pi r), K_IC = sqrt(E G_I) and r
+ *       the rest distance of the vertex ahead from the front's edge: the
+ *       field of a crack tip at the toughness (docs/physics.md §5.1)
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
