@@ -157,8 +157,9 @@ enum { STAR_PARALLEL_MIN = 256 };
 /* The lowest threshold of the source's rule among the facets on node n's
  * original vertex, Pa: `lowest`, the weakest facet's of the solid, where
  * the strength is uniform; with a front threshold from the toughness, no
- * more than the vertex's lowest as the vertex ahead of a front.  A nodal value below it passes no facet there
- * (source_threshold grows with the strength, rounding included). */
+ * more than the vertex's lowest as the vertex ahead of a front.  A nodal
+ * value below it passes no facet there (source_threshold grows with the
+ * strength, rounding included). */
 static double vertex_floor(const cf_solid *s, int n, double lowest)
 {
     int o = s->origin[n];
@@ -228,12 +229,7 @@ static int edge_cracked(const cf_solid *s, int f, int a, int b)
  * stress intensity K is K / sqrt(2 pi r); docs/physics.md §5.1). */
 static double front_threshold(const cf_solid *s, int ta, int k, int j, double threshold)
 {
-    if (s->front_K <= 0)
-        return threshold;
-    const int *T = &s->tet0[4 * ta], *F = CF_TET_FACE[k];
-    double r = cf_point_line_distance(&s->X[3 * T[F[j]]], &s->X[3 * T[F[(j + 1) % 3]]],
-                                      &s->X[3 * T[F[(j + 2) % 3]]]);
-    return fmin(threshold, cf_front_toughness_threshold(s->front_K, r));
+    return s->front_K > 0 ? fmin(threshold, cf_front_toughness(s, ta, k, j)) : threshold;
 }
 
 /* The source's rule at a crack front (docs/physics.md §5.1): face k of tet
@@ -567,8 +563,10 @@ static double facet_ratio(const cf_solid *s, int f, cf_criterion rule)
  * each of its nodes valued in this check (nodal_principal), the largest of
  * them, over the facet's threshold.  The node ahead of the front gives it:
  * the two on the cracked edge read the unloaded wake, as the front rule
- * says.  A NaN reads as infinitely far (the divergence guard stops the
- * run); -INFINITY when no node was valued. */
+ * says.  With a front threshold from the toughness, also each vertex ahead
+ * of a cracked edge over its own (front_threshold), and the larger ratio.
+ * A NaN reads as infinitely far (the divergence guard stops the run);
+ * -INFINITY when no node was valued. */
 static double front_stress_ratio(const cf_solid *s, int f)
 {
     const int *F = &s->facet[4 * f];

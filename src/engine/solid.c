@@ -287,17 +287,15 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     return CF_OK;
 }
 
-double cf_front_toughness_threshold(double K, double r) { return K / sqrt(2 * acos(-1.0) * r); }
-
-double cf_point_line_distance(const double p[3], const double a[3], const double b[3])
+double cf_front_toughness(const cf_solid *s, int t, int k, int j)
 {
+    const int *T = &s->tet0[4 * t], *F = CF_TET_FACE[k];
+    const double *p = &s->X[3 * T[F[j]]], *a = &s->X[3 * T[F[(j + 1) % 3]]],
+                 *b = &s->X[3 * T[F[(j + 2) % 3]]];
     double e[3], d[3], c[3];
-    for (int k = 0; k < 3; k++)
-        e[k] = b[k] - a[k], d[k] = p[k] - a[k];
-    c[0] = e[1] * d[2] - e[2] * d[1], c[1] = e[2] * d[0] - e[0] * d[2],
-    c[2] = e[0] * d[1] - e[1] * d[0];
-    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) /
-           sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    v3_sub(b, a, e), v3_sub(p, a, d), v3_cross(e, d, c);
+    double r = v3_norm(c) / v3_norm(e); /* from the line through a and b */
+    return s->front_K / sqrt(2 * acos(-1.0) * r);
 }
 
 cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
@@ -312,13 +310,11 @@ cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
     for (int f = 0; f < s->n_facets; f++) {
         if (s->facet[4 * f + 2] < 0) /* a boundary face never cracks */
             continue;
-        const int *T = &s->tet0[4 * s->facet[4 * f]], *k = CF_TET_FACE[s->facet[4 * f + 1]];
+        int t = s->facet[4 * f], k = s->facet[4 * f + 1];
         for (int j = 0; j < 3; j++) {
-            int o = T[k[j]];
-            double r = cf_point_line_distance(&s->X[3 * o], &s->X[3 * T[k[(j + 1) % 3]]],
-                                              &s->X[3 * T[k[(j + 2) % 3]]]);
+            int o = s->tet0[4 * t + CF_TET_FACE[k][j]];
             /* rounded down, so that the float never lies above a threshold */
-            float th = nextafterf((float)cf_front_toughness_threshold(s->front_K, r), 0.0f);
+            float th = nextafterf((float)cf_front_toughness(s, t, k, j), 0.0f);
             s->vert_front_floor[o] = fminf(s->vert_front_floor[o], th);
             s->front_floor_min = fmin(s->front_floor_min, th);
         }

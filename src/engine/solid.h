@@ -184,12 +184,11 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
  * Errors: CF_ERR_NOMEM. */
 cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err);
 
-/* A front threshold at the toughness, Pa: K_IC / sqrt(2 pi r) for a vertex
- * ahead at rest distance r (m) from the front's edge. */
-double cf_front_toughness_threshold(double K, double r);
-
-/* Rest distance (m) of point p from the line through a and b. */
-double cf_point_line_distance(const double p[3], const double a[3], const double b[3]);
+/* The field of a crack tip at the toughness, Pa: K_IC / sqrt(2 pi r) at the
+ * vertex at corner j of face k of tet t as the vertex ahead of a front, r
+ * (m) its rest distance from the line of the face's other two vertices
+ * (the front's edge).  With s->front_K set. */
+double cf_front_toughness(const cf_solid *s, int t, int k, int j);
 
 /* Crack area, m^2: the rest area of every facet whose cohesive element has
  * failed completely (all three node pairs), one side counted. */

@@ -228,7 +228,8 @@ def main():
     worst = max(every, key=lambda r: r["residual"])
     bad = [tag for r in every for tag in r["bad"]]
     checks.append(("residual", worst["residual"] <= 0.01 and not bad,
-                   f"{len(every)} cases ({sum(len(r['seeds']) for r in every)} runs), largest residual {100 * worst['residual']:.3g} % "
+                   f"{len(every)} cases ({sum(len(r['seeds']) for r in every)} runs), "
+                   f"largest residual {100 * worst['residual']:.3g} % "
                    f"({worst['tag']}); outside tests/checks/check_physics.py: {', '.join(bad) or 'none'}"))
 
     write_report(out, a.size, ladder, threshold, twice, conv, checks)
