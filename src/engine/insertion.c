@@ -178,9 +178,25 @@ static double vertex_floor(const cf_solid *s, int n, double lowest)
  * rank reads all three of its nodes' (facet_ratio). */
 static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowest)
 {
+    /* The copies of one original vertex in the fragment share its star,
+     * so they share its value: the first copy to claim the vertex in this
+     * check walks the star, the others take what it found.  Beside a crack
+     * a vertex has two or more copies, and the marked nodes lie there. */
+    unsigned stamp = s->check_stamp;
     CF_PARALLEL(marked->n >= STAR_PARALLEL_MIN, "omp parallel for schedule(static)",
-        for (int i = 0; i < marked->n; i++)
-            s->nodal[marked->v[i]] = nodal_principal(s, marked->v[i], frag, lowest););
+        for (int i = 0; i < marked->n; i++) {
+            int n = marked->v[i], o = s->origin[n];
+            if (__atomic_exchange_n(&s->vert_check[o], stamp, __ATOMIC_RELAXED) != stamp)
+                s->vert_node[o] = n, s->nodal[n] = nodal_principal(s, n, frag, lowest);
+        });
+    CF_PARALLEL(marked->n >= STAR_PARALLEL_MIN, "omp parallel for schedule(static)",
+        for (int i = 0; i < marked->n; i++) {
+            int n = marked->v[i], m = s->vert_node[s->origin[n]];
+            if (m != n) {
+                s->nodal[n] = s->nodal[m], s->nodal_check[n] = stamp;
+                memcpy(&s->nodal_stress[6 * n], &s->nodal_stress[6 * m], 6 * sizeof(double));
+            }
+        });
     int kept = 0;
     for (int i = 0; i < marked->n; i++) {
         int n = marked->v[i];
@@ -369,6 +385,7 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
         return -1;
     if (++s->check_stamp == 0) { /* wrapped: no node was valued in check 0 */
         memset(s->nodal_check, 0, (size_t)s->cap_nodes * sizeof(unsigned));
+        memset(s->vert_check, 0, (size_t)s->n_verts0 * sizeof(unsigned));
         s->check_stamp = 1;
     }
     if (rule == CF_CRITERION_SOURCE) /* no facet threshold lies below the bound's s1 */

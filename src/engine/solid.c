@@ -241,11 +241,13 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
     s->nodal_stress = malloc((size_t)s->cap_nodes * 6 * sizeof(double));
     s->nodal_check = calloc((size_t)s->cap_nodes, sizeof(unsigned)); /* no check is 0 */
     s->check_stamp = 0;
+    s->vert_check = calloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1), sizeof(unsigned));
+    s->vert_node = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(int));
     s->piece = malloc((size_t)s->n_tets * sizeof(int));
     s->piece_mark = calloc((size_t)s->n_tets, sizeof(unsigned));
     s->piece_stamp = 0;
     if (!s->sigma || !s->hot || !s->qualify || !s->node_mark || !s->nodal ||
-        !s->nodal_stress || !s->nodal_check || !s->piece ||
+        !s->nodal_stress || !s->nodal_check || !s->vert_check || !s->vert_node || !s->piece ||
         !s->piece_mark || build_facets(s))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory building facets of %d tets",
                             s->n_tets);
@@ -485,7 +487,7 @@ void cf_solid_free(cf_solid *s)
     void *ptrs[] = {s->X, s->x, s->v, s->p, s->f, s->m, s->vcap, s->speed, s->mass_scale,
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
-                    s->nodal, s->nodal_stress, s->nodal_check, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
+                    s->nodal, s->nodal_stress, s->nodal_check, s->vert_check, s->vert_node, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
                     s->cracked, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_floor, s->vt_start, s->vt_slot, s->coh,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)

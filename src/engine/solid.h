@@ -131,6 +131,10 @@ typedef struct cf_solid {
                                  nodal value (xx yy zz xy xz yz), Pa */
     unsigned *nodal_check;    /* [cap_nodes] the check that last valued each node */
     unsigned check_stamp;     /* the last check's number (cf_insertion_candidates) */
+    unsigned *vert_check;     /* [n_verts0] the check that last valued a copy of each
+                                 original vertex */
+    int *vert_node;           /* [n_verts0] that copy: the others of the check take
+                                 its values (nodal_values) */
     int *piece;               /* [nt] scratch of the small-piece search: tets reached */
     unsigned *piece_mark;     /* [nt] the search's stamp of each tet reached */
     unsigned piece_stamp;     /* the last stamp used */
