@@ -327,7 +327,7 @@ static int *deformed_box(cf_solid *s, cf_mesh *m, cf_criterion rule, double stre
         all[t] = t;
     cf_stress_check bound = cf_insertion_bound(s, rule);
     *n_hot = 0;
-    cf_tet4_forces(s, all, s->n_tets, CF_ELASTICITY_COROTATIONAL, &bound, n_hot);
+    cf_tet4_forces(s, all, s->n_tets, CF_ELASTICITY_COROTATIONAL, &bound, 0, n_hot);
     return all;
 }
 

@@ -106,7 +106,7 @@ static void test_scatter_equals_the_tet_order_sum(void **state)
     for (int i = 0; i < s.n_nodes; i++)
         nodes[i] = (5 * i) % s.n_nodes; /* the list in no particular order */
     assert_int_equal(s.n_nodes % 5 != 0, 1);
-    cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     const double g[3] = {0.1, -0.2, -9.81};
     double *want = malloc((size_t)s.n_nodes * 3 * sizeof(double));
     for (int a = 0; a < s.n_nodes; a++)

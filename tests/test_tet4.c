@@ -98,7 +98,7 @@ static void stretch_case(cf_elasticity kind)
     for (int i = 0; i < 4; i++)
         s.x[3 * i] = (1 + e) * s.X[3 * i];
     int t = 0;
-    cf_tet4_forces(&s, &t, 1, kind, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, kind, NULL, 0, NULL);
     double sigma[9];
     cf_tet4_stress(&s, 0, kind, sigma);
     double lam = s.lambda, mu = s.mu;
@@ -135,11 +135,11 @@ static void test_crushing_uniaxial_strain(void **state)
     double sc = mat.compressive_strength, ey = sc / (2 * s.mu), e = -3 * ey;
     double K = s.lambda + 2 * s.mu / 3, V = s.vol[0];
     int t = 0;
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     assert_true(s.wp[0] == 0); /* at rest: elastic */
     for (int i = 0; i < 4; i++)
         s.x[3 * i] = (1 + e) * s.X[3 * i];
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     double sigma[9];
     cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
     assert_near(sigma[0] - sigma[4], -sc, 1e-9 * sc);
@@ -149,20 +149,98 @@ static void test_crushing_uniaxial_strain(void **state)
     assert_near(s.wp[0], w_closed, 1e-9 * w_closed);
     /* strain energy: the elastic part only, 1/2 sigma : (eps - eps_p) V */
     assert_near(s.tw[0], 0.5 * V * (K * e * e + sc * sc / (3 * s.mu)), 1e-9 * s.tw[0]);
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     assert_near(s.wp[0], w_closed, 1e-9 * w_closed); /* on the surface: no more flow */
     for (int i = 0; i < 4; i++) /* unloading by 1.5 e_y (< 2 e_y): elastic */
         s.x[3 * i] = (1 + e / 2) * s.X[3 * i];
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
     assert_near(s.wp[0], w_closed, 1e-9 * w_closed);
     assert_near(sigma[0] - sigma[4], 0.5 * sc, 1e-9 * sc);
     cf_tet4_drop_plastic_strain(&s, &t, 1);
     for (int i = 0; i < 4; i++)
         memcpy(&s.x[3 * i], &s.X[3 * i], 3 * sizeof(double));
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     assert_near(s.wp[0], w_closed, 1e-9 * w_closed); /* the work done stays booked */
     assert_near(s.tw[0], 0.0, 1e-20);
+    cf_solid_free(&s);
+}
+
+/* Linear bulk viscosity (docs/physics.md §2.3): a tet turned rigidly by
+ * R (stress free) whose nodes move with the velocity a (x - c) + w x (x - c),
+ * a uniform dilatation rate and a spin, has the volumetric strain rate
+ * D = 3a, whatever the spin, and carries the viscous pressure -eta D with
+ * eta = b1 rho c_d h, h = 6 V / (face area): the force on node a is
+ * -V eta D R grad N_a, and the forces take V eta D^2 of power.  The
+ * work booked over a step of length dt is the leapfrog's trapezoid,
+ * 1/2 V eta dt (D' D + D^2) with D' the last pass's rate: 1/2 V eta dt D^2
+ * at the first pass, V eta dt D^2 more at the second; a rigid motion alone
+ * takes nothing, and the check's stress stays the material's (zero). */
+static void test_bulk_viscosity_of_a_dilatation(void **state)
+{
+    (void)state;
+    cf_material mat = material(5e9, 0.2, 1200);
+    cf_solid s;
+    one_tet(&s, skew, &mat);
+    double b1 = 0.06, R[9], q[4] = {cos(0.2), sin(0.2) * 0.6, sin(0.2) * 0.0, sin(0.2) * 0.8};
+    quat_to_mat(q, R);
+    assert_int_equal(cf_solid_init_bulk_viscosity(&s, b1, NULL), CF_OK);
+    double c_d = sqrt((s.lambda + 2 * s.mu) / mat.rho), V = s.vol[0];
+    double area = 0;
+    for (int k = 0; k < 4; k++) { /* the faces opposite each corner */
+        const double *a = skew[(k + 1) % 4], *b = skew[(k + 2) % 4], *c = skew[(k + 3) % 4];
+        double e1[3], e2[3], n[3];
+        v3_sub(b, a, e1), v3_sub(c, a, e2), v3_cross(e1, e2, n);
+        area += 0.5 * v3_norm(n);
+    }
+    double eta = b1 * mat.rho * c_d * 6 * V / area;
+    assert_near(s.bv_eta[0], eta, 1e-12 * eta);
+    double rate = 40, spin[3] = {30, -20, 50}, c[3] = {0.4, 0.4, 0.35}, D = 3 * rate, dt = 1e-7;
+    for (int i = 0; i < 4; i++) {
+        double r[3], w[3];
+        v3_sub(skew[i], c, r);
+        m3_mulv(R, r, w); /* turned about c */
+        for (int k = 0; k < 3; k++)
+            s.x[3 * i + k] = c[k] + w[k], r[k] = w[k];
+        v3_cross(spin, r, w);
+        for (int k = 0; k < 3; k++)
+            s.v[3 * i + k] = rate * r[k] + w[k];
+    }
+    int t = 0;
+    double g[4][3];
+    cf_tet4_gradients(&s, 0, g);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, dt, NULL);
+    double power = 0, scale = V * eta * D * 10;
+    for (int a = 0; a < 4; a++) {
+        double Rg[3];
+        m3_mulv(R, g[a], Rg);
+        for (int k = 0; k < 3; k++)
+            assert_near(s.tf[3 * a + k], -V * eta * D * Rg[k], 1e-5 * scale);
+        power += v3_dot(&s.tf[3 * a], &s.v[3 * a]);
+    }
+    assert_near(power, -V * eta * D * D, 1e-4 * V * eta * D * D);
+    assert_near(s.bv_rate[0], D, 1e-4 * D);
+    double w1 = 0.5 * V * eta * dt * D * D;
+    assert_near(s.bv_work[0], w1, 1e-4 * w1);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, dt, NULL);
+    assert_near(s.bv_work[0], 3 * w1, 3e-4 * w1);
+    double sigma[9];
+    cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
+    for (int k = 0; k < 9; k++)
+        assert_near(sigma[k], 0.0, 1e-6 * eta * D);
+    /* the spin alone: no force, no work (the rotation found to its
+     * tolerance, 1e-7, leaves a rate of 1e-5 of the spin) */
+    for (int i = 0; i < 4; i++) {
+        double r[3];
+        v3_sub(&s.x[3 * i], c, r);
+        v3_cross(spin, r, &s.v[3 * i]);
+    }
+    cf_tet4_drop_plastic_strain(&s, &t, 1); /* a hand-off: the last rate is zeroed */
+    assert_near(s.bv_rate[0], 0.0, 0.0);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, dt, NULL);
+    for (int k = 0; k < 12; k++)
+        assert_near(s.tf[k], 0.0, 1e-6 * scale);
+    assert_near(s.bv_work[0], 3 * w1, 3e-4 * w1);
     cf_solid_free(&s);
 }
 
@@ -189,7 +267,7 @@ static void test_crushing_grows_with_pressure(void **state)
     int t = 0;
     for (int i = 0; i < 4; i++)
         s.x[3 * i] = (1 + e) * s.X[3 * i];
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     double sigma[9], q = k + beta * K * fabs(e);
     cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
     assert_near(sigma[0] - sigma[4], -q, 1e-9 * q);
@@ -207,7 +285,7 @@ static void test_crushing_grows_with_pressure(void **state)
     double g = 2 * (k / sqrt(3)) / s.mu; /* engineering shear strain, twice the yield */
     for (int i = 0; i < 4; i++)
         s.x[3 * i] = s.X[3 * i] + g * s.X[3 * i + 1];
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_LINEAR, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_LINEAR, NULL, 0, NULL);
     cf_tet4_stress(&s, 0, CF_ELASTICITY_LINEAR, sigma);
     assert_near(sigma[1], k / sqrt(3), 1e-9 * k);
     assert_true(s.wp[0] > 0);
@@ -238,10 +316,10 @@ static void test_rigid_rotation_is_stress_free(void **state)
     for (int i = 0; i < 4; i++)
         m3_mulv(R, &s.X[3 * i], &s.x[3 * i]);
     int t = 0;
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
     for (int k = 0; k < 12; k++)
         assert_near(s.tf[k], 0.0, 1e-9 * s.mu * s.vol[0]);
-    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_LINEAR, NULL, NULL);
+    cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_LINEAR, NULL, 0, NULL);
     double fmax = 0;
     for (int k = 0; k < 12; k++)
         fmax = fmax > fabs(s.tf[k]) ? fmax : fabs(s.tf[k]);
@@ -330,7 +408,7 @@ static void test_lanes_equal_one_tet_at_a_time(void **state)
             memcpy(&q0[4 * t], qt, sizeof qt);
         }
         cf_stress_check check = {INFINITY, INFINITY};
-        cf_tet4_forces(&s, list, nt, el, &check, NULL);
+        cf_tet4_forces(&s, list, nt, el, &check, 0, NULL);
         for (int i = 0; i < nt; i++) {
             int t = list[i];
             double f[12], w, sigma[9], sigma_one[9];
@@ -480,6 +558,7 @@ int main(void)
         cmocka_unit_test(test_rigid_rotation_is_stress_free),
         cmocka_unit_test(test_crushing_uniaxial_strain),
         cmocka_unit_test(test_crushing_grows_with_pressure),
+        cmocka_unit_test(test_bulk_viscosity_of_a_dilatation),
         cmocka_unit_test(test_no_crushing_no_plastic_state),
         cmocka_unit_test(test_lanes_equal_one_tet_at_a_time),
         cmocka_unit_test(test_cfl_of_regular_tet),

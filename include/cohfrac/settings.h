@@ -140,6 +140,8 @@ typedef enum {
       "explicit runs: project nodes onto obstacles, or a penalty force (docs/physics.md 7.1)") \
     X("solver", "mass_scaling", NUM, solver.mass_scaling, 0, NULL, NULL, CF_R_UNIT, "",       \
       "floor of a tet's stable step over the median's, by added mass; 0 none")                \
+    X("solver", "bulk_viscosity", NUM, solver.bulk_viscosity, 0, NULL, NULL, CF_R_UNIT, "",   \
+      "linear bulk viscosity b1 of fracture mode (docs/physics.md 2.3); 0 none")              \
     X("solver", "min_piece_tets", INT, solver.min_piece_tets, 4, NULL, NULL, CF_R_PIECE_TETS, \
       "", "no insertion closes a piece of at most this many tets; 0 no bound")                \
     X("solver", "min_piece_size", NUM, solver.min_piece_size, 0, NULL, NULL,                  \

@@ -164,6 +164,7 @@ typedef struct cf_solver_settings {
     double contact_stiffness;     /* Pa/m, 0 = stability cap */
     cf_obstacle_contact obstacle_contact; /* explicit runs: kinematic or penalty */
     double mass_scaling;          /* floor of a tet's step over the median's; 0: none */
+    double bulk_viscosity;        /* linear bulk viscosity b1 of explicit runs; 0: none */
     double max_inverted_fraction;
     double max_energy_growth;
     int threads;

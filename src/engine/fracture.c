@@ -374,14 +374,14 @@ static void penalty_chunk(void *ctx, int i0, int i1, double *acc)
  * x_n (corotational or Neo-Hookean forces per tet, rotation, inverted
  * tets; the stress too when `check`), and the strain energy.  Returns how
  * many tets are above the criterion's bound (cf_tet4_forces). */
-static int elasticity(const cf_step_ctx *ctx, cf_fragment *f, int check)
+static int elasticity(const cf_step_ctx *ctx, cf_fragment *f, int check, double dt)
 {
     cf_solid *s = ctx->solid;
     const cf_solver_settings *set = &ctx->def->solver;
     cf_stress_check bound = cf_insertion_bound(s, set->criterion);
     int n_hot = 0;
     f->n_inverted = cf_tet4_forces(s, f->tets, f->nt, set->elasticity, check ? &bound : NULL,
-                                   &n_hot);
+                                   dt, &n_hot);
     f->e_strain = cf_tet4_strain_energy(s, f->tets, f->nt);
     return n_hot;
 }
@@ -725,12 +725,12 @@ static void velocity_update(const cf_step_ctx *ctx, cf_fragment *f, const cf_con
 /* Stages elasticity (part one) of a fracture step: e_strain restarts from
  * the tets' strain energy.  *check: whether the criterion is checked at
  * this step (every check_interval steps).  Returns the hot tets' count. */
-static int fracture_stress(const cf_step_ctx *ctx, cf_fragment *f, int *check)
+static int fracture_stress(const cf_step_ctx *ctx, cf_fragment *f, int *check, double dt)
 {
     const cf_solver_settings *set = &ctx->def->solver;
     *check = set->criterion != CF_CRITERION_NONE && (f->steps % set->check_interval) == 0;
     f->e_strain = 0;
-    int n_hot = elasticity(ctx, f, *check);
+    int n_hot = elasticity(ctx, f, *check, dt);
     cf_profile_lap(ctx->prof, CF_STAGE_ELASTICITY);
     return n_hot;
 }
@@ -840,7 +840,7 @@ static cf_status pass_one(const cf_step_ctx *ctx, const pass *p, int stage, int 
 {
     int fi = p->list[i];
     if (stage == PASS_STRESS) {
-        p->n_hot[i] = fracture_stress(ctx, &p->frag[fi], &p->check[i]);
+        p->n_hot[i] = fracture_stress(ctx, &p->frag[fi], &p->check[i], p->dt);
         return CF_OK;
     }
     return solver_advance(ctx, &p->frag[fi], fi, p->t, p->dt, 1);

@@ -228,6 +228,26 @@ static double strength_field(int seed, double L, double m, const double x[3])
     return pow(-log(survive), 1.0 / m);
 }
 
+cf_status cf_solid_init_bulk_viscosity(cf_solid *s, double b1, cf_error *err)
+{
+    int nt = s->n_tets;
+    s->bv_eta = malloc((size_t)(nt > 0 ? nt : 1) * sizeof(double));
+    s->bv_rate = calloc((size_t)(nt > 0 ? nt : 1), sizeof(double));
+    s->bv_work = calloc((size_t)(nt > 0 ? nt : 1), sizeof(double));
+    if (!s->bv_eta || !s->bv_rate || !s->bv_work)
+        return cf_error_set(err, CF_ERR_NOMEM, "out of memory for the bulk viscosity of %d tets",
+                            nt);
+    double modulus = s->lambda + 2 * s->mu; /* rho c_d^2 */
+    for (int t = 0; t < nt; t++) {
+        const int *T = &s->tet0[4 * t];
+        double rho = s->mat.rho * (s->mass_scale ? s->mass_scale[t] : 1.0);
+        double h = tet_h(s->vol[t], &s->X[3 * T[0]], &s->X[3 * T[1]], &s->X[3 * T[2]],
+                         &s->X[3 * T[3]]);
+        s->bv_eta[t] = b1 * sqrt(rho * modulus) * h; /* b1 rho c_t h */
+    }
+    return CF_OK;
+}
+
 cf_status cf_solid_init_facets(cf_solid *s, cf_error *err)
 {
     if (s->facet)
@@ -489,7 +509,8 @@ void cf_solid_free(cf_solid *s)
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->nodal_stress, s->nodal_check, s->vert_check, s->vert_node, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
                     s->cracked, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_floor, s->vt_start, s->vt_slot, s->coh,
-                    s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until};
+                    s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until,
+                    s->bv_eta, s->bv_rate, s->bv_work};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)
         free(ptrs[i]);
     cf_crack_grid_free(&s->cracks);

@@ -153,6 +153,11 @@ typedef struct cf_solid {
     double *mass_scale;
     int n_mass_scaled;
     double mass_scale_max, mass_added, mass_total;
+    /* Linear bulk viscosity (solver.bulk_viscosity, docs/physics.md §2.3;
+     * NULL without): [nt] each tet's volumetric viscosity b1 rho_t c_t h_t,
+     * Pa s; its volumetric strain rate at the last force pass, 1/s (0 in
+     * rigid mode); the work the viscosity has taken from it, J. */
+    double *bv_eta, *bv_rate, *bv_work;
 } cf_solid;
 
 /* Mass of tet t, kg: rho V, times its mass scale. */
@@ -174,6 +179,14 @@ void cf_solid_free(cf_solid *s);
  * masses grow by as much; dt_cfl becomes the smallest step after scaling.
  * floor in (0, 1]; 0 does nothing.  Errors: CF_ERR_NOMEM. */
 cf_status cf_solid_scale_mass(cf_solid *s, double floor, cf_error *err);
+
+/* Linear bulk viscosity (docs/physics.md §2.3): each tet's volumetric
+ * viscosity b1 rho_t c_t h_t (Pa s), rho_t its density (mass scaling
+ * included), c_t its dilatational wave speed, h_t = 6 V / (face area) its
+ * rest length of the stable step (§3).  After cf_solid_scale_mass.
+ * b1 > 0 (dimensionless, the fraction of critical damping of the
+ * highest dilatational mode).  Errors: CF_ERR_NOMEM. */
+cf_status cf_solid_init_bulk_viscosity(cf_solid *s, double b1, cf_error *err);
 
 /* The facets (interior and boundary faces), each tet face's facet, the
  * crack flags and the stress of the checks: the fracture state, built only for a scene that may insert

@@ -275,31 +275,96 @@ static inline vd lanes_det(lane9 A)
            A[2] * (A[3] * A[7] - A[4] * A[6]);
 }
 
+/* tr(R^T dF/dt) of tets t[0..LANES-1]: the volumetric strain rate in the
+ * element frame (1/s), dF/dt from the nodes' velocities as F from their
+ * positions; zero for a rigid motion, whatever R. */
+static inline __attribute__((always_inline)) vd lanes_volume_rate(const cf_solid *s,
+                                                                  const int t[LANES], lane9 Di,
+                                                                  lane9 R)
+{
+    vd V[4][3];
+    for (int j = 0; j < 4; j++) {
+        int node[LANES];
+        for (int l = 0; l < LANES; l++)
+            node[l] = s->tet[4 * t[l] + j];
+        lanes_load(s->v, 3, node, V[j]);
+    }
+    lane9 Vs, Fdot;
+    for (int j = 0; j < 3; j++)
+        for (int r = 0; r < 3; r++)
+            Vs[3 * r + j] = V[j + 1][r] - V[0][r];
+    lanes_mul(Vs, Di, Fdot);
+    vd rate = splat(0);
+    for (int k = 0; k < 9; k++)
+        rate += R[k] * Fdot[k];
+    return rate;
+}
+
+/* Linear bulk viscosity (docs/physics.md §2.3): the pressure -eta D of the
+ * volumetric strain rate D added to the first stress P of tets t (P += eta
+ * D R, live lanes only), and its work over the step of length dt that
+ * ended at these positions, booked per tet.  The leapfrog gives up
+ * 1/2 (f' + f) . (x - x') to a force (§10); the nodes moved by dt v, v the
+ * velocities this pass reads, so with f = -V eta D R grad N the viscosity
+ * took 1/2 V eta dt (D' D_R' + D^2), D' the last pass's rate and D_R' this
+ * motion's rate in the last pass's frame R' (the rotation's warm start). */
+/* (always inlined, as every helper that takes a vector by value: the
+ * kernel's clones for wider vector units would pass it otherwise than a
+ * plain function takes it) */
+static inline __attribute__((always_inline)) void bulk_viscosity(cf_solid *s, const int t[LANES],
+                                                                 int n, tet_lanes *L,
+                                                                 cf_elasticity kind, vd live,
+                                                                 vd vol, double dt, lane9 P)
+{
+    vd eta, last;
+    lanes_load(s->bv_eta, 1, t, &eta);
+    lanes_load(s->bv_rate, 1, t, &last);
+    eta *= live;
+    vd rate = lanes_volume_rate(s, t, L->Di, L->R), rate_then = rate;
+    if (kind == CF_ELASTICITY_COROTATIONAL) { /* s->rq: the last pass's rotation */
+        vd q[4];
+        lane9 R0;
+        lanes_load(s->rq, 4, t, q);
+        lanes_quat_to_mat(q, R0);
+        rate_then = lanes_volume_rate(s, t, L->Di, R0);
+    }
+    for (int k = 0; k < 9; k++)
+        P[k] += eta * rate * L->R[k];
+    vd work = 0.5 * vol * eta * dt * (last * rate_then + rate * rate);
+    for (int l = 0; l < n; l++)
+        s->bv_work[t[l]] += work[l], s->bv_rate[t[l]] = rate[l];
+}
+
 /* cf_tet4_forces for tets t[0..n-1], n <= LANES (the missing lanes repeat
  * the first tet and are dropped); counts inverted and hot tets. */
 CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_elasticity kind,
-                      const cf_stress_check *check, int *inverted, int *hot)
+                      const cf_stress_check *check, double dt, int *inverted, int *hot)
 {
     int t[LANES];
     for (int l = 0; l < LANES; l++)
         t[l] = tets[l < n ? l : 0];
     tet_lanes L;
     tet_lanes_eval(s, t, kind, &L);
-    lane9 P, *G = &L.Di; /* P = R sigma; G: rows grad N1..N3 */
+    lane9 P, Pf, *G = &L.Di; /* P = R sigma, Pf with the viscosity; G: rows grad N1..N3 */
     lanes_mul(L.R, L.sig, P);
     vd vol = {s->vol[t[0]], s->vol[t[1]], s->vol[t[2]], s->vol[t[3]]}, v = -vol;
+    vd live = splat(1); /* a crushed tet is powder: it carries nothing (§2.2) */
+    if (s->crushed)
+        for (int l = 0; l < LANES; l++)
+            live[l] = !s->crushed[t[l]];
+    for (int k = 0; k < 9; k++)
+        Pf[k] = P[k];
+    if (s->bv_eta) /* a force, not a stress of the material: the check reads P */
+        bulk_viscosity(s, t, n, &L, kind, live, vol, dt, Pf);
     vd f[12]; /* f_a = -V P grad N_a, grad N0 = -(grad N1 + grad N2 + grad N3) */
     for (int a = 0; a < 4; a++) {
         vd g[3];
         for (int c = 0; c < 3; c++)
             g[c] = a ? (*G)[3 * (a - 1) + c] : -((*G)[c] + (*G)[3 + c] + (*G)[6 + c]);
         for (int r = 0; r < 3; r++)
-            f[3 * a + r] = v * (P[3 * r] * g[0] + P[3 * r + 1] * g[1] + P[3 * r + 2] * g[2]);
+            f[3 * a + r] = v * (Pf[3 * r] * g[0] + Pf[3 * r + 1] * g[1] + Pf[3 * r + 2] * g[2]);
     }
-    vd live = splat(1); /* a crushed tet is powder: it carries nothing (§2.2) */
     if (s->crushed) {
-        for (int l = 0; l < LANES; l++)
-            live[l] = !s->crushed[t[l]];
         for (int k = 0; k < 12; k++)
             f[k] *= live;
         for (int k = 0; k < 9; k++)
@@ -335,7 +400,7 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
 }
 
 int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
-                   const cf_stress_check *check, int *n_hot)
+                   const cf_stress_check *check, double dt, int *n_hot)
 {
     int inverted = 0, hot = 0;
     /* Threads only for fragments large enough to repay the fork and join:
@@ -344,8 +409,8 @@ int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
     CF_PARALLEL(nt >= CF_TET4_PARALLEL_MIN,
                 "omp parallel for schedule(static) reduction(+ : inverted, hot)",
         for (int i0 = 0; i0 < nt; i0 += LANES)
-            tet_block(s, &tets[i0], nt - i0 < LANES ? nt - i0 : LANES, kind, check, &inverted,
-                      &hot););
+            tet_block(s, &tets[i0], nt - i0 < LANES ? nt - i0 : LANES, kind, check, dt,
+                      &inverted, &hot););
     if (n_hot)
         *n_hot = hot;
     return inverted;
@@ -383,6 +448,9 @@ void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt)
     if (s->ep)
         for (int i = 0; i < nt; i++)
             memset(&s->ep[6 * tets[i]], 0, 6 * sizeof(double));
+    if (s->bv_rate) /* at rest in rigid mode: the next spell's first pass has no last force */
+        for (int i = 0; i < nt; i++)
+            s->bv_rate[tets[i]] = 0;
 }
 
 void cf_tet4_scatter(cf_solid *s, const int *tets, int nt, const int *nodes, int nn,

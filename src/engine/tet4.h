@@ -43,11 +43,16 @@ typedef struct cf_stress_check {
  * `check` (a check is due; needs the fracture state of
  * cf_solid_init_facets), also the world-frame Cauchy stress into s->sigma
  * (Pa) and s->hot (0/1) per tet, and the number of hot tets into *n_hot.
+ * With the bulk viscosity (s->bv_eta, docs/physics.md §2.3) the forces
+ * also carry its pressure at the velocities s->v (the step's half-step
+ * velocities), and its work over the step of length dt (s) that ended at
+ * these positions is added to s->bv_work (J); the stress of the check is
+ * the material's without it.
  * Parallel over tets (OpenMP) from CF_TET4_PARALLEL_MIN tets on; each tet
  * writes only its own slots, so the result does not depend on the thread
  * count.  Returns the number of inverted tets (det F <= 0). */
 int cf_tet4_forces(cf_solid *s, const int *tets, int nt, cf_elasticity kind,
-                   const cf_stress_check *check, int *n_hot);
+                   const cf_stress_check *check, double dt, int *n_hot);
 
 /* An upper bound of the largest eigenvalue of the symmetric 3x3 matrix A
  * (Pa for a stress): the Tet4 kernel's hot-flag bound (the tighter of
@@ -69,7 +74,9 @@ double cf_tet4_energy_now(const cf_solid *s, const int *tets, int nt, cf_elastic
 /* A fragment going back to rigid mode: its tets' plastic strain is dropped
  * with their elastic strain (a rigid fragment keeps the rest shape, so on
  * re-entry its nodes start from it unstressed).  The plastic work already
- * dissipated (s->wp) stays.  No-op without crushing. */
+ * dissipated (s->wp) stays.  The bulk viscosity's last rate is zeroed (the
+ * fragment rests in rigid mode, so its next spell starts with no viscous
+ * force), its work stays.  No-op without either. */
 void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt);
 
 /* Nodal forces of a fragment: f = m g at each of its nodes (nn of them),

@@ -439,6 +439,8 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
             memcpy(w->solid.bc, bc, (size_t)all.n_nodes * sizeof(int));
         if (st == CF_OK)
             st = cf_solid_scale_mass(&w->solid, scene->solver.mass_scaling, err);
+        if (st == CF_OK && scene->solver.bulk_viscosity > 0)
+            st = cf_solid_init_bulk_viscosity(&w->solid, scene->solver.bulk_viscosity, err);
         if (st == CF_OK && scene->solver.criterion != CF_CRITERION_NONE)
             st = cf_solid_init_facets(&w->solid, err);
         if (st == CF_OK && scene->solver.criterion == CF_CRITERION_SOURCE &&

@@ -52,6 +52,9 @@ void cf_world_ledger_terms(const cf_world *w, cf_ledger *l, int momenta)
     l->work_obstacles = w->flow.obstacles;
     l->contact = w->flow.contact, l->pbd = w->flow.pbd;
     l->damping = w->flow.damping, l->handoff = w->flow.handoff;
+    if (s->bv_work) /* the bulk viscosity's, tet by tet (tet4.h) */
+        for (int t = 0; t < s->n_tets; t++)
+            l->damping += s->bv_work[t];
     l->integration = w->flow.integration;
     l->initial = w->e0;
     l->residual = l->kinetic + l->strain + l->cohesive_stored + l->cohesive_dissipated +

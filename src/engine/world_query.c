@@ -296,7 +296,8 @@ void cf_world_memory(const cf_world *w, cf_memory *m)
     memset(m, 0, sizeof *m);
     /* per node: X x v f, the row p, m vcap speed; origin bc */
     m->solid = cn * (19 * D + 2 * I) + nt * (27 * D + 9 * I) +
-               ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I + (s->ep ? nt * 7 * D : 0);
+               ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I + (s->ep ? nt * 7 * D : 0) +
+               (s->bv_eta ? nt * 3 * D : 0); /* the bulk viscosity's eta, rate, work */
     if (s->facet)
         m->fracture = nt * (9 * D + 2 + 20 * I) + cn * (1 + 7 * D + sizeof(unsigned)) +
                       (unsigned long long)s->n_facets * (1 + (s->candidate != NULL)) +

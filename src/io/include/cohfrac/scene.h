@@ -194,6 +194,11 @@
  *       whose stable step h/c_d lies below this fraction of the median
  *       tet's gets the density that raises it to that fraction (the added
  *       mass is printed in the summary); 0 = none, at most 1
+ *     bulk_viscosity [0]: linear bulk viscosity b1 of fracture mode
+ *       (docs/physics.md §2.3): each tet carries the volumetric viscous
+ *       stress b1 rho c_d h tr(R^T dF/dt) I, which damps the mesh's
+ *       highest modes (b1 of critical) and is booked as damping; 0 = none,
+ *       at most 1 (Abaqus/Explicit's and LS-DYNA's default is 0.06)
  *     obstacle_contact ["kinematic"] | "penalty": how fracture-mode nodes
  *       meet obstacles in explicit runs (docs/physics.md §7.1): "kinematic"
  *       projects each node onto the surface and applies restitution per
