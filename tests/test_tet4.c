@@ -157,7 +157,7 @@ static void test_crushing_uniaxial_strain(void **state)
     cf_tet4_stress(&s, 0, CF_ELASTICITY_COROTATIONAL, sigma);
     assert_near(s.wp[0], w_closed, 1e-9 * w_closed);
     assert_near(sigma[0] - sigma[4], 0.5 * sc, 1e-9 * sc);
-    cf_tet4_drop_plastic_strain(&s, &t, 1);
+    cf_tet4_to_rigid(&s, &t, 1);
     for (int i = 0; i < 4; i++)
         memcpy(&s.x[3 * i], &s.X[3 * i], 3 * sizeof(double));
     cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, 0, NULL);
@@ -235,7 +235,7 @@ static void test_bulk_viscosity_of_a_dilatation(void **state)
         v3_sub(&s.x[3 * i], c, r);
         v3_cross(spin, r, &s.v[3 * i]);
     }
-    cf_tet4_drop_plastic_strain(&s, &t, 1); /* a hand-off: the last rate is zeroed */
+    cf_tet4_to_rigid(&s, &t, 1); /* a hand-off: the last rate is zeroed */
     assert_near(s.bv_rate[0], 0.0, 0.0);
     cf_tet4_forces(&s, &t, 1, CF_ELASTICITY_COROTATIONAL, NULL, dt, NULL);
     for (int k = 0; k < 12; k++)

@@ -511,7 +511,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
     /* A rigid fragment keeps no strain or cohesive energy. */
     sim->flow.handoff += f->e_strain + cf_cohesive_release(s, f->coh.v, f->coh.n);
     f->e_strain = 0;
-    cf_tet4_drop_plastic_strain(s, tets, nt);
+    cf_tet4_to_rigid(s, tets, nt);
     cf_node_state before;
     cf_nodes_momenta(s, f->nodes.v, f->nodes.n, &before);
     double P0[3], L0[3], P1[3] = {0, 0, 0}, L1[3] = {0, 0, 0}, ke_after = 0;

@@ -151,6 +151,24 @@ static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, 
     lanes_quat_to_mat(q, R);
 }
 
+/* The edge matrix [u1 - u0, u2 - u0, u3 - u0] (columns) of the nodal field
+ * u (x or v, [n][3]) over tets t[0..LANES-1]: Ds of the positions, its rate
+ * of the velocities. */
+static inline __attribute__((always_inline)) void lanes_edges(const cf_solid *s, const double *u,
+                                                              const int t[LANES], lane9 E)
+{
+    vd U[4][3]; /* the tets' nodes' values */
+    for (int j = 0; j < 4; j++) {
+        int node[LANES];
+        for (int l = 0; l < LANES; l++)
+            node[l] = s->tet[4 * t[l] + j];
+        lanes_load(u, 3, node, U[j]);
+    }
+    for (int j = 0; j < 3; j++)
+        for (int r = 0; r < 3; r++)
+            E[3 * r + j] = U[j + 1][r] - U[0][r];
+}
+
 /* What one pass finds for LANES tets. */
 typedef struct {
     lane9 Di;  /* inverse rest edge matrix: rows grad N1..N3, 1/m */
@@ -172,17 +190,8 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
                                                                  const int t[LANES],
                                                                  cf_elasticity kind, tet_lanes *L)
 {
-    vd X[4][3]; /* the tets' nodes' positions */
-    for (int j = 0; j < 4; j++) {
-        int node[LANES];
-        for (int l = 0; l < LANES; l++)
-            node[l] = s->tet[4 * t[l] + j];
-        lanes_load(s->x, 3, node, X[j]);
-    }
     lane9 Ds;
-    for (int j = 0; j < 3; j++)
-        for (int r = 0; r < 3; r++)
-            Ds[3 * r + j] = X[j + 1][r] - X[0][r];
+    lanes_edges(s, s->x, t, Ds);
     lanes_load(s->Dm_inv, 9, t, L->Di);
     lanes_mul(Ds, L->Di, L->F);
     lane9 S; /* the stretch whose symmetric part less I is the strain */
@@ -275,29 +284,14 @@ static inline vd lanes_det(lane9 A)
            A[2] * (A[3] * A[7] - A[4] * A[6]);
 }
 
-/* tr(R^T dF/dt) of tets t[0..LANES-1]: the volumetric strain rate in the
- * element frame (1/s), dF/dt from the nodes' velocities as F from their
- * positions; zero for a rigid motion, whatever R. */
-static inline __attribute__((always_inline)) vd lanes_volume_rate(const cf_solid *s,
-                                                                  const int t[LANES], lane9 Di,
-                                                                  lane9 R)
+/* tr(R^T A): with A = dF/dt the volumetric strain rate in the frame R
+ * (1/s), zero for a rigid motion. */
+static inline __attribute__((always_inline)) vd lanes_trace_tn(lane9 R, lane9 A)
 {
-    vd V[4][3];
-    for (int j = 0; j < 4; j++) {
-        int node[LANES];
-        for (int l = 0; l < LANES; l++)
-            node[l] = s->tet[4 * t[l] + j];
-        lanes_load(s->v, 3, node, V[j]);
-    }
-    lane9 Vs, Fdot;
-    for (int j = 0; j < 3; j++)
-        for (int r = 0; r < 3; r++)
-            Vs[3 * r + j] = V[j + 1][r] - V[0][r];
-    lanes_mul(Vs, Di, Fdot);
-    vd rate = splat(0);
+    vd tr = splat(0);
     for (int k = 0; k < 9; k++)
-        rate += R[k] * Fdot[k];
-    return rate;
+        tr += R[k] * A[k];
+    return tr;
 }
 
 /* Linear bulk viscosity (docs/physics.md §2.3): the pressure -eta D of the
@@ -320,13 +314,16 @@ static inline __attribute__((always_inline)) void bulk_viscosity(cf_solid *s, co
     lanes_load(s->bv_eta, 1, t, &eta);
     lanes_load(s->bv_rate, 1, t, &last);
     eta *= live;
-    vd rate = lanes_volume_rate(s, t, L->Di, L->R), rate_then = rate;
+    lane9 Vs, Fdot; /* dF/dt from the nodes' velocities, as F from their positions */
+    lanes_edges(s, s->v, t, Vs);
+    lanes_mul(Vs, L->Di, Fdot);
+    vd rate = lanes_trace_tn(L->R, Fdot), rate_then = rate;
     if (kind == CF_ELASTICITY_COROTATIONAL) { /* s->rq: the last pass's rotation */
         vd q[4];
         lane9 R0;
         lanes_load(s->rq, 4, t, q);
         lanes_quat_to_mat(q, R0);
-        rate_then = lanes_volume_rate(s, t, L->Di, R0);
+        rate_then = lanes_trace_tn(R0, Fdot);
     }
     for (int k = 0; k < 9; k++)
         P[k] += eta * rate * L->R[k];
@@ -443,7 +440,7 @@ double cf_tet4_energy_now(const cf_solid *s, const int *tets, int nt, cf_elastic
     return e;
 }
 
-void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt)
+void cf_tet4_to_rigid(cf_solid *s, const int *tets, int nt)
 {
     if (s->ep)
         for (int i = 0; i < nt; i++)

@@ -77,7 +77,7 @@ double cf_tet4_energy_now(const cf_solid *s, const int *tets, int nt, cf_elastic
  * dissipated (s->wp) stays.  The bulk viscosity's last rate is zeroed (the
  * fragment rests in rigid mode, so its next spell starts with no viscous
  * force), its work stays.  No-op without either. */
-void cf_tet4_drop_plastic_strain(cf_solid *s, const int *tets, int nt);
+void cf_tet4_to_rigid(cf_solid *s, const int *tets, int nt);
 
 /* Nodal forces of a fragment: f = m g at each of its nodes (nn of them),
  * then the tf slots of its tets (nt, ascending) added at their nodes in
