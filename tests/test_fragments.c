@@ -126,6 +126,35 @@ static void test_global_damping_preserves_momenta(void **state)
     free(nodes), free(all), cf_solid_free(&s);
 }
 
+/* The quiet count of docs/physics.md §9: with growth 0 any insertion
+ * restarts it; with growth 0.01 a fragment of 300 cohesive elements stays
+ * quiet through 3 insertions since the last restart, and the 4th restarts
+ * it (the elements it brings are counted too). */
+static void test_quiet_through_a_trickle(void **state)
+{
+    (void)state;
+    cf_fragment f = {.coh = {.n = 300}};
+    for (int i = 0; i < 5; i++)
+        cf_fragment_count_quiet(&f, 0, 0.0);
+    assert_int_equal(f.quiet, 5);
+    cf_fragment_count_quiet(&f, 1, 0.0);
+    assert_int_equal(f.quiet, 0);
+    assert_int_equal(f.grown, 0);
+    for (int i = 0; i < 3; i++) { /* one insertion a step, 3 <= 0.01 x 301..303 */
+        f.coh.n++;
+        cf_fragment_count_quiet(&f, 1, 0.01);
+        cf_fragment_count_quiet(&f, 0, 0.01);
+    }
+    assert_int_equal(f.quiet, 6);
+    assert_int_equal(f.grown, 3);
+    f.coh.n++;
+    cf_fragment_count_quiet(&f, 1, 0.01); /* 4 > 0.01 x 304 */
+    assert_int_equal(f.quiet, 0);
+    assert_int_equal(f.grown, 0);
+    cf_fragment_count_quiet(&f, 0, 0.01);
+    assert_int_equal(f.quiet, 1);
+}
+
 /* Which pieces can split no further (docs/physics.md §9.2): with cracks
  * from fronts, a split leaves pieces of more than min_piece_tets tets and
  * at least the volume of a sphere of min_piece_size each, so a fragment
@@ -168,6 +197,7 @@ int main(void)
         cmocka_unit_test(test_shape_matching_recovers_rotation),
         cmocka_unit_test(test_global_damping_preserves_momenta),
         cmocka_unit_test(test_pieces_too_small_to_split),
+        cmocka_unit_test(test_quiet_through_a_trickle),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -117,7 +117,9 @@ typedef enum {
     X("solver", "check_interval", INT, solver.check_interval, 1, NULL, NULL,                  \
       CF_R_AT_LEAST_ONE, "", "fracture steps between insertion checks")                        \
     X("solver", "quiet_steps", INT, solver.quiet_steps, 400, NULL, NULL, CF_R_AT_LEAST_ONE,   \
-      "", "fracture steps without insertion before a fragment goes back to rigid mode")       \
+      "", "quiet fracture steps before a fragment goes back to rigid mode")                   \
+    X("solver", "quiet_growth", NUM, solver.quiet_growth, 0, NULL, NULL, CF_R_NON_NEGATIVE,   \
+      "", "insertions still quiet, over its cohesive elements (0: none; docs/physics.md 9)")  \
     X("solver", "max_fracture_time", NUM, solver.max_fracture_time, 0.05, NULL, NULL,         \
       CF_R_POSITIVE, "s", "the longest a fragment stays in fracture mode")                     \
     X("solver", "impact_threshold", NUM, solver.impact_threshold, 0.2, NULL, NULL,            \

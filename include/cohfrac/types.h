@@ -136,6 +136,7 @@ typedef struct cf_solver_settings {
     double cfl_fraction;          /* > 0: dt_fracture = cfl_fraction dt_cfl */
     int check_interval;
     int quiet_steps;
+    double quiet_growth;
     double max_fracture_time;
     double impact_threshold;
     int ccd;                      /* Bullet continuous collision detection */

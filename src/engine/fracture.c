@@ -752,7 +752,7 @@ static cf_status fracture_insert(const cf_step_ctx *ctx, cf_fragment *f, double 
         if (st != CF_OK)
             return st;
     }
-    f->quiet = inserted ? 0 : f->quiet + 1;
+    cf_fragment_count_quiet(f, inserted, ctx->def->solver.quiet_growth);
     return CF_OK;
 }
 

@@ -66,6 +66,18 @@ int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set
     return f->nt < 2 * (set->min_piece_tets + 1) || f->volume < 2 * cf_min_piece_volume(set);
 }
 
+/* A ratio of crack areas, which refining the mesh leaves alone: on a large
+ * ringing body the weakest of its many facets keep giving one at a time
+ * long after its break has settled, and a count of none never comes. */
+void cf_fragment_count_quiet(cf_fragment *f, int inserted, double growth)
+{
+    f->grown += inserted;
+    if (f->grown > growth * f->coh.n)
+        f->quiet = f->grown = 0;
+    else
+        f->quiet++;
+}
+
 /* Mass and centre of mass from the tets (identical to the lumped ones); the
  * inertia of the lumped masses, the solver's own discretisation, so that a
  * hand-off preserves linear and angular momentum and never adds kinetic

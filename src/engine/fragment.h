@@ -48,7 +48,9 @@ typedef struct cf_fragment {
     /* In-house solver state (fracture mode, or pbd rigid mode). */
     cf_bars bars;
     cf_int_list coh;         /* its cohesive elements */
-    long steps, quiet;       /* solver steps in this mode; steps since the last insertion */
+    long steps, quiet;       /* solver steps in this mode; steps its cracks have been
+                                quiet (grown by at most solver.quiet_growth) */
+    long grown;              /* elements inserted and tets crushed since quiet restarted */
     int separated;           /* its cohesive elements with every node pair failed at the
                                 last split check; -1: not counted yet */
     double t_enter;          /* s, when fracture mode began */
@@ -103,6 +105,14 @@ double cf_min_piece_volume(const cf_solver_settings *set);
  * cuts tets free (crushing_strain of material m).  1 or 0. */
 int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set,
                              const cf_material *m);
+
+/* Counts a fracture step of f in which `inserted` cohesive elements were
+ * inserted or tets crushed into its quiet period (docs/physics.md §9): the
+ * count f->quiet goes on while the insertions since it last restarted
+ * (f->grown) are at most `growth` times f's cohesive elements, and
+ * restarts, with f->grown, otherwise.  growth = 0: quiet means no
+ * insertion. */
+void cf_fragment_count_quiet(cf_fragment *f, int inserted, double growth);
 
 /* Computes f's rest-shape mass properties from its tets and nodes on the
  * solid s: mass (kg), volume (m^3), centre of mass (m), principal axes Q and

@@ -330,7 +330,7 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     clear_obstacles(sim, f);
     f->mode = CF_MODE_FRACTURE;
     f->separated = -1;
-    f->steps = f->quiet = 0;
+    f->steps = f->quiet = f->grown = 0;
     f->t_enter = sim->t;
     cf_fragment_ledger_reset(f, &sim->solid, &sim->flow);
     f->e_enter = f->e_kin;
@@ -442,7 +442,7 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
         cf_fragment *g = &sim->frag[ci], *p = &sim->frag[fi]; /* the array may have moved */
         cf_fragment_rest_props(g, &sim->solid);
         g->mode = CF_MODE_FRACTURE;
-        g->steps = p->steps, g->quiet = p->quiet, g->t_enter = p->t_enter;
+        g->steps = p->steps, g->quiet = p->quiet, g->grown = p->grown, g->t_enter = p->t_enter;
         g->e_enter = p->e_enter;
         memcpy(g->q_match, p->q_match, sizeof g->q_match);
         cf_step_ctx ctx = cf_world_step_ctx(sim);

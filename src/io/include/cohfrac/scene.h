@@ -132,6 +132,10 @@
  *       with an awake body wakes it.  Both 0: no sleeping; otherwise both
  *       must be > 0
  *     dt_fracture [5e-6] s, check_interval [1] steps, quiet_steps [400]
+ *     quiet_growth [0]: a fracture-mode fragment counts as quiet while the
+ *       cohesive elements inserted (and tets crushed) since its quiet count
+ *       restarted are at most this fraction of its cohesive elements; 0:
+ *       quiet means no insertion (docs/physics.md §9)
  *     cfl_fraction [0]: when > 0, dt_fracture = cfl_fraction x dt_cfl of the
  *       mesh (docs/physics.md §3) instead of the dt_fracture value
  *     max_fracture_time [0.05] s (a fragment returns to rigid mode after this
