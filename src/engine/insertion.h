@@ -12,6 +12,7 @@ typedef struct cf_int_list {
 } cf_int_list;
 
 int cf_int_list_push(cf_int_list *l, int value); /* 0, or -1 out of memory */
+int cf_int_list_reserve(cf_int_list *l, int n);   /* room for n; 0, or -1 out of memory */
 
 void cf_ints_sort(int *v, int n); /* v[0..n) ascending */
 
