@@ -19,7 +19,7 @@ forbid() {
 cli='cohfrac/(bench|compare|study|stability)\.h|report\.h'
 io='lua\.h|lauxlib\.h|lualib\.h|hdf5\.h|H5[A-Za-z]*\.h|h5_quiet\.h|cohfrac/(scene|h5_output|sim)\.h|trajectory\.h'
 mesh='cohfrac/(mesh|surface)\.h'
-engine_private='solid\.h|def_check\.h|world_events\.h|world_ledger\.h|arena\.h|profile\.h|parallel\.h|tet4\.h|cohesive\.h|cohesive_law\.h|cohesive_ppr\.h|obstacle\.h|insertion\.h|pbd\.h|contact\.h|decompose\.h|fragment\.h|pieces\.h|fracture\.h|handoff\.h|renumber\.h|world_impl\.h|cf_bullet\.h|cf_fcl\.h'
+engine_private='solid\.h|def_check\.h|world_events\.h|world_ledger\.h|arena\.h|grow\.h|profile\.h|parallel\.h|tet4\.h|cohesive\.h|cohesive_law\.h|cohesive_ppr\.h|obstacle\.h|insertion\.h|pbd\.h|contact\.h|decompose\.h|fragment\.h|pieces\.h|fracture\.h|handoff\.h|renumber\.h|world_impl\.h|cf_bullet\.h|cf_fcl\.h'
 
 forbid engine "$cli|$io|$mesh|file_text\.h|process\.h" \
     "the engine depends on no Lua, HDF5, mesh preparation, files or programs"

@@ -3,6 +3,7 @@
 #include "contact.h"
 
 #include "cf_fcl.h"
+#include "grow.h"
 #include "linalg.h"
 
 #include <math.h>
@@ -19,16 +20,10 @@ void cf_frag_surface_free(cf_frag_surface *fs)
 /* The contact caches: a table keyed by fragment (contact.h). */
 int cf_contact_caches_reserve(cf_contact_caches *c, int n)
 {
-    if (n <= c->cap)
-        return 0;
-    int cap = c->cap ? c->cap : 16;
-    while (cap < n)
-        cap *= 2;
-    cf_contact_cache *v = realloc(c->v, (size_t)cap * sizeof *v);
-    if (!v)
+    int held = c->cap;
+    if (cf_grow_to((void **)&c->v, &c->cap, n, sizeof *c->v, 16))
         return -1;
-    memset(&v[c->cap], 0, (size_t)(cap - c->cap) * sizeof *v);
-    c->v = v, c->cap = cap;
+    memset(&c->v[held], 0, (size_t)(c->cap - held) * sizeof *c->v);
     return 0;
 }
 

@@ -1,5 +1,6 @@
 #include "insertion.h"
 
+#include "grow.h"
 #include "linalg.h"
 #include "parallel.h"
 #include "tet4.h"
@@ -9,16 +10,7 @@
 
 int cf_int_list_reserve(cf_int_list *l, int n)
 {
-    if (n <= l->cap)
-        return 0;
-    int cap = l->cap ? l->cap : 64;
-    while (cap < n)
-        cap *= 2;
-    int *v = realloc(l->v, (size_t)cap * sizeof(int));
-    if (!v)
-        return -1;
-    l->v = v, l->cap = cap;
-    return 0;
+    return cf_grow_to((void **)&l->v, &l->cap, n, sizeof(int), 64);
 }
 
 int cf_int_list_push(cf_int_list *l, int value)
