@@ -45,10 +45,12 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
     double area = mid_normal(s, ce, s->x, 3, a, b, nrm);
     if (area == 0)
         return 0;
-    /* The law of the facet's strength (material.strength). */
+    /* The law of the facet's strength (material.strength), where a pair
+     * still holds: most elements of a fragment that broke are free crack
+     * faces, which only the compression penalty below still reads. */
     double scaled[CF_LAW_PARAMS_MAX];
     const void *p = params;
-    if (ce->strength != 1.0) {
+    if (ce->strength != 1.0 && !(ce->failed[0] && ce->failed[1] && ce->failed[2])) {
         memcpy(scaled, params, law->params_size);
         law->scale(scaled, ce->strength);
         p = scaled;
@@ -63,15 +65,20 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         for (int k = 0; k < 3; k++)
             tv[k] = d[k] - dn * nrm[k];
         double dtl = v3_norm(tv);
-        double Tn, Tt;
+        double Tn = 0, Tt = 0;
         double *L = ce->last[i]; /* dn, Tn at the last evaluation */
-        law->traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
+        if (!ce->failed[i]) /* a failed pair's law gives none (cohesive_law.h) */
+            law->traction(p, dn, dtl, &ce->dn_max[i], &ce->dt_max[i], &ce->failed[i], &Tn, &Tt);
         n_failed += ce->failed[i];
         /* Stability cap of a node pair at step dt: a node pair is shared
          * by up to ~8 elements, so a sixteenth of the two-mass limit
-         * 4/(dt^2 (wa + wb)) keeps their sum stable. */
-        double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
-        double cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
+         * 4/(dt^2 (wa + wb)) keeps their sum stable.  Only a pair in
+         * compression or with a tangential traction reads it. */
+        double cap = 0;
+        if (dn <= 0 || Tt != 0) {
+            double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
+            cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
+        }
         if (dn <= 0) { /* compression: penalty, while the faces still face each other */
             /* The penalty engages only on a pair that reaches the overlap
              * facing (it was open, or just started) and holds while it
@@ -87,7 +94,8 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
          * undefined, and a jump to tau_max there would act in a
          * direction set by round-off (time continuity, Papoulia et al.
          * 2003). */
-        Tt = fmin(Tt, cap * dtl);
+        if (Tt != 0)
+            Tt = fmin(Tt, cap * dtl);
         double fvec[3] = {0, 0, 0}; /* pulls A towards B */
         v3_axpy(area / 3.0 * Tn, nrm, fvec);
         if (dtl > 0)
@@ -114,14 +122,47 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
     return n_failed;
 }
 
+/* An element's loads come through three indirections (the element, the
+ * node rows of its two tets, its six nodes), and on a fragment that broke
+ * the duplicated nodes lie far apart: each is a cache miss the core waits
+ * on.  The loop fetches them ahead, each stage once the one before it has
+ * arrived: element e + 3 LEAD, the tets' rows of e + 2 LEAD, the nodes of
+ * e + LEAD. */
+enum { LEAD = 4 };
+
+static void prefetch_element(const cf_solid *s, const int *elems, int e, int n)
+{
+    if (e + 3 * LEAD < n) {
+        const char *c = (const char *)&s->coh[elems[e + 3 * LEAD]];
+        for (size_t k = 0; k < sizeof(cf_cohesive); k += 64)
+            __builtin_prefetch(c + k);
+    }
+    if (e + 2 * LEAD < n) {
+        const cf_cohesive *ce = &s->coh[elems[e + 2 * LEAD]];
+        __builtin_prefetch(&s->tet[4 * ce->tet[0]]);
+        __builtin_prefetch(&s->tet[4 * ce->tet[1]]);
+    }
+    if (e + LEAD < n) {
+        const cf_cohesive *ce = &s->coh[elems[e + LEAD]];
+        for (int i = 0; i < 3; i++) {
+            int a, b;
+            pair_nodes(s, ce, i, &a, &b);
+            __builtin_prefetch(&s->x[3 * a]);
+            __builtin_prefetch(&s->x[3 * b]);
+        }
+    }
+}
+
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
                        const int *elems, int n, double dt, double kp, cf_pair_force *pairs)
 {
     int n_failed = 0;
     CF_PARALLEL(n >= CF_COHESIVE_PARALLEL_MIN,
                 "omp parallel for schedule(static) reduction(+ : n_failed)",
-        for (int e = 0; e < n; e++)
-            n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, &pairs[3 * e]););
+        for (int e = 0; e < n; e++) {
+            prefetch_element(s, elems, e, n);
+            n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, &pairs[3 * e]);
+        });
     /* Elements share nodes: the sums in list and pair order, on one thread. */
     for (int j = 0; j < 3 * n; j++)
         if (pairs[j].a >= 0) {

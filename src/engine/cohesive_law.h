@@ -24,7 +24,8 @@ typedef struct cf_cohesive_law {
     void (*envelope)(const void *params, double dn, double dt, double *Tn, double *Tt);
     /* Traction with history for one node pair: updates the largest openings
      * so far and `failed`; a negative dn counts as zero opening (the element
-     * code adds compression). */
+     * code adds compression).  A failed pair carries no traction for good:
+     * the element code does not call it again for that pair. */
     void (*traction)(const void *params, double dn, double dt, double *dn_max, double *dt_max,
                      unsigned char *failed, double *Tn, double *Tt);
 } cf_cohesive_law;
