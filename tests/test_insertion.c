@@ -1012,6 +1012,50 @@ static void test_fronts_run_across_the_tension(void **state)
     assert_true(below[0] >= 1);
 }
 
+/* A front's rank reads only this check's nodal values (facet_ratio): a
+ * node on its cracked edge that no hot tet holds is not valued, and reads
+ * as 0, not as whatever the array kept from another check.  A box under a
+ * uniaxial tension of 3.3 thresholds with one old crack, the tets at the
+ * crack's vertices cold and unloaded: one check takes the same fronts
+ * whether the array held zeros or other values (the ranking decides which
+ * front wins a tet two of them share). */
+static void test_front_rank_reads_this_check_only(void **state)
+{
+    (void)state;
+    int n[2];
+    unsigned char *taken[2];
+    for (int stale = 0; stale < 2; stale++) {
+        cf_mesh m;
+        cf_solid s;
+        int *all = box_with_crack(&m, &s, 3.0), f0 = middle_facet(&s), o0[3];
+        facet_vertices(&s, f0, o0);
+        for (int t = 0; t < s.n_tets; t++)
+            for (int j = 0; j < 4; j++)
+                if (s.tet0[4 * t + j] == o0[0] || s.tet0[4 * t + j] == o0[1] ||
+                    s.tet0[4 * t + j] == o0[2]) {
+                    s.hot[t] = 0;
+                    memset(&s.sigma[9 * t], 0, 9 * sizeof(double));
+                }
+        unsigned r = 12345;
+        for (int a = 0; a < s.n_nodes; a++, r = r * 1103515245u + 12345u)
+            s.nodal[a] = stale ? (double)(r >> 16 & 1023) : 0.0;
+        cf_int_list cand = {0};
+        n[stale] = check_fronts(&s, all, 0, &cand);
+        taken[stale] = calloc((size_t)s.n_facets, 1);
+        for (int i = 0; i < n[stale]; i++)
+            taken[stale][cand.v[i]] = 1;
+        if (stale)
+            assert_memory_equal(taken[0], taken[1], (size_t)s.n_facets);
+        free(cand.v), free(all);
+        cf_solid_free(&s), cf_mesh_free(&m);
+    }
+    printf("FIGURE front rank: %d facets taken with a clean array, %d with stale values\n", n[0],
+           n[1]);
+    assert_true(n[0] >= 1);
+    assert_int_equal(n[0], n[1]);
+    free(taken[0]), free(taken[1]);
+}
+
 /* A front's threshold from the toughness (solver.front_threshold
  * "toughness", docs/physics.md §5.1).  A box of 0.25 m cells under a
  * uniaxial tension sy of 0.6 of a facet's threshold, with one crack normal
@@ -1173,6 +1217,7 @@ int main(void)
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
         cmocka_unit_test(test_fronts_do_not_branch),
         cmocka_unit_test(test_fronts_run_across_the_tension),
+        cmocka_unit_test(test_front_rank_reads_this_check_only),
         cmocka_unit_test(test_front_threshold_from_the_toughness),
         cmocka_unit_test(test_contact_memo_changes_nothing),
         cmocka_unit_test(test_strength_is_a_field_of_the_material),

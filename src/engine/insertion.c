@@ -549,11 +549,16 @@ int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched)
     return 0;
 }
 
-/* How far qualifying facet f exceeds its strength, at least 1: the smallest
- * of its three nodal values over the facet's threshold (source), or the
- * larger of sigma_n / sigma_max_f and tau / tau_max_f (traction), from the
- * nodal values and stresses of the check that found it.  A NaN reads as
- * infinitely far (the divergence guard stops the run). */
+/* How far qualifying facet f exceeds its strength: the smallest of its
+ * three nodal values over the facet's threshold (source), or the larger of
+ * sigma_n / sigma_max_f and tau / tau_max_f (traction), from the nodal
+ * values and stresses of the check that found it.  A front facet qualifies
+ * on the vertex ahead alone (front_rule), and a node on its cracked edge
+ * that no hot tet holds was not valued in this check: the array holds
+ * what the last check that valued it found, another state of the body.
+ * No tet of such a node is hot, so it reads as 0, below every threshold,
+ * as the edge's unloaded wake does.  A NaN reads as infinitely far (the
+ * divergence guard stops the run). */
 static double facet_ratio(const cf_solid *s, int f, cf_criterion rule)
 {
     const int *F = &s->facet[4 * f];
@@ -562,7 +567,8 @@ static double facet_ratio(const cf_solid *s, int f, cf_criterion rule)
         double threshold = source_threshold(s->mat.sigma_max, w);
         r = INFINITY;
         for (int j = 0; j < 3; j++) {
-            double q = s->nodal[s->tet[4 * F[0] + CF_TET_FACE[F[1]][j]]] / threshold;
+            int a = s->tet[4 * F[0] + CF_TET_FACE[F[1]][j]];
+            double q = s->nodal_check[a] == s->check_stamp ? s->nodal[a] / threshold : 0;
             r = q < r ? q : r;
         }
     } else {
