@@ -39,6 +39,26 @@ static inline double crush(const cf_solid *s, double sig[9], double eps[9], doub
     return (sc / seq) * back * ss / (2 * s->mu); /* (1 - back) s : back s / 2 mu */
 }
 
+/* Whether any lane's stress sig lies outside crush's yield surface: its
+ * test, the same operations lane by lane.  Most tets of a body in fracture
+ * mode never crush, and a block whose four do not skips the return, which
+ * goes lane by lane. */
+static inline __attribute__((always_inline)) int lanes_yield(const cf_solid *s, vd sig[9])
+{
+    vd m = (sig[0] + sig[4] + sig[8]) / 3, ss = splat(0);
+    for (int k = 0; k < 9; k++) {
+        vd dev = sig[k] - ((k % 4) == 0 ? m : splat(0));
+        ss += dev * dev;
+    }
+    vd seq = v_sqrt(1.5 * ss), sc = s->crush_k - s->crush_beta * m;
+    sc = pick((vm)(sc > splat(0)), sc, splat(0)); /* fmax(0, sc): a NaN gives 0 */
+    vm yield = (vm)(seq > sc);
+    int any = 0;
+    for (int l = 0; l < LANES; l++)
+        any |= yield[l] != 0;
+    return any;
+}
+
 /* The kernel below runs LANES tets side by side (lanes.h): every per-tet
  * number is a vector, so the core overlaps the lanes' long dependent chains
  * (the rotation's square roots and divisions).  Each lane does
@@ -221,7 +241,7 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
     vd tr = eps[0] + eps[4] + eps[8];
     for (int k = 0; k < 9; k++)
         L->sig[k] = 2 * s->mu * eps[k] + ((k % 4) == 0 ? s->lambda * tr : splat(0));
-    if (s->ep)
+    if (s->ep && lanes_yield(s, L->sig))
         for (int l = 0; l < LANES; l++) {
             double sg[9], e[9], ep[6];
             for (int k = 0; k < 9; k++)
