@@ -314,6 +314,8 @@ typedef struct cf_step_stats {
     long fracture_steps;                   /* fracture-mode fragment steps since creation */
     long long tet_steps;                   /* tets stepped, summed over those steps */
     double fracture_time;                  /* s simulated with a fragment in fracture mode */
+    double spell_time;                     /* s since the fracture-mode fragment that has been
+                                              in it longest entered it (0: none in it) */
     double stage[CF_STAGE_COUNT];          /* s of wall time since creation (cf_stage) */
     int tets, nodes, bars, cohesive;       /* in fracture mode now */
     int iterations;                        /* constraint iterations per step */

@@ -339,6 +339,7 @@ void cf_world_step_stats(const cf_world *w, cf_step_stats *o)
         if (f->mode != CF_MODE_FRACTURE)
             continue;
         o->tets += f->nt, o->nodes += f->nodes.n, o->bars += f->bars.n, o->cohesive += f->coh.n;
+        o->spell_time = fmax(o->spell_time, w->t - f->t_enter); /* pieces keep their parent's */
         if (f->bars.color_start) {
             o->colours = f->bars.n_colors > o->colours ? f->bars.n_colors : o->colours;
             o->serial_bars += f->bars.n - f->bars.color_start[CF_BARS_COLORS];

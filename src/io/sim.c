@@ -58,6 +58,7 @@ struct cf_sim {
     double t_inner;             /* s, simulated time reached inside the current step */
     int bar_shown;              /* a progress bar is on the terminal's last line */
     double output_time;         /* s of wall time writing the file */
+    double frame_time;          /* s of it writing frames (write_frame), for the ETA */
     unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
     /* Geometry output (docs/output.md): the rest tets (input order), the
      * rest mesh's own boundary faces (sorted keys: a fragment face not
@@ -517,17 +518,24 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     sim->frames_written += st == CF_OK;
     free(fs), free(fr);
     sim->output_time += cf_wall_time() - t0;
+    sim->frame_time += cf_wall_time() - t0;
     return st;
 }
 
 /* Remaining wall time of the run, s, from the cost of each mode measured
- * so far (docs/performance.md): the rigid steps and the output per
- * simulated second; every other stage of the step (cf_stage) per tet and
- * fracture step, at the tets in fracture mode now.  While a fragment is in
- * fracture mode it counts as much fracture mode again as has run, at most
- * what the run has left: when it ends no measure says.  (The wall per
- * rigid step so far, extrapolated from the middle of an impact over the
- * flight after it, read 5,000-9,000 s on a 110 s run.) */
+ * so far (docs/performance.md): the rigid steps per simulated second; the
+ * frames per frame, at the frames left (the rest mesh and the fragments'
+ * surfaces are written once, at the start and as fragments are born: over
+ * the first millisecond of a drop they read as 50 s per simulated second);
+ * every other stage of the step (cf_stage) per tet and fracture step, at
+ * the tets in fracture mode now.  While a fragment is in
+ * fracture mode it counts as much fracture mode again as its spell has
+ * run (the longest spell of those in it; a piece split off keeps its
+ * parent's), at most what the run has left: when it ends no measure says.
+ * (The run's whole fracture time instead counted the impact's 2.6 ms again
+ * for every piece that rolled onto a corner later: 417 s where 30 s were
+ * left.  The wall per rigid step so far, extrapolated from the middle of
+ * an impact over the flight after it, read 5,000-9,000 s on a 110 s run.) */
 static double eta(const cf_sim *sim, const cf_world_stats *ws)
 {
     cf_world *w = sim->world;
@@ -537,13 +545,16 @@ static double eta(const cf_sim *sim, const cf_world_stats *ws)
     double fracture_wall = 0; /* every stage but the rigid step's */
     for (int i = 0; i < CF_STAGE_COUNT; i++)
         fracture_wall += i == CF_STAGE_RIGID_STEP ? 0 : ws->stage[i];
-    double per_rigid = t > 0 ? (ws->stage[CF_STAGE_RIGID_STEP] + sim->output_time) / t : 0;
+    double per_rigid = t > 0 ? ws->stage[CF_STAGE_RIGID_STEP] / t : 0;
+    double per_frame = sim->frames_written > 0 ? sim->frame_time / sim->frames_written : 0;
+    double frames_left = sim->h5 && sim->output.frame_interval > 0
+                             ? ceil(left / sim->output.frame_interval) : 0;
     /* Fracture mode costs per tet and step; what runs in it now sets the
      * rate (the tets stepped per simulated second). */
     double per_tet_step = st.tet_steps > 0 ? fracture_wall / (double)st.tet_steps : 0;
     double per_fracture = ws->dt_fracture > 0 ? per_tet_step * st.tets / ws->dt_fracture : 0;
-    double more_fracture = ws->in_fracture ? fmin(left, st.fracture_time) : 0;
-    return more_fracture * per_fracture + left * per_rigid;
+    double more_fracture = ws->in_fracture ? fmin(left, st.spell_time) : 0;
+    return more_fracture * per_fracture + left * per_rigid + frames_left * per_frame;
 }
 
 /* Progress: simulated time, mode, fragments and an ETA (eta). */
