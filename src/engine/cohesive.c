@@ -50,7 +50,7 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
      * faces, which only the compression penalty below still reads. */
     double scaled[CF_LAW_PARAMS_MAX];
     const void *p = params;
-    if (ce->strength != 1.0 && !(ce->failed[0] && ce->failed[1] && ce->failed[2])) {
+    if (ce->strength != 1.0 && !cf_cohesive_all_failed(ce)) {
         memcpy(scaled, params, law->params_size);
         law->scale(scaled, ce->strength);
         p = scaled;
@@ -234,7 +234,7 @@ void cf_cohesive_project_contact(cf_solid *s, const int *elems, int n)
 double cf_cohesive_damage(const cf_solid *s, int e)
 {
     const cf_cohesive *ce = &s->coh[e];
-    if (ce->failed[0] && ce->failed[1] && ce->failed[2])
+    if (cf_cohesive_all_failed(ce))
         return 1.0;
     int a[3], b[3];
     double n[3], area = mid_normal(s, ce, s->x, 3, a, b, n);
@@ -250,7 +250,7 @@ void cf_cohesive_state(const cf_solid *s, int e, double centroid[3], double norm
     int a[3], b[3];
     *area = mid_normal(s, ce, s->x, 3, a, b, normal);
     *opening = *sliding = 0;
-    *failed = ce->failed[0] && ce->failed[1] && ce->failed[2];
+    *failed = cf_cohesive_all_failed(ce);
     centroid[0] = centroid[1] = centroid[2] = 0;
     for (int i = 0; i < 3; i++) {
         double d[3], mid[3];

@@ -400,10 +400,8 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
      * pairs have failed (cf_label_pieces).  Unless more elements have failed
      * completely since the last check, the pieces are those it found. */
     int separated = 0;
-    for (int e = 0; e < f->coh.n; e++) {
-        const unsigned char *failed = s->coh[f->coh.v[e]].failed;
-        separated += failed[0] && failed[1] && failed[2];
-    }
+    for (int e = 0; e < f->coh.n; e++)
+        separated += cf_cohesive_all_failed(&s->coh[f->coh.v[e]]);
     if (separated == f->separated)
         return 0;
     f->separated = separated;

@@ -62,7 +62,7 @@ int cf_label_pieces(const cf_solid *s, const int *tets, int nt, const int *coh, 
         }
     for (int e = 0; e < ncoh; e++) {
         const cf_cohesive *ce = &s->coh[coh[e]];
-        if (!(ce->failed[0] && ce->failed[1] && ce->failed[2]))
+        if (!cf_cohesive_all_failed(ce))
             join(parent, position_of(tets, nt, ce->tet[0]), position_of(tets, nt, ce->tet[1]));
     }
     int k = 0;

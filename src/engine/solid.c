@@ -349,7 +349,7 @@ double cf_solid_crack_area(const cf_solid *s)
     double area = 0;
     for (int i = 0; i < s->n_coh; i++) {
         const cf_cohesive *c = &s->coh[i];
-        if (!(c->failed[0] && c->failed[1] && c->failed[2]))
+        if (!cf_cohesive_all_failed(c))
             continue;
         const int *tn = &s->tet[4 * c->tet[0]];
         area += tri_area(&s->X[3 * tn[c->slot[0][0]]], &s->X[3 * tn[c->slot[0][1]]],

@@ -46,6 +46,13 @@ typedef struct cf_cohesive {
     unsigned char started[3];    /* `last`, f_last, d_last hold an evaluation of the pair */
 } cf_cohesive;
 
+/* Whether every node pair of ce has failed: a free crack face, which
+ * joins its two tets no more and carries only the compression penalty. */
+static inline int cf_cohesive_all_failed(const cf_cohesive *ce)
+{
+    return ce->failed[0] && ce->failed[1] && ce->failed[2];
+}
+
 typedef struct cf_solid {
     cf_material mat;
     double lambda, mu;        /* Lamé, Pa */

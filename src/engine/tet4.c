@@ -39,6 +39,29 @@ static inline double crush(const cf_solid *s, double sig[9], double eps[9], doub
     return (sc / seq) * back * ss / (2 * s->mu); /* (1 - back) s : back s / 2 mu */
 }
 
+/* The kernel below runs LANES tets side by side (lanes.h): every per-tet
+ * number is a vector, so the core overlaps the lanes' long dependent chains
+ * (the rotation's square roots and divisions).  Each lane does
+ * exactly the operations of the scalar formulas (linalg.h: m3_mul,
+ * polar_rotation, ...) in the same order: the bits are those of one tet at
+ * a time (test_tet4.c compares them). */
+typedef vd lane9[9];
+
+static inline vd v_fabs(vd a) { return (vd)((vm)a & ~(vm)splat(-0.0)); } /* sign bit off */
+
+/* fmax and fmin lane by lane: a NaN operand gives the other one. */
+static inline vd v_fmax(vd a, vd b) { return pick((vm)(a >= b) | (vm)(b != b), a, b); }
+static inline vd v_fmin(vd a, vd b) { return pick((vm)(a <= b) | (vm)(b != b), a, b); }
+
+/* Whether any lane of the mask m is set. */
+static inline int lanes_any(vm m)
+{
+    int any = 0;
+    for (int l = 0; l < LANES; l++)
+        any |= m[l] != 0;
+    return any;
+}
+
 /* Whether any lane's stress sig lies outside crush's yield surface: its
  * test, the same operations lane by lane.  Most tets of a body in fracture
  * mode never crush, and a block whose four do not skips the return, which
@@ -50,24 +73,9 @@ static inline __attribute__((always_inline)) int lanes_yield(const cf_solid *s, 
         vd dev = sig[k] - ((k % 4) == 0 ? m : splat(0));
         ss += dev * dev;
     }
-    vd seq = v_sqrt(1.5 * ss), sc = s->crush_k - s->crush_beta * m;
-    sc = pick((vm)(sc > splat(0)), sc, splat(0)); /* fmax(0, sc): a NaN gives 0 */
-    vm yield = (vm)(seq > sc);
-    int any = 0;
-    for (int l = 0; l < LANES; l++)
-        any |= yield[l] != 0;
-    return any;
+    vd seq = v_sqrt(1.5 * ss), sc = v_fmax(splat(0), s->crush_k - s->crush_beta * m);
+    return lanes_any((vm)(seq > sc));
 }
-
-/* The kernel below runs LANES tets side by side (lanes.h): every per-tet
- * number is a vector, so the core overlaps the lanes' long dependent chains
- * (the rotation's square roots and divisions).  Each lane does
- * exactly the operations of the scalar formulas (linalg.h: m3_mul,
- * polar_rotation, ...) in the same order: the bits are those of one tet at
- * a time (test_tet4.c compares them). */
-typedef vd lane9[9];
-
-static inline vd v_fabs(vd a) { return (vd)((vm)a & ~(vm)splat(-0.0)); } /* sign bit off */
 
 /* C = A B (m3_mul); C is neither A nor B, as in all three products. */
 static inline void lanes_mul(lane9 A, lane9 B, lane9 C)
@@ -152,10 +160,7 @@ static inline __attribute__((always_inline)) void lanes_polar_rotation(lane9 F, 
             om[k] *= s;
         vd angle2 = om[0] * om[0] + om[1] * om[1] + om[2] * om[2];
         vm turn = ~(vm)(angle2 < splat(tol * tol)); /* NaN turns, as in the scalar loop */
-        int turning = 0;
-        for (int l = 0; l < LANES; l++)
-            turning |= turn[l] != 0;
-        if (!turning)
+        if (!lanes_any(turn))
             break;
         /* q <- (1, omega/2) q where the lane turns (polar_turn); a finished
          * lane's result is dropped */
@@ -258,10 +263,6 @@ static inline __attribute__((always_inline)) void tet_lanes_eval(const cf_solid 
     for (int k = 0; k < 9; k++)
         L->w += 0.5 * L->sig[k] * eps[k];
 }
-
-/* fmax and fmin lane by lane: a NaN operand gives the other one. */
-static inline vd v_fmax(vd a, vd b) { return pick((vm)(a >= b) | (vm)(b != b), a, b); }
-static inline vd v_fmin(vd a, vd b) { return pick((vm)(a <= b) | (vm)(b != b), a, b); }
 
 /* Bounds of a symmetric 3x3 matrix's eigenvalues: every one lies in
  * [lo, hi].  Two bounds, the tighter taken: Gershgorin's discs, and the
