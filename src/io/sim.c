@@ -517,8 +517,8 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
         st = cf_h5_write_frame(sim->h5, step, t, fr, n, err);
     sim->frames_written += st == CF_OK;
     free(fs), free(fr);
-    sim->output_time += cf_wall_time() - t0;
-    sim->frame_time += cf_wall_time() - t0;
+    double took = cf_wall_time() - t0;
+    sim->output_time += took, sim->frame_time += took;
     return st;
 }
 
@@ -528,10 +528,10 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
  * surfaces are written once, at the start and as fragments are born: over
  * the first millisecond of a drop they read as 50 s per simulated second);
  * every other stage of the step (cf_stage) per tet and fracture step, at
- * the tets in fracture mode now.  While a fragment is in
- * fracture mode it counts as much fracture mode again as its spell has
- * run (the longest spell of those in it; a piece split off keeps its
- * parent's), at most what the run has left: when it ends no measure says.
+ * the tets in fracture mode now.  While a fragment is in fracture mode it
+ * counts as much fracture mode again as its spell has run (the longest
+ * spell of those in it; a piece split off keeps its parent's), at most
+ * what the run has left: when it ends no measure says.
  * (The run's whole fracture time instead counted the impact's 2.6 ms again
  * for every piece that rolled onto a corner later: 417 s where 30 s were
  * left.  The wall per rigid step so far, extrapolated from the middle of
@@ -547,8 +547,7 @@ static double eta(const cf_sim *sim, const cf_world_stats *ws)
         fracture_wall += i == CF_STAGE_RIGID_STEP ? 0 : ws->stage[i];
     double per_rigid = t > 0 ? ws->stage[CF_STAGE_RIGID_STEP] / t : 0;
     double per_frame = sim->frames_written > 0 ? sim->frame_time / sim->frames_written : 0;
-    double frames_left = sim->h5 && sim->output.frame_interval > 0
-                             ? ceil(left / sim->output.frame_interval) : 0;
+    double frames_left = sim->output.frame_interval > 0 ? ceil(left / sim->output.frame_interval) : 0;
     /* Fracture mode costs per tet and step; what runs in it now sets the
      * rate (the tets stepped per simulated second). */
     double per_tet_step = st.tet_steps > 0 ? fracture_wall / (double)st.tet_steps : 0;
