@@ -3,6 +3,7 @@
 #include "cohfrac/sim.h"
 
 #include "clock.h"
+#include "eta.h"
 #include "cohfrac/h5_output.h"
 #include "cohfrac/scene.h"
 #include "cohfrac/surface.h"
@@ -59,6 +60,8 @@ struct cf_sim {
     int bar_shown;              /* a progress bar is on the terminal's last line */
     double output_time;         /* s of wall time writing the file */
     double frame_time;          /* s of it writing frames (write_frame), for the ETA */
+    cf_eta eta;                 /* the run sampled for the ETA (eta.h) */
+    double last_sample;         /* s, wall clock of its last sample */
     unsigned long long output_peak; /* largest HDF5 metadata cache seen at a frame, bytes */
     /* Geometry output (docs/output.md): the rest tets (input order), the
      * rest mesh's own boundary faces (sorted keys: a fragment face not
@@ -349,6 +352,10 @@ cf_status cf_sim_create(const cf_scene *sc, const cf_run_options *opt, cf_sim **
     if (st == CF_OK) {
         cf_world_set_tick(sim->world, tick, sim);
         sim->n_steps = lround(ceil(sim->duration / cf_world_dt_outer(sim->world) - 1e-9));
+        double dt = cf_world_dt_fracture(sim->world);
+        cf_eta_rule rule = {dt, w.solver.quiet_steps * dt, w.solver.quiet_growth,
+                            w.solver.max_fracture_time};
+        cf_eta_init(&sim->eta, &rule);
     }
     if (st == CF_OK && w.solver.threads == 0) { /* the default: adapts to the host */
         cf_world_stats ws;
@@ -522,38 +529,38 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     return st;
 }
 
-/* Remaining wall time of the run, s, from the cost of each mode measured
- * so far (docs/performance.md): the rigid steps per simulated second; the
- * frames per frame, at the frames left (the rest mesh and the fragments'
- * surfaces are written once, at the start and as fragments are born: over
- * the first millisecond of a drop they read as 50 s per simulated second);
- * every other stage of the step (cf_stage) per tet and fracture step, at
- * the tets in fracture mode now.  While a fragment is in fracture mode it
- * counts as much fracture mode again as its spell has run (the longest
- * spell of those in it; a piece split off keeps its parent's), at most
- * what the run has left: when it ends no measure says.
- * (The run's whole fracture time instead counted the impact's 2.6 ms again
- * for every piece that rolled onto a corner later: 417 s where 30 s were
- * left.  The wall per rigid step so far, extrapolated from the middle of
- * an impact over the flight after it, read 5,000-9,000 s on a 110 s run.) */
-static double eta(const cf_sim *sim, const cf_world_stats *ws)
+/* The run now, for the ETA: inside a rigid step the simulated time is the
+ * heartbeat's (tick), and the spell now running has run as much further. */
+static void eta_sample(cf_sim *sim)
 {
     cf_world *w = sim->world;
     cf_step_stats st;
     cf_world_step_stats(w, &st);
-    double t = cf_world_time(w), left = fmax(0.0, sim->duration - t);
-    double fracture_wall = 0; /* every stage but the rigid step's */
-    for (int i = 0; i < CF_STAGE_COUNT; i++)
-        fracture_wall += i == CF_STAGE_RIGID_STEP ? 0 : ws->stage[i];
-    double per_rigid = t > 0 ? ws->stage[CF_STAGE_RIGID_STEP] / t : 0;
+    double t0 = cf_world_time(w), t = fmax(t0, sim->t_inner);
+    cf_eta_sample s = {.t = t, .tet_steps = (double)st.tet_steps,
+                       .cracks = cf_world_cohesive_count(w),
+                       .spell = st.spell_time > 0 ? st.spell_time + (t - t0) : 0};
+    for (int i = 0; i < CF_STAGE_COUNT; i++) {
+        s.wall += st.stage[i];
+        s.fracture_wall += i == CF_STAGE_RIGID_STEP ? 0 : st.stage[i];
+    }
+    cf_eta_add(&sim->eta, &s);
+}
+
+/* Remaining wall time of the run, s (eta.h): the spell now running, the
+ * rest of the simulated time, and the frames left at the wall per frame
+ * so far (the rest mesh and the fragments' surfaces are written once, at
+ * the start and as fragments are born: over the first millisecond of a
+ * drop they read as 50 s per simulated second). */
+static double eta(const cf_sim *sim)
+{
+    double t = fmax(cf_world_time(sim->world), sim->t_inner);
+    double left = fmax(0.0, sim->duration - t);
     double per_frame = sim->frames_written > 0 ? sim->frame_time / sim->frames_written : 0;
     double frames_left = sim->output.frame_interval > 0 ? ceil(left / sim->output.frame_interval) : 0;
-    /* Fracture mode costs per tet and step; what runs in it now sets the
-     * rate (the tets stepped per simulated second). */
-    double per_tet_step = st.tet_steps > 0 ? fracture_wall / (double)st.tet_steps : 0;
-    double per_fracture = ws->dt_fracture > 0 ? per_tet_step * st.tets / ws->dt_fracture : 0;
-    double more_fracture = ws->in_fracture ? fmin(left, st.spell_time) : 0;
-    return more_fracture * per_fracture + left * per_rigid + frames_left * per_frame;
+    cf_step_stats st;
+    cf_world_step_stats(sim->world, &st);
+    return cf_eta_left(&sim->eta, left, st.tets, frames_left * per_frame);
 }
 
 /* Progress: simulated time, mode, fragments and an ETA (eta). */
@@ -563,6 +570,10 @@ static void progress(cf_sim *sim, int final)
         return;
     double now = cf_wall_time();
     int term = tty();
+    if (now - sim->last_sample >= 0.1) {
+        eta_sample(sim);
+        sim->last_sample = now;
+    }
     if (!final && now - sim->last_progress < (term ? 0.2 : 10.0))
         return;
     sim->last_progress = now;
@@ -571,7 +582,7 @@ static void progress(cf_sim *sim, int final)
     double frac = total > 0 ? fmin(1.0, (double)done / (double)total) : 1.0;
     cf_world_stats ws;
     cf_world_stats_get(w, &ws);
-    double left = final ? 0 : eta(sim, &ws);
+    double left = final ? 0 : eta(sim);
     double t = fmin(fmax(cf_world_time(w), sim->t_inner), sim->duration);
     const char *mode = ws.in_fracture ? "fracture" : "rigid";
     if (term) {
