@@ -12,8 +12,9 @@
 -- not believable: the explicit Tet4 kick is unstable on the smallest tets,
 -- the projection removes the energy it invents (ledger residual 68 % of
 -- the input) and single tets leave at 68 m/s against the bound 55 m/s of
--- tests/checks/check_physics.py.  At 1e-5 s: residual 0.02 %, fastest 49 m/s
--- (docs/physics.md §14.8).
+-- tests/checks/check_physics.py.  At 1e-5 s: residual 0.11 % (docs/physics.md
+-- §14.8); a 6-tet piece from under the indenter leaves at 72 m/s, over that
+-- bound (tests/plausibility_known.txt says why).
 return {
   name = "mixed_mode_beam",
   duration = 0.009,
