@@ -97,8 +97,9 @@ static double quiet_for(const cf_eta *e, double some)
  * drop's break ran 0.5 ms past the end its cracks as a whole gave, the
  * 15,040-tet drop's 0.3 ms); as much again as the spell has run is the
  * latest one looked for.  The spell is given their geometric mean.
- * Where the cracks no longer grow, an impact holds the spell (the quiet
- * rule waits for its end, §9): as long again as they have been quiet. */
+ * Where the cracks no longer grow, a landing or a crushing holds the spell
+ * (each crushed tet restarts the quiet count, §9): as long again as they
+ * have been quiet. */
 double cf_eta_spell_left(const cf_eta *e)
 {
     if (e->n == 0 || e->s[e->n - 1].spell <= 0)

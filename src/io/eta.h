@@ -1,8 +1,9 @@
 /* The run's remaining wall time, from the cost of each mode measured as it
  * goes (docs/performance.md, "The ETA").
  *
- * The run is sampled every quarter second or so of wall time (older
- * samples thinned as the history fills).  What is left costs:
+ * The run is sampled every tenth of a second or so of wall time (kept a
+ * quarter second apart at first, thinned as the history fills).  What is
+ * left costs:
  *  - the fracture-mode spell now running: the simulated time it still
  *    runs (cf_eta_spell_left) at the cost per tet and fracture step of the
  *    recent samples, at the tets in fracture mode now;
@@ -52,11 +53,13 @@ void cf_eta_init(cf_eta *e, const cf_eta_rule *rule);
  * than `spacing` of wall to the last one replaces it. */
 void cf_eta_add(cf_eta *e, const cf_eta_sample *s);
 
-/* Simulated time, s, that the spell now running still runs: the crack
- * growth's decay over its last half, extrapolated to the rate the quiet
- * rule takes for none, plus the quiet time; as much again as it has run
- * where the growth does not decay (or the cracks are quiet and an impact
- * holds it).  At most rule.max_spell less what it ran; 0 with no spell. */
+/* Simulated time, s, that the spell now running still runs: the geometric
+ * mean of as much again as it has run and the time to the end that the
+ * crack growth's decay over its last half gives (the rate the quiet rule
+ * takes for none, plus the quiet time); as much again where the growth
+ * does not decay; as long again as the cracks have been quiet where a
+ * landing or a crushing holds it.  At most rule.max_spell less what it
+ * ran; 0 with no spell. */
 double cf_eta_spell_left(const cf_eta *e);
 
 /* Wall time, s, of the rest of the run: `t_left` s simulated, `tets` in
