@@ -352,7 +352,7 @@ static void test_handoff_keeps_bonded_pieces_together(void **state)
             alive++, rigid += w->frag[i].mode == CF_MODE_RIGID, fi = i;
     int failed = 0;
     for (int c = 0; c < w->solid.n_coh; c++)
-        failed += w->solid.coh[c].failed[0] && w->solid.coh[c].failed[1] && w->solid.coh[c].failed[2];
+        failed += cf_cohesive_all_failed(&w->solid.coh[c]);
     int *comp = malloc((size_t)w->frag[fi].nt * sizeof(int));
     int by_nodes = cf_label_components(&w->solid, w->frag[fi].tets, w->frag[fi].nt, comp);
     printf("FIGURE bonded: %d cohesive elements (%d failed), %d hand-offs, %d fragment(s) alive, "

@@ -39,8 +39,7 @@ static void account(cf_eta *e, const cf_eta_sample *a, const cf_eta_sample *b)
 void cf_eta_add(cf_eta *e, const cf_eta_sample *s)
 {
     if (e->n > 0)
-        account(e, &e->last, s);
-    e->last = *s;
+        account(e, &e->s[e->n - 1], s); /* the newest sample is always the last one kept */
     if (e->n > 1 && s->wall - e->s[e->n - 2].wall < e->spacing) {
         e->s[e->n - 1] = *s; /* too close to the one before: the newest replaces it */
         return;
@@ -110,8 +109,8 @@ double cf_eta_spell_left(const cf_eta *e)
     if (s > 2 * q && cracks_at(e, now->t - 2 * d, &c0) && cracks_at(e, now->t - d, &c1)) {
         double r0 = (c1 - c0) / d, r1 = (now->cracks - c1) / d; /* per s simulated */
         double some = fmax(e->rule.quiet_growth * now->cracks, 1.0), none = some / q;
-        if (r1 <= none) /* quiet: the rule ends it within a quiet time, or an impact holds
-                           it, for about as long again as it has held it */
+        if (r1 <= none) /* quiet: the rule ends it within a quiet time, or a landing or a
+                           crushing holds it, for about as long again as it has held it */
             left = fmax(q, fmin(s, quiet_for(e, some)));
         else if (r1 < r0) {
             double u = log(r0 / r1), tau = d / u, rate = r1 * u / (r0 / r1 - 1);

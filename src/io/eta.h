@@ -42,7 +42,6 @@ typedef struct cf_eta {
     cf_eta_sample s[CF_ETA_KEEP]; /* oldest first */
     int n;
     double spacing;               /* s of wall between the samples kept */
-    cf_eta_sample last;           /* the newest sample added */
     double rest_wall, rest_t;     /* s of wall, s simulated, outside long spells */
     double pending_wall, pending_t; /* the spell now running's, until it ends */
 } cf_eta;

@@ -529,14 +529,20 @@ static cf_status write_frame(cf_sim *sim, cf_error *err)
     return st;
 }
 
-/* The run now, for the ETA: inside a rigid step the simulated time is the
- * heartbeat's (tick), and the spell now running has run as much further. */
+/* Simulated time reached, s: inside a rigid step, the heartbeat's (tick). */
+static double time_reached(const cf_sim *sim)
+{
+    return fmax(cf_world_time(sim->world), sim->t_inner);
+}
+
+/* The run now, for the ETA: inside a rigid step the spell now running has
+ * run as far as the heartbeat's time. */
 static void eta_sample(cf_sim *sim)
 {
     cf_world *w = sim->world;
     cf_step_stats st;
     cf_world_step_stats(w, &st);
-    double t0 = cf_world_time(w), t = fmax(t0, sim->t_inner);
+    double t0 = cf_world_time(w), t = time_reached(sim);
     cf_eta_sample s = {.t = t, .tet_steps = (double)st.tet_steps,
                        .cracks = cf_world_cohesive_count(w),
                        .spell = st.spell_time > 0 ? st.spell_time + (t - t0) : 0};
@@ -554,8 +560,7 @@ static void eta_sample(cf_sim *sim)
  * drop they read as 50 s per simulated second). */
 static double eta(const cf_sim *sim)
 {
-    double t = fmax(cf_world_time(sim->world), sim->t_inner);
-    double left = fmax(0.0, sim->duration - t);
+    double left = fmax(0.0, sim->duration - time_reached(sim));
     double per_frame = sim->frames_written > 0 ? sim->frame_time / sim->frames_written : 0;
     double frames_left = sim->output.frame_interval > 0 ? ceil(left / sim->output.frame_interval) : 0;
     cf_step_stats st;
@@ -583,7 +588,7 @@ static void progress(cf_sim *sim, int final)
     cf_world_stats ws;
     cf_world_stats_get(w, &ws);
     double left = final ? 0 : eta(sim);
-    double t = fmin(fmax(cf_world_time(w), sim->t_inner), sim->duration);
+    double t = fmin(time_reached(sim), sim->duration);
     const char *mode = ws.in_fracture ? "fracture" : "rigid";
     if (term) {
         char bar[31];
