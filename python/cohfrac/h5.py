@@ -49,7 +49,8 @@ class Run:
             if isinstance(self.scene, bytes):
                 self.scene = self.scene.decode()
             parts = f["particles/fragments"]
-            t = len(parts["position/step"])           # complete frames only
+            # whole frames only: a killed run's file may hold one partial row
+            t = int(f.attrs.get("frames", len(parts["position/step"])))
             self.steps = parts["position/step"][:t]
             self.times = parts["position/time"][:t]
             self.ids = parts["id/value"][:t]

@@ -9,8 +9,11 @@
  *   - The particle fields share one step and one time dataset through hard
  *     links (H5MD allows this), so one append per frame updates all of them.
  *   - Within a frame the values are written first and step/time last, and the
- *     file is flushed at the end: len(step) is always the number of complete
- *     frames, even in a file left behind by a killed run.
+ *     file is flushed at the end: len(step) is the number of complete frames.
+ *     HDF5 flushes its metadata entry by entry, so a run killed during a
+ *     flush may leave one dataset a frame longer than another; the root
+ *     attribute `frames`, written only once the flush has returned, is the
+ *     count of whole frames even then.
  *   - The writer takes no HDF5 file lock, so another process (h5py, a
  *     monitoring script) can open the file read-only while the run goes on.
  *   - HDF5's automatic error printing is switched off for the duration of
@@ -355,6 +358,31 @@ static int write_ints_attr(hid_t loc, const char *name, const int *values, hsize
     int ok = s >= 0 &&
              (a = H5Acreate2(loc, name, H5T_STD_I32LE, s, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
              H5Awrite(a, H5T_NATIVE_INT, values) >= 0;
+    if (a >= 0)
+        H5Aclose(a);
+    if (s >= 0)
+        H5Sclose(s);
+    return ok ? 0 : -1;
+}
+
+/* The root attribute `frames` (int64, scalar): the frames the last finished
+ * flush carried to disk.  HDF5 writes its metadata entry by entry, so a
+ * process killed during a flush can leave one dataset a frame longer than
+ * another; this count is written only after the flush has returned, so on
+ * disk it never counts a frame whose rows are not all there. */
+static int write_frames_attr(hid_t file, hsize_t frames, int create)
+{
+    int64_t v = (int64_t)frames;
+    hid_t s = H5I_INVALID_HID, a;
+    if (create) {
+        s = H5Screate(H5S_SCALAR);
+        a = s >= 0 ? H5Acreate_by_name(file, "/", "frames", H5T_STD_I64LE, s, H5P_DEFAULT,
+                                       H5P_DEFAULT, H5P_DEFAULT)
+                   : H5I_INVALID_HID;
+    } else {
+        a = H5Aopen_by_name(file, "/", "frames", H5P_DEFAULT, H5P_DEFAULT);
+    }
+    int ok = a >= 0 && H5Awrite(a, H5T_NATIVE_INT64, &v) >= 0;
     if (a >= 0)
         H5Aclose(a);
     if (s >= 0)
@@ -747,7 +775,8 @@ static cf_status build_layout(cf_h5 *h, const char *file_name, const char *scene
              write_string_attr(root, "units", "SI") == 0 &&
              write_string_attr(root, "up_axis", "+z") == 0 &&
              write_string_attr(root, "quaternion_order", "wxyz") == 0 &&
-             write_string_attr(root, "scene_name", scene_name) == 0;
+             write_string_attr(root, "scene_name", scene_name) == 0 &&
+             write_frames_attr(h->file, 0, 1) == 0;
     if (root >= 0)
         H5Gclose(root);
     if (!ok)
@@ -957,7 +986,8 @@ static cf_status write_frame_impl(cf_h5 *h, long step, double time, const cf_fra
             return h5_fail(err, h->path, "writing frame %llu of /particles/fragments/%s/value",
                            (unsigned long long)T, c->name);
     }
-    /* step last: its length is the number of complete frames. */
+    /* step last: its length is the number of complete frames in a file
+     * closed by the run (a killed run's file: the attribute `frames`). */
     int64_t step64 = (int64_t)step;
     if (append_rows(h->time, T, 1, H5T_NATIVE_DOUBLE, &time) < 0)
         return h5_fail(err, h->path, "appending to /particles/fragments/id/time");
@@ -966,6 +996,15 @@ static cf_status write_frame_impl(cf_h5 *h, long step, double time, const cf_fra
     char what[64];
     snprintf(what, sizeof what, "flushing frame %llu", (unsigned long long)T);
     cf_status st = flush_file(h, err, what);
+    if (st != CF_OK)
+        return st;
+    /* Only now is the frame whole on disk; a second flush (the root's
+     * header alone) lets a reader, or a file left by a killed run, count it. */
+    if (write_frames_attr(h->file, T + 1, 0) < 0)
+        return h5_fail(err, h->path, "counting frame %llu in the root attribute 'frames'",
+                       (unsigned long long)T);
+    snprintf(what, sizeof what, "flushing the count of frame %llu", (unsigned long long)T);
+    st = flush_file(h, err, what);
     if (st != CF_OK)
         return st;
 
@@ -1909,6 +1948,7 @@ static void rollback(cf_h5 *h)
         trim_rows(h->value[f], h->nframes);
     trim_rows(h->time, h->nframes);
     trim_rows(h->step, h->nframes);
+    write_frames_attr(h->file, h->nframes, 0);
     for (int c = 0; c < FR_COUNT; ++c)
         trim_rows(h->fragment[c], h->nfragments);
     for (int c = 0; c < HO_COUNT; ++c)

@@ -48,6 +48,8 @@ def summarize(f, say):
     T = len(step)
     if len(time) != T:
         problems.append(f"step has {T} rows but time has {len(time)}")
+    if "frames" in f.attrs and int(f.attrs["frames"]) != T:
+        problems.append(f"the root attribute frames is {int(f.attrs['frames'])}, but step has {T} rows")
     if T > 1 and np.any(np.diff(step) < 0):
         problems.append("step is not non-decreasing")
     N = p["id/value"].shape[1]
