@@ -64,7 +64,7 @@ static void test_deep_cuts_lose_no_volume(void **state)
     int *tets, nt;
     l_shape(&s, &tets, &nt);
     cf_hulls h;
-    assert_int_equal(cf_decompose(&s, tets, nt, -0.5, 48, 1, &h), 0);
+    assert_int_equal(cf_decompose(&s, tets, nt, -0.5, 48, 1, &h, NULL, NULL), 0);
     printf("FIGURE deep cuts: %d hulls, hull volume %.12g for a volume of %.12g\n", h.n_hulls,
            h.hull_volume, h.tet_volume);
     assert_true(h.n_hulls >= 16);
@@ -86,7 +86,7 @@ static void test_single_hull_error_is_the_l_shapes_excess(void **state)
     int *tets, nt;
     l_shape(&s, &tets, &nt);
     cf_hulls h;
-    assert_int_equal(cf_decompose(&s, tets, nt, 0.05, 1, 4, &h), 0);
+    assert_int_equal(cf_decompose(&s, tets, nt, 0.05, 1, 4, &h, NULL, NULL), 0);
     assert_int_equal(h.n_hulls, 1);
     assert_true(fabs(h.tet_volume - 3.0) < 1e-12);
     assert_true(fabs(h.hull_volume - 3.5) < 1e-12);
@@ -96,18 +96,26 @@ static void test_single_hull_error_is_the_l_shapes_excess(void **state)
     cf_solid_free(&s);
 }
 
+static void count_cut(void *user) { ++*(int *)user; }
+
 /* Bisection along the L's principal spread cuts it into two convex
  * quadrilateral prisms: the bound holds and is met exactly, and the hulls
- * still cover every node. */
+ * still cover every node.  The heartbeat comes once per cut (one cell
+ * more each) and changes nothing: the same hulls without it. */
 static void test_decomposition_meets_the_error_bound(void **state)
 {
     (void)state;
     cf_solid s;
-    int *tets, nt;
+    int *tets, nt, cuts = 0;
     l_shape(&s, &tets, &nt);
-    cf_hulls h;
-    assert_int_equal(cf_decompose(&s, tets, nt, 0.05, 8, 4, &h), 0);
+    cf_hulls h, quiet;
+    assert_int_equal(cf_decompose(&s, tets, nt, 0.05, 8, 4, &h, count_cut, &cuts), 0);
+    assert_int_equal(cf_decompose(&s, tets, nt, 0.05, 8, 4, &quiet, NULL, NULL), 0);
     assert_true(h.n_hulls >= 2 && h.n_hulls <= 8);
+    assert_true(cuts >= h.n_hulls - 1 && cuts <= 7);
+    assert_int_equal(quiet.n_hulls, h.n_hulls);
+    assert_memory_equal(quiet.pts, h.pts, (size_t)h.start[h.n_hulls] * 3 * sizeof(double));
+    cf_hulls_free(&quiet);
     assert_true(cf_hulls_error(&h) <= 0.05);
     assert_true(fabs(cf_hulls_error(&h)) < 1e-9);
     for (int t = 0; t < nt; t++)
@@ -132,7 +140,7 @@ static void test_convex_block_keeps_one_hull(void **state)
     for (int t = 0; t < s.n_tets; t++)
         all[t] = t;
     cf_hulls h;
-    assert_int_equal(cf_decompose(&s, all, s.n_tets, 0.05, 16, 4, &h), 0);
+    assert_int_equal(cf_decompose(&s, all, s.n_tets, 0.05, 16, 4, &h, NULL, NULL), 0);
     assert_int_equal(h.n_hulls, 1);
     assert_int_equal(h.start[1], 8); /* the box's corners */
     assert_true(fabs(cf_hulls_error(&h)) < 1e-12);

@@ -400,7 +400,7 @@ static int split(const cf_solid *s, cluster *c, cluster *d)
 static double excess(const cluster *c) { return c->hull_volume - c->tet_volume; }
 
 int cf_decompose(const cf_solid *s, const int *tets, int nt, double max_error, int max_hulls,
-                 int min_tets, cf_hulls *out)
+                 int min_tets, cf_hulls *out, cf_decompose_tick tick, void *user)
 {
     memset(out, 0, sizeof *out);
     if (max_hulls < 1)
@@ -439,6 +439,8 @@ int cf_decompose(const cf_solid *s, const int *tets, int nt, double max_error, i
         if (ok && (cl[worst].n_pts == 0 || cl[n].n_pts == 0))
             cl[worst].frozen = cl[n].frozen = 1;
         n++;
+        if (tick)
+            tick(user);
     }
     /* Cells with no volume of the fragment (a cut through empty space) add
      * no hull. */

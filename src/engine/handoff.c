@@ -21,6 +21,14 @@ static const double PI = 3.14159265358979323846;
  * rest shape only, so a fragment that comes back from fracture mode in one
  * piece keeps the hulls it had: the same bits, without the work (most of
  * a drop's wall time went to decomposing pieces again after each touch). */
+/* The world's heartbeat between the cuts of a decomposition (the hulls of
+ * a 10^5-tet piece take more than a second). */
+static void decompose_tick(void *user)
+{
+    const cf_world *sim = user;
+    sim->tick(sim->tick_user, sim->t);
+}
+
 static int decompose_fragment(cf_world *sim, cf_fragment *f)
 {
     if (f->hulls.n_hulls > 0)
@@ -30,7 +38,7 @@ static int decompose_fragment(cf_world *sim, cf_fragment *f)
     int most = f->nt / CF_HULL_TETS_PER_HULL;
     most = most < 1 ? 1 : most > CF_HULL_MAX_COUNT ? CF_HULL_MAX_COUNT : most;
     int fail = cf_decompose(&sim->solid, f->tets, f->nt, CF_HULL_MAX_ERROR, most,
-                            CF_HULL_MIN_TETS, &f->hulls);
+                            CF_HULL_MIN_TETS, &f->hulls, sim->tick ? decompose_tick : NULL, sim);
     for (int i = 0; !fail && i < f->hulls.start[f->hulls.n_hulls]; i++) {
         double r[3];
         v3_sub(&f->hulls.pts[3 * i], f->com_rest, r);
