@@ -129,7 +129,7 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
         {"/visual/tet", 0, offsetof(run_data, vis_tet)},
     };
     int rk;
-    hsize_t dims[N_READS][3], dmap[3], dmt[3];
+    hsize_t dims[N_READS][3] = {{0}}, dmap[3], dmt[3];
     for (int k = 0; k < N_READS; k++) {
         void *data = cf_h5_read_all(f, reads[k].path,
                                     reads[k].is_double ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT,
@@ -143,6 +143,17 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
         tf = cf_h5_read_all(f, "/mesh/tet_fragment/value", H5T_NATIVE_INT, 4, &rk, dmap);
         tf_time = cf_h5_read_all(f, "/mesh/tet_fragment/time", H5T_NATIVE_DOUBLE, 8, &rk, dmt);
     }
+    /* Whole frames only: the count the file keeps, and never more rows
+     * than the shortest per-frame dataset holds. */
+    hsize_t rows = dims[TIME][0];
+    const int per_frame[] = {ID, POS, QUAT, MODE};
+    for (size_t k = 0; k < sizeof per_frame / sizeof per_frame[0]; k++) {
+        void *data;
+        memcpy(&data, (char *)r + reads[per_frame[k]].field, sizeof data);
+        if (data && dims[per_frame[k]][0] < rows)
+            rows = dims[per_frame[k]][0];
+    }
+    r->T = cf_h5_whole_frames(f, rows);
     H5Fclose(f);
     if (!r->X || !r->first || !r->count || !r->com_rest || !r->tri)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
@@ -152,8 +163,6 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
     if (!r->time || !r->id || !r->pos || !r->quat)
         return cf_error_set(err, CF_ERR_MESH_PARSE, "%s holds no frames (/particles/fragments)",
                             path);
-    /* Complete frames only (a killed run may leave one partial row). */
-    r->T = dims[TIME][0] < dims[ID][0] ? dims[TIME][0] : dims[ID][0];
     r->N = dims[ID][1], r->nn = dims[X][0], r->M = dims[TRI][0], r->nf = (int)dims[FIRST][0];
     cf_status st = CF_OK;
     if (tf && tf_time &&

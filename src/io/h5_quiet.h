@@ -34,4 +34,11 @@ static inline void quiet_end(const quiet_state *q)
 void *cf_h5_read_all(hid_t file, const char *name, hid_t type, size_t size, int *rank,
                      hsize_t dims[3]);
 
+/* The whole frames of an open output, at most `rows` (the shortest
+ * per-frame dataset the caller read): the root attribute `frames` where
+ * the file has it (a run killed during a flush may leave one dataset a
+ * row longer than another; docs/output.md), else `rows`.  In
+ * trajectory.c. */
+hsize_t cf_h5_whole_frames(hid_t file, hsize_t rows);
+
 #endif

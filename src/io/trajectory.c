@@ -42,6 +42,19 @@ void *cf_h5_read_all(hid_t file, const char *name, hid_t type, size_t size, int 
     return buf;
 }
 
+hsize_t cf_h5_whole_frames(hid_t file, hsize_t rows)
+{
+    int64_t whole = -1;
+    if (H5Aexists_by_name(file, "/", "frames", H5P_DEFAULT) > 0) {
+        hid_t a = H5Aopen_by_name(file, "/", "frames", H5P_DEFAULT, H5P_DEFAULT);
+        if (a < 0 || H5Aread(a, H5T_NATIVE_INT64, &whole) < 0)
+            whole = -1;
+        if (a >= 0)
+            H5Aclose(a);
+    }
+    return whole >= 0 && (hsize_t)whole < rows ? (hsize_t)whole : rows;
+}
+
 /* First and last complete sample of an observable (NaN when absent). */
 static void read_observable(hid_t file, const char *name, double *first, double *last)
 {
@@ -83,19 +96,8 @@ cf_status cf_trajectory_read(const char *path, cf_trajectory *t, cf_error *err)
                       sizeof(double), &rp, dp);
     t->parent = cf_h5_read_all(file, "/fragments/parent", H5T_NATIVE_INT, sizeof(int), &rpar, dpar);
     t->mass = cf_h5_read_all(file, "/fragments/mass", H5T_NATIVE_DOUBLE, sizeof(double), &rm, dm);
-    /* The whole frames: the root attribute `frames` where the file has it
-     * (a killed run may leave one dataset a row longer; docs/output.md). */
-    int64_t whole = -1;
-    if (step && H5Aexists_by_name(file, "/", "frames", H5P_DEFAULT) > 0) {
-        hid_t a = H5Aopen_by_name(file, "/", "frames", H5P_DEFAULT, H5P_DEFAULT);
-        if (a < 0 || H5Aread(a, H5T_NATIVE_INT64, &whole) < 0 || whole < 0 ||
-            (hsize_t)whole > ds[0])
-            whole = -1;
-        if (a >= 0)
-            H5Aclose(a);
-    }
-    if (step && whole >= 0)
-        ds[0] = (hsize_t)whole;
+    if (step) /* the whole frames (a killed run's file: docs/output.md) */
+        ds[0] = cf_h5_whole_frames(file, ds[0]);
     if (!step || !t->time || !t->pos || !t->parent || !t->mass)
         st = cf_error_set(err, CF_ERR_MESH_FORMAT,
                           "%s: /particles/fragments/position or /fragments/{parent,mass} "
