@@ -18,15 +18,18 @@ grep '^fragments' "$tmp/run.txt"
 "$exe" export "$tmp/box.h5" --format gltf -o "$tmp/box.glb"
 /usr/bin/python3 "$src/tests/checks/check_gltf.py" "$tmp/box.h5" "$tmp/box.glb"
 # A file torn by a kill during a flush (docs/output.md): the orientations a
-# row short of the other per-frame datasets, the root attribute `frames`
-# counting the whole frames.  The export reads those only (it read the
-# longest two, and the orientation past its end).
+# row short of the other per-frame datasets, the ids a column wider (a
+# frame's new fragment), the root attribute `frames` counting the whole
+# frames.  The export reads those only (it read the longest two, and the
+# orientation past its end).
 cp "$tmp/box.h5" "$tmp/torn.h5"
 /usr/bin/python3 - "$tmp/torn.h5" <<'PY'
 import sys, h5py, numpy as np
 with h5py.File(sys.argv[1], "r+") as f:
     q = f["particles/fragments/orientation/value"]
     q.resize(q.shape[0] - 1, axis=0)
+    ids = f["particles/fragments/id/value"]
+    ids.resize(ids.shape[1] + 1, axis=1)
     f.attrs["frames"] = np.int64(q.shape[0])
 PY
 "$exe" export "$tmp/torn.h5" --format gltf -o "$tmp/torn.glb"

@@ -91,6 +91,14 @@ static int own_visual(run_data *r, const int *tf, const double *tf_time, hsize_t
     return 0;
 }
 
+/* Rows [0, T) of a [..][cols][k] array (elements of `size` bytes) kept as
+ * [T][n][k], in place (n <= cols). */
+static void keep_columns(void *a, hsize_t T, hsize_t cols, hsize_t n, size_t k, size_t size)
+{
+    for (hsize_t t = 0; a && n < cols && t < T; t++)
+        memmove((char *)a + t * n * k * size, (char *)a + t * cols * k * size, n * k * size);
+}
+
 static cf_status run_read(const char *path, run_data *r, cf_error *err)
 {
     memset(r, 0, sizeof *r);
@@ -143,17 +151,26 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
         tf = cf_h5_read_all(f, "/mesh/tet_fragment/value", H5T_NATIVE_INT, 4, &rk, dmap);
         tf_time = cf_h5_read_all(f, "/mesh/tet_fragment/time", H5T_NATIVE_DOUBLE, 8, &rk, dmt);
     }
-    /* Whole frames only: the count the file keeps, and never more rows
-     * than the shortest per-frame dataset holds. */
-    hsize_t rows = dims[TIME][0];
+    /* Whole frames only: the count the file keeps, never more rows than
+     * the shortest per-frame dataset holds, and the columns all of them
+     * have (a run killed during a flush may leave one dataset a row
+     * longer, or a frame's new columns wider, than another). */
     const int per_frame[] = {ID, POS, QUAT, MODE};
-    for (size_t k = 0; k < sizeof per_frame / sizeof per_frame[0]; k++) {
-        void *data;
-        memcpy(&data, (char *)r + reads[per_frame[k]].field, sizeof data);
-        if (data && dims[per_frame[k]][0] < rows)
-            rows = dims[per_frame[k]][0];
+    const size_t width[] = {1, 3, 4, 1};
+    enum { N_PER_FRAME = sizeof per_frame / sizeof per_frame[0] };
+    void *data[N_PER_FRAME];
+    hsize_t rows = dims[TIME][0], cols = dims[ID][1];
+    for (int k = 0; k < N_PER_FRAME; k++) {
+        const hsize_t *d = dims[per_frame[k]];
+        memcpy(&data[k], (char *)r + reads[per_frame[k]].field, sizeof data[k]);
+        rows = data[k] && d[0] < rows ? d[0] : rows;
+        cols = data[k] && d[1] < cols ? d[1] : cols;
     }
     r->T = cf_h5_whole_frames(f, rows);
+    for (int k = 0; k < N_PER_FRAME; k++)
+        keep_columns(data[k], r->T, dims[per_frame[k]][1], cols, width[k],
+                     reads[per_frame[k]].is_double ? 8 : 4);
+    dims[ID][1] = cols;
     H5Fclose(f);
     if (!r->X || !r->first || !r->count || !r->com_rest || !r->tri)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
