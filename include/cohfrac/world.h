@@ -85,9 +85,10 @@ void cf_world_set_threads(cf_world *w, int n);
 /* A heartbeat inside a long rigid step, for progress displays: fn(user, t)
  * is called after every fracture sub-step (t the simulated time it
  * reached, s) and after every cut of the convex decomposition of a
- * fragment handed to Bullet, and at its end (t the time of the hand-off).  fn may call the read-only queries
- * (cf_world_stats_get, cf_world_time, cf_world_step_count) and nothing
- * that changes the world.  NULL (the default): no call. */
+ * fragment handed to Bullet, and at its end (t the time of the hand-off).
+ * fn may call the read-only queries (cf_world_stats_get, cf_world_time,
+ * cf_world_step_count) and nothing that changes the world.  NULL (the
+ * default): no call. */
 typedef void (*cf_world_tick_fn)(void *user, double t);
 void cf_world_set_tick(cf_world *w, cf_world_tick_fn fn, void *user);
 

@@ -15,12 +15,6 @@
 
 static const double PI = 3.14159265358979323846;
 
-/* Convex decomposition of fragment fi (docs/physics.md §9), kept in the principal
- * frame for Bullet and for fracture-mode contact.  A fragment's tets never
- * change (a split makes new fragments) and the decomposition reads their
- * rest shape only, so a fragment that comes back from fracture mode in one
- * piece keeps the hulls it had: the same bits, without the work (most of
- * a drop's wall time went to decomposing pieces again after each touch). */
 /* The world's heartbeat between the cuts of a decomposition (the hulls of
  * a 10^5-tet piece take more than a second). */
 static void decompose_tick(void *user)
@@ -29,6 +23,12 @@ static void decompose_tick(void *user)
     sim->tick(sim->tick_user, sim->t);
 }
 
+/* Convex decomposition of fragment fi (docs/physics.md §9), kept in the principal
+ * frame for Bullet and for fracture-mode contact.  A fragment's tets never
+ * change (a split makes new fragments) and the decomposition reads their
+ * rest shape only, so a fragment that comes back from fracture mode in one
+ * piece keeps the hulls it had: the same bits, without the work (most of
+ * a drop's wall time went to decomposing pieces again after each touch). */
 static int decompose_fragment(cf_world *sim, cf_fragment *f)
 {
     if (f->hulls.n_hulls > 0)

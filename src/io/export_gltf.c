@@ -170,7 +170,6 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
     for (int k = 0; k < N_PER_FRAME; k++)
         keep_columns(data[k], r->T, dims[per_frame[k]][1], cols, width[k],
                      reads[per_frame[k]].is_double ? 8 : 4);
-    dims[ID][1] = cols;
     H5Fclose(f);
     if (!r->X || !r->first || !r->count || !r->com_rest || !r->tri)
         return cf_error_set(err, CF_ERR_MESH_PARSE,
@@ -180,7 +179,7 @@ static cf_status run_read(const char *path, run_data *r, cf_error *err)
     if (!r->time || !r->id || !r->pos || !r->quat)
         return cf_error_set(err, CF_ERR_MESH_PARSE, "%s holds no frames (/particles/fragments)",
                             path);
-    r->N = dims[ID][1], r->nn = dims[X][0], r->M = dims[TRI][0], r->nf = (int)dims[FIRST][0];
+    r->N = cols, r->nn = dims[X][0], r->M = dims[TRI][0], r->nf = (int)dims[FIRST][0];
     cf_status st = CF_OK;
     if (tf && tf_time &&
         own_visual(r, tf, tf_time, dmap[0] < dmt[0] ? dmap[0] : dmt[0], dmap[1]) != 0)
