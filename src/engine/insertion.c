@@ -175,9 +175,15 @@ static double vertex_floor(const cf_solid *s, int n, double lowest)
  * order.  Only the tets the rest own can then qualify: the same facets,
  * from fewer stars.  With a strength field the floor of a vertex is its
  * own weakest facet's, where the solid's weakest would keep most stressed
- * nodes.  The values stay exact from `lowest` up all the same: a facet's
- * rank reads all three of its nodes' (facet_ratio). */
-static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowest)
+ * nodes.  The values stay exact from `lowest` up all the same where a
+ * front's rank reads all three of its nodes' (facet_ratio), the two on its
+ * cracked edge below any floor; with `floor_exact` no rank reads a value
+ * below its vertex's floor (a front ranks by its normal stress, a nucleus
+ * has all three nodes at their thresholds, or no rank is read), and the
+ * values are exact from each vertex's floor up: the eigenvalue's
+ * trigonometry is spared where a bound shows a node below it. */
+static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowest,
+                         int floor_exact)
 {
     /* The copies of one original vertex in the fragment share its star,
      * so they share its value: the first copy to claim the vertex in this
@@ -187,8 +193,11 @@ static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowe
     CF_PARALLEL(marked->n >= STAR_PARALLEL_MIN, "omp parallel for schedule(static)",
         for (int i = 0; i < marked->n; i++) {
             int n = marked->v[i], o = s->origin[n];
-            if (__atomic_exchange_n(&s->vert_check[o], stamp, __ATOMIC_RELAXED) != stamp)
-                s->vert_node[o] = n, s->nodal[n] = nodal_principal(s, n, frag, lowest);
+            if (__atomic_exchange_n(&s->vert_check[o], stamp, __ATOMIC_RELAXED) != stamp) {
+                double from = floor_exact ? vertex_floor(s, n, lowest) : lowest;
+                s->vert_node[o] = n;
+                s->nodal[n] = nodal_principal(s, n, frag, from);
+            }
         });
     CF_PARALLEL(marked->n >= STAR_PARALLEL_MIN, "omp parallel for schedule(static)",
         for (int i = 0; i < marked->n; i++) {
@@ -371,7 +380,7 @@ static void star_unqualify(cf_solid *s, int n)
 }
 
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
-                            cf_int_list *out)
+                            const cf_growth *g, cf_int_list *out)
 {
     out->n = 0;
     if (n_hot == 0 || rule == CF_CRITERION_NONE)
@@ -392,7 +401,8 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
         s->check_stamp = 1;
     }
     if (rule == CF_CRITERION_SOURCE) /* no facet threshold lies below the bound's s1 */
-        nodal_values(s, out, s->tet_frag[tets[0]], cf_insertion_bound(s, rule).s1);
+        nodal_values(s, out, s->tet_frag[tets[0]], cf_insertion_bound(s, rule).s1,
+                     g && (g->rule == CF_GROWTH_ALL || g->along_stress));
     /* The faces of the tets that may have a qualifying one, then those
      * tets listed after the nodes. */
     int m = out->n, rc = 0, nq = qualify_near_marks(s, out, rule);

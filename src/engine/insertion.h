@@ -25,6 +25,19 @@ void cf_ints_sort(int *v, int n); /* v[0..n) ascending */
  * never looked at. */
 cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
 
+/* How a check chooses among the facets that meet the criterion
+ * (docs/physics.md §5.1). */
+typedef struct cf_growth {
+    cf_crack_growth rule;  /* fronts, or all (the source's) */
+    double front_speed;    /* m/s: the fastest a crack front may move (Rayleigh speed) */
+    int min_piece_tets;    /* no insertion closes a piece of at most this many tets */
+    double min_piece_volume; /* m^3: nor one of less volume (0: no bound) */
+    double t;              /* s: now */
+    int along_stress;      /* a front takes only a facet whose normal stress reaches its
+                              threshold (solver.front_direction "stress"; criterion
+                              source) */
+} cf_growth;
+
 /* Insertion criterion on the interior, uncracked facets of `tets` (a
  * fragment's whole list, ascending: the facets are found from the stars of
  * the hot tets' nodes, which hold no tet of another fragment; listed in tet
@@ -40,28 +53,19 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
  *   (computed only at nodes of hot tets, in s->nodal, s->node_mark); or,
  *   for a facet that shares an edge with a cracked facet, at its vertex off
  *   that edge, ahead of the crack's front (docs/physics.md §5.1).
+ * g is the growth rule the candidates go to (cf_insertion_select): where
+ * no rank it reads lies below a vertex's floor, the nodal values are exact
+ * from that floor up only; NULL keeps them exact from the weakest facet's
+ * threshold up.  The candidates are the same either way.
  * Writes the qualifying facet indices into `out` (emptied first) and
  * returns their number, or -1 when out of memory. */
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
-                            cf_int_list *out);
+                            const cf_growth *g, cf_int_list *out);
 
 /* Set facet f's cracked flag (1 or 0), and move on the crack version of
  * its three original vertices, which the growth rule's memo keys on: every
  * change of a facet's flag goes through here. */
 void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked);
-
-/* How a check chooses among the facets that meet the criterion
- * (docs/physics.md §5.1). */
-typedef struct cf_growth {
-    cf_crack_growth rule;  /* fronts, or all (the source's) */
-    double front_speed;    /* m/s: the fastest a crack front may move (Rayleigh speed) */
-    int min_piece_tets;    /* no insertion closes a piece of at most this many tets */
-    double min_piece_volume; /* m^3: nor one of less volume (0: no bound) */
-    double t;              /* s: now */
-    int along_stress;      /* a front takes only a facet whose normal stress reaches its
-                              threshold (solver.front_direction "stress"; criterion
-                              source) */
-} cf_growth;
 
 /* The facets of `cand` (cf_insertion_candidates) that a check inserts,
  * left in `cand` in ascending order; each is marked cracked, with its
