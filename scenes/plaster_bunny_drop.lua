@@ -4,7 +4,7 @@
 -- so it pays for the impact and the 0.15 s of flight after it, not for
 -- the second of free fall.  Why 5.1 m: the plaster sphere ladder
 -- (docs/physics.md §15) breaks at 9-12 m/s, and the 1.3 m drop this scene
--- used to make (5 m/s) lies below it: the bunny then keeps 70-99 % in one
+-- used to make (5 m/s) lies below it: the bunny then keeps 68-99 % in one
 -- piece.
 -- Material: gypsum plaster (plaster of Paris), E 5 GPa, nu 0.2,
 -- rho 1200 kg/m^3, tensile strength 2 MPa with Weibull scatter (modulus 6),
@@ -38,15 +38,15 @@
 -- Floor: a penalty contact (docs/physics.md §7.1) that neither takes nor
 -- gives energy; the body's elasticity makes the rebound.  Fracture mode
 -- begins at the engine's impact threshold (0.2 m/s).
--- Expected (seed 1): 71 fragments, three pieces of at least 5% of the mass
--- (13.6, 11.8 and 9.4%), 21 more of 1-5% and no chip of 4 tets or fewer;
--- of the 305 J it lands with, about 202 J go into crushing and 5.1 J into
--- the cracks, and 31 J of strain energy are dropped (and booked) at the
--- hand-offs; the fastest piece, 10 tets thrown from the crushed layer,
--- leaves at 12.8 m/s against the bound 20.0 m/s of
--- tests/checks/check_physics.py; about 3.5 s.  Seeds 2-5 give 4, 3, 1 and 5
--- pieces of at least 5%, and the largest share agrees within 0.15 with
--- bunny_4k's and bunny_small's for every seed (docs/physics.md §14.28).
+-- Expected (seed 1): 67 fragments, four pieces of at least 5% of the mass
+-- (24.0, 10.2, 6.6 and 5.0%), 20 more of 1-5% and no chip of 4 tets or
+-- fewer; of the 305 J it lands with, about 197 J go into crushing and
+-- 5.0 J into the cracks, and 34 J of strain energy are dropped (and
+-- booked) at the hand-offs; the fastest piece leaves at 6.5 m/s against
+-- the bound 20.0 m/s of tests/checks/check_physics.py; about 3.2 s.
+-- Seeds 2-5 give 3, 3, 2 and 5 pieces of at least 5%, and the largest
+-- share agrees within 0.15 with bunny_4k's and bunny_small's for seeds
+-- 1-3 (docs/physics.md §14.29).
 return {
   name = "plaster_bunny_drop",
   duration = 0.15,

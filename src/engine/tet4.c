@@ -6,6 +6,7 @@
 #include "parallel.h"
 
 #include <omp.h>
+#include <string.h>
 
 /* Voigt slots (xx yy zz xy xz yz) of the plastic strain, as row and column. */
 static const int VOIGT[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
@@ -353,6 +354,44 @@ static inline __attribute__((always_inline)) void bulk_viscosity(cf_solid *s, co
         s->bv_work[t[l]] += work[l], s->bv_rate[t[l]] = rate[l];
 }
 
+/* The skew part a plastic tet's stress needs for its forces to be the
+ * gradient of its strain energy, added to P = R sigma (Pa).  The strain is
+ * sym(U) - I - ep with U = R^T F, R the polar rotation, and
+ * dW = sigma : dU; with R^T dF = dU + Omega U (Omega = R^T dR, skew),
+ * P = R (sigma + A) gives P : dF = sigma : dU for every dF exactly when
+ * (sigma + A) U is symmetric, i.e. A U + U A = U sigma - sigma U.  For a
+ * skew A = [a]x and a symmetric U, A U + U A = [((tr U) I - U) a]x, so
+ * a = ((tr U) I - U)^-1 c, with [c]x = U sigma - sigma U.  An elastic
+ * sigma, a polynomial of U, commutes with it (A = 0); a plastic strain in
+ * another direction does not, and without A the forces did work that
+ * neither the strain energy nor the plastic work counts (about 1 % of
+ * the crushing work of the plaster sphere drops), and held a moment:
+ * P F^T = R (sigma U) R^T was not symmetric (docs/physics.md §2.1). */
+static void plastic_spin(const double R[9], const double F[9], const double sig[9],
+                         double dP[9])
+{
+    double S[9], U[9], US[9], SU[9], M[9], Mi[9], c[3], a[3];
+    m3_mul_tn(R, F, S);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            U[3 * i + j] = 0.5 * (S[3 * i + j] + S[3 * j + i]);
+    m3_mul(U, sig, US);
+    m3_mul(sig, U, SU);
+    c[0] = 0.5 * ((US[7] - SU[7]) - (US[5] - SU[5]));
+    c[1] = 0.5 * ((US[2] - SU[2]) - (US[6] - SU[6]));
+    c[2] = 0.5 * ((US[3] - SU[3]) - (US[1] - SU[1]));
+    double tr = U[0] + U[4] + U[8];
+    for (int k = 0; k < 9; k++)
+        M[k] = ((k % 4) == 0 ? tr : 0) - U[k];
+    if (!(m3_inv(M, Mi) > 0)) { /* a tet turned inside out: no spin to add */
+        memset(dP, 0, 9 * sizeof(double));
+        return;
+    }
+    m3_mulv(Mi, c, a);
+    double A[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
+    m3_mul(R, A, dP);
+}
+
 /* cf_tet4_forces for tets t[0..n-1], n <= LANES (the missing lanes repeat
  * the first tet and are dropped); counts inverted and hot tets. */
 CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_elasticity kind,
@@ -372,6 +411,20 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
             live[l] = !s->crushed[t[l]];
     for (int k = 0; k < 9; k++)
         Pf[k] = P[k];
+    /* The plastic tets' spin (the check reads the symmetric sigma).  Small
+     * strain needs none: with R = I, sigma : sym(dF) = sigma : dF. */
+    if (s->ep && kind == CF_ELASTICITY_COROTATIONAL)
+        for (int l = 0; l < n; l++) {
+            if (!(L.ep[0][l] != 0 || L.ep[1][l] != 0 || L.ep[2][l] != 0 || L.ep[3][l] != 0 ||
+                  L.ep[4][l] != 0 || L.ep[5][l] != 0))
+                continue;
+            double R[9], F[9], sg[9], dP[9];
+            for (int k = 0; k < 9; k++)
+                R[k] = L.R[k][l], F[k] = L.F[k][l], sg[k] = L.sig[k][l];
+            plastic_spin(R, F, sg, dP);
+            for (int k = 0; k < 9; k++)
+                Pf[k][l] += dP[k];
+        }
     if (s->bv_eta) /* a force, not a stress of the material: the check reads P */
         bulk_viscosity(s, t, n, &L, kind, live, vol, dt, Pf);
     vd f[12]; /* f_a = -V P grad N_a, grad N0 = -(grad N1 + grad N2 + grad N3) */
