@@ -311,17 +311,15 @@ static void test_criterion_selects_facets_normal_to_tension(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
-/* The box of m as a solid with every node moved by a fixed pseudo-random
- * 2 % of its size, strengths sigma_max = tau_max = `strength` (Pa), and the
- * stresses and hot flags of one check under `rule` (*n_hot of them hot).
- * Returns the list of all tets, in order (the caller frees it). */
-static int *deformed_box(cf_solid *s, cf_mesh *m, cf_criterion rule, double strength, int *n_hot)
+/* Every node of solid s moved by a fixed pseudo-random 2 % of a unit box,
+ * then the stresses and hot flags of one check under `rule` (*n_hot of
+ * them hot).  Returns the list of all tets, in order (the caller frees
+ * it). */
+static int *deform_and_check(cf_solid *s, cf_criterion rule, int *n_hot)
 {
-    init(s, m);
     for (int i = 0; i < s->n_nodes; i++)
         for (int k = 0; k < 3; k++)
             s->x[3 * i + k] += 0.02 * sin(12.9898 * i + 78.233 * k);
-    s->mat.sigma_max = s->mat.tau_max = strength;
     int *all = malloc((size_t)s->n_tets * sizeof(int));
     for (int t = 0; t < s->n_tets; t++)
         all[t] = t;
@@ -329,6 +327,15 @@ static int *deformed_box(cf_solid *s, cf_mesh *m, cf_criterion rule, double stre
     *n_hot = 0;
     cf_tet4_forces(s, all, s->n_tets, CF_ELASTICITY_COROTATIONAL, &bound, 0, n_hot);
     return all;
+}
+
+/* The box of m as a solid with strengths sigma_max = tau_max = `strength`
+ * (Pa), deformed and checked once under `rule` (deform_and_check). */
+static int *deformed_box(cf_solid *s, cf_mesh *m, cf_criterion rule, double strength, int *n_hot)
+{
+    init(s, m);
+    s->mat.sigma_max = s->mat.tau_max = strength;
+    return deform_and_check(s, rule, n_hot);
 }
 
 /* The tet-level bound (Gershgorin, cf_insertion_bound) never drops a facet
@@ -1098,9 +1105,9 @@ static void test_front_threshold_from_the_toughness(void **state)
 }
 
 /* The 4-cell box of m with a Weibull strength field (modulus 6, reference
- * area 0.01, seed 3) of mean strength near `strength` (Pa), deformed as
- * deformed_box does, with an old crack at its middle facet; the stresses
- * and hot flags of one check of the source's rule.  Returns all its tets. */
+ * area 0.01, seed 3) of mean strength near `strength` (Pa), deformed and
+ * checked once under the source's rule (deform_and_check), with an old
+ * crack at its middle facet.  Returns all its tets. */
 static int *weibull_box_with_crack(cf_solid *s, cf_mesh *m, double strength)
 {
     fixture_box(m, 4, 4, 4, 1, 1, 1);
@@ -1111,16 +1118,7 @@ static int *weibull_box_with_crack(cf_solid *s, cf_mesh *m, double strength)
     assert_int_equal(cf_solid_init(s, m, &mt, body, NULL), CF_OK);
     assert_int_equal(cf_solid_init_facets(s, NULL), CF_OK);
     free(body);
-    for (int i = 0; i < s->n_nodes; i++)
-        for (int k = 0; k < 3; k++)
-            s->x[3 * i + k] += 0.02 * sin(12.9898 * i + 78.233 * k);
-    int *all = malloc((size_t)s->n_tets * sizeof(int));
-    for (int t = 0; t < s->n_tets; t++)
-        all[t] = t;
-    cf_stress_check bound = cf_insertion_bound(s, CF_CRITERION_SOURCE);
-    int n_hot = 0;
-    cf_tet4_forces(s, all, s->n_tets, CF_ELASTICITY_COROTATIONAL, &bound, 0, &n_hot);
-    int f0 = middle_facet(s);
+    int n_hot, *all = deform_and_check(s, CF_CRITERION_SOURCE, &n_hot), f0 = middle_facet(s);
     assert_true(f0 >= 0);
     old_crack(s, f0);
     return all;
