@@ -46,6 +46,7 @@ struct Body {
     BodyKind kind;
     btVector3 kin_v, kin_w;  // prescribed velocity of a kinematic obstacle
     double impulse;          // normal contact impulse during the last cfb_step
+    double impulse_static;   // the part of it from static bodies
     std::vector<int> ignored;
     // The quaternion last given by the caller and the basis it produced:
     // while the basis is untouched, get_state returns that exact quaternion
@@ -246,6 +247,7 @@ int add_body(cfb_world *w, btCollisionShape *shape, double mass, const btVector3
     b->kin_v = kin_v;
     b->kin_w = btVector3(0, 0, 0);
     b->impulse = 0.0;
+    b->impulse_static = 0.0;
     b->has_quat = false;
 
     const int id = static_cast<int>(w->bodies.size());
@@ -324,10 +326,15 @@ void post_tick(btDynamicsWorld *dw, btScalar h)
             sum += man->getContactPoint(c).getAppliedImpulse();
         if (sum == 0.0) continue;
         const int ids[2] = {man->getBody0()->getUserIndex(), man->getBody1()->getUserIndex()};
+        Body *pair[2];
+        for (int k = 0; k < 2; ++k)
+            pair[k] = ids[k] >= 0 && static_cast<size_t>(ids[k]) < w->bodies.size()
+                          ? w->bodies[ids[k]] : nullptr;
         for (int k = 0; k < 2; ++k) {
-            if (ids[k] >= 0 && static_cast<size_t>(ids[k]) < w->bodies.size() &&
-                w->bodies[ids[k]])
-                w->bodies[ids[k]]->impulse += sum;
+            if (!pair[k]) continue;
+            pair[k]->impulse += sum;
+            if (pair[1 - k] && pair[1 - k]->kind == BODY_STATIC)
+                pair[k]->impulse_static += sum;
         }
     }
     for (size_t i = 0; i < w->kinematic.size(); ++i) {
@@ -1131,7 +1138,7 @@ static int step_unguarded(cfb_world *w, double dt, int substeps)
     while (static_cast<int>(t / h) < substeps)
         t = std::nextafter(t, std::numeric_limits<double>::infinity());
     for (size_t i = 0; i < w->bodies.size(); ++i)
-        if (w->bodies[i]) w->bodies[i]->impulse = 0.0;
+        if (w->bodies[i]) w->bodies[i]->impulse = w->bodies[i]->impulse_static = 0.0;
     w->ticks = 0;
     w->dyn->reset_local_time();
     w->dyn->stepSimulation(t, substeps, h);
@@ -1147,6 +1154,12 @@ double cfb_contact_impulse(const cfb_world *w, int id)
 {
     const Body *b = lookup(w, id);
     return b ? b->impulse : -1.0;
+}
+
+double cfb_contact_impulse_static(const cfb_world *w, int id)
+{
+    const Body *b = lookup(w, id);
+    return b ? b->impulse_static : -1.0;
 }
 
 int cfb_body_count(const cfb_world *w)

@@ -158,6 +158,11 @@ int cfb_step(cfb_world *w, double dt, int substeps);
  * cfb_step (all sub-steps), against any other body; -1 for an invalid id. */
 double cfb_contact_impulse(const cfb_world *w, int id);
 
+/* The part of cfb_contact_impulse (N s) from static bodies (fixed
+ * obstacles: they move nothing, so they bring no new energy to the body);
+ * -1 for an invalid id. */
+double cfb_contact_impulse_static(const cfb_world *w, int id);
+
 /* Number of dynamic bodies currently in the world. */
 int cfb_body_count(const cfb_world *w);
 

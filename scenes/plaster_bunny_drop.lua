@@ -38,7 +38,7 @@
 -- Floor: a penalty contact (docs/physics.md §7.1) that neither takes nor
 -- gives energy; the body's elasticity makes the rebound.  Fracture mode
 -- begins at the engine's impact threshold (0.2 m/s).
--- Expected (seed 1): 67 fragments, four pieces of at least 5% of the mass
+-- Expected (seed 1): 66 fragments, four pieces of at least 5% of the mass
 -- (24.0, 10.2, 6.6 and 5.0%), 20 more of 1-5% and no chip of 4 tets or
 -- fewer; of the 305 J it lands with, about 197 J go into crushing and
 -- 5.0 J into the cracks, and 34 J of strain energy are dropped (and

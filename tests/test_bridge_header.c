@@ -47,6 +47,7 @@ static void test_header_calls(void **state)
     cfb_remove_body(w, b);
     assert_int_equal(cfb_body_count(w), 1);
     assert_true(cfb_contact_impulse(w, b) < 0.0);
+    assert_true(cfb_contact_impulse_static(w, b) < 0.0);
     const char *msg = cfb_last_error();
     assert_non_null(msg);
     assert_true(strlen(msg) > 0);

@@ -819,6 +819,126 @@ static void test_resting_body_stays_rigid(void **state)
     cf_scene_free(&sc);
 }
 
+/* A cube thrown spinning onto the floor tumbles, slides and rocks to rest,
+ * striking the floor face after face (docs/physics.md §9).  Each strike
+ * passes the impact threshold, and each spell ends, quiet and clear of the
+ * impact, without breaking the cube: before the rule it went back to
+ * fracture mode at 7 of them, to t = 0.95 s.  Now a strike sends it back
+ * only when it is stronger than the strongest the cube has taken whole:
+ * every entry's impact exceeds the last, and the strikes in rigid mode that
+ * pass the threshold but not the taken impact stay rigid. */
+static const char *tumble_scene =
+    "return {\n"
+    "  name = 'tumble', duration = 1.0,\n"
+    "  material = {E = 1e5, nu = 0.25, rho = 1000, G_I = 1, sigma_max = 1e9,\n"
+    "              friction = 0.5, restitution = 0},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {2, 2, 2}},\n"
+    "             position = {0, 0, 0.08}, velocity = {1.5, 0, -0.5},\n"
+    "             angular_velocity = {0, 30, 0}}},\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {dt_rigid = 1e-3, dt_fracture = 1e-4, quiet_steps = 100,\n"
+    "            constraints = 'xpbd'},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void test_reentry_only_on_a_stronger_impact(void **state)
+{
+    (void)state;
+    cf_scene sc;
+    cf_sim *sim = make_sim(tumble_scene, &sc);
+    int entries = 0, was = 0, declined = 0, rising = 1;
+    double last = 0, threshold = cf_sim_world(sim)->def.solver.impact_threshold;
+    while (!cf_sim_done(sim)) {
+        advance(sim);
+        cf_world *w = cf_sim_world(sim);
+        const cf_fragment *f = &w->frag[0];
+        int now = f->mode == CF_MODE_FRACTURE;
+        if (now && !was) {
+            printf("FIGURE tumble: entry %d at t = %.3f s, impact %.3f m/s\n", entries + 1,
+                   cf_world_time(w), f->dv_enter);
+            rising &= f->dv_enter > last;
+            last = f->dv_enter, entries++;
+        } else if (!now && f->body >= 0 &&
+                   cfb_contact_impulse(w->bullet, f->body) / f->mass > threshold) {
+            declined++;
+            assert_true(cfb_contact_impulse(w->bullet, f->body) / f->mass <= f->dv_taken);
+        }
+        was = now;
+    }
+    cf_world *w = cf_sim_world(sim);
+    cf_fragment_state fs[1];
+    assert_int_equal(cf_world_fragments(w, fs, 1), 1);
+    double speed = sqrt(fs[0].v[0] * fs[0].v[0] + fs[0].v[1] * fs[0].v[1] + fs[0].v[2] * fs[0].v[2]);
+    printf("FIGURE tumble: %d entries into fracture mode, %d hand-offs; %d strikes past the "
+           "threshold taken in rigid mode, none stronger than %.3f m/s; at t = 1 s %.2e m/s\n",
+           entries, w->n_handoffs, declined, w->frag[0].dv_taken, speed);
+    assert_true(entries >= 2); /* the first landing, and a stronger slap */
+    assert_true(entries <= 3);
+    assert_true(rising);
+    assert_true(declined >= 3); /* the strikes the old rule re-entered at */
+    assert_true(speed < 0.01);  /* at rest */
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
+/* A cube lands on a corner at 2 m/s and crushes it (compressive strength
+ * 20 kPa), sinking into the floor for longer than any elastic landing
+ * lasts.  The floor holds it in fracture mode no longer than its landing
+ * time (docs/physics.md §9): twice Hertz's contact time of a sphere of its
+ * mass and volume at the impact threshold's speed, 21 ms; then rigid mode
+ * takes the contact.  Before, the floor held it 42 ms and it went back to
+ * fracture mode three times more, each time held again. */
+static const char *sink_scene =
+    "return {\n"
+    "  name = 'sink', duration = 0.3,\n"
+    "  material = {E = 1e7, nu = 0.25, rho = 1000, G_I = 1, sigma_max = 1e9,\n"
+    "              compressive_strength = 2e4, friction = 0.5, restitution = 0},\n"
+    "  bodies = {{mesh = {type = 'box', size = {0.1, 0.1, 0.1}, cells = {2, 2, 2}},\n"
+    "             position = {0, 0, 0.09}, velocity = {0, 0, -2},\n"
+    "             orientation = {0.8804762392171493, 0.2798481564548788,\n"
+    "                            0.3647051996310009, 0.1159169123637259}}},\n"
+    "  obstacles = {{type = 'plane', point = {0, 0, 0}, normal = {0, 0, 1}}},\n"
+    "  solver = {dt_rigid = 1e-3, dt_fracture = 1e-4, quiet_steps = 20,\n"
+    "            constraints = 'none', obstacle_contact = 'penalty'},\n"
+    "  output = {file = ''},\n"
+    "}\n";
+
+static void test_floor_holds_no_longer_than_a_landing(void **state)
+{
+    (void)state;
+    cf_scene sc;
+    cf_sim *sim = make_sim(sink_scene, &sc);
+    cf_world *w = cf_sim_world(sim);
+    /* Hertz: 2 x 2.94 d / v, d = (15 m v^2 / (16 E* sqrt(R)))^(2/5) */
+    double m = 1.0, R = cbrt(3 * 1e-3 / (4 * acos(-1.0))), E = 1e7 / (1 - 0.25 * 0.25);
+    double v = w->def.solver.impact_threshold;
+    double landing = 2 * 2.94 * pow(15 * m * v * v / (16 * E * sqrt(R)), 0.4) / v;
+    int entries = 0, was = 0;
+    double t_in = -1, t_out = -1;
+    while (!cf_sim_done(sim)) {
+        advance(sim);
+        int now = any_in_fracture_mode(sim);
+        if (now && !was)
+            entries++, t_in = t_in < 0 ? cf_world_time(w) - w->def.solver.dt_rigid : t_in;
+        if (was && !now && t_out < 0)
+            t_out = cf_world_time(w);
+        was = now;
+    }
+    cf_ledger l;
+    cf_world_ledger(w, &l);
+    printf("FIGURE sink: landing time %.4f s; in fracture mode from t = %.3f to %.3f s, %d "
+           "entries; plastic work %.3g J, contact removed %.3g J, residual %.2e of %.3g J\n",
+           landing, t_in, t_out, entries, l.plastic_dissipated, l.contact, fabs(l.residual),
+           l.initial);
+    assert_int_equal(entries, 1);
+    assert_true(t_out - t_in >= landing - 1e-12);
+    assert_true(t_out - t_in <= landing + 2 * w->def.solver.dt_rigid);
+    assert_true(l.plastic_dissipated > 0); /* it crushed */
+    assert_true(fabs(l.residual) <= 1e-3 * l.initial);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
 /* The cube of examples/drop.c lands from 1 m, takes the impact in fracture
  * mode without breaking, and goes back to rigid mode on its way up.  A
  * fragment that stays whole keeps the principal frame its hulls were built
@@ -988,6 +1108,8 @@ int main(void)
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),
         cmocka_unit_test(test_wedged_piece_enters_clear),
         cmocka_unit_test(test_no_return_while_driving_in),
+        cmocka_unit_test(test_reentry_only_on_a_stronger_impact),
+        cmocka_unit_test(test_floor_holds_no_longer_than_a_landing),
         cmocka_unit_test(test_fracture_only_fragments_and_weibull),
         cmocka_unit_test(test_handoff_keeps_bonded_pieces_together),
     };

@@ -124,7 +124,8 @@ typedef enum {
       CF_R_POSITIVE, "s", "the longest a fragment stays in fracture mode")                     \
     X("solver", "impact_threshold", NUM, solver.impact_threshold, 0.2, NULL, NULL,            \
       CF_R_NON_NEGATIVE, "m/s",                                                                \
-      "a rigid step's contact impulse over the mass that starts fracture mode")                \
+      "a rigid step's contact impulse over the mass that starts fracture mode, when new or "   \
+      "stronger than one taken (docs/physics.md 9)")                                           \
     X("solver", "elasticity", ENUM, solver.elasticity, 0, NULL, cf_names_elasticity,         \
       CF_R_NONE, "", "corotational Tet4, or the source's small strain")                        \
     X("solver", "criterion", ENUM, solver.criterion, 0, NULL, cf_names_criterion, CF_R_NONE,  \

@@ -78,6 +78,11 @@ typedef struct cf_fragment {
     double decompose_time;   /* s of wall time to decompose it */
     double pushed;           /* N s: impulse fracture-mode nodes gave its body
                                 since the last rigid step (impact trigger) */
+    double dv_enter;         /* m/s: the impact (contact impulse over mass) that
+                                began its fracture-mode spell; 0 none */
+    double dv_taken;         /* m/s: the strongest impact it has taken in fracture
+                                mode and come back from whole; only a stronger
+                                one sends it back (docs/physics.md §9) */
 } cf_fragment;
 
 /* Appends a new fragment to the table frag[0..*n) of capacity *cap (grown

@@ -523,8 +523,12 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
     double P0[3], L0[3], P1[3] = {0, 0, 0}, L1[3] = {0, 0, 0}, ke_after = 0;
     cf_fragment_momenta(f, &sim->solid, sim->bullet, P0, L0);
 
-    /* One component: the fragment stays itself; several: children. */
+    /* One component: the fragment stays itself, and has taken the impact
+     * it entered with (a weaker one leaves it rigid); several: children,
+     * new bodies whose next impact is their own. */
     int first = fi;
+    if (k == 1)
+        f->dv_taken = fmax(f->dv_taken, f->dv_enter);
     if (k > 1) {
         f->mode = CF_MODE_DEAD;
         first = sim->n_frag;
