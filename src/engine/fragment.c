@@ -66,6 +66,34 @@ int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set
     return f->nt < 2 * (set->min_piece_tets + 1) || f->volume < 2 * cf_min_piece_volume(set);
 }
 
+/* One with no uncracked interior facet has nothing left to break. */
+int cf_fragment_can_break(const cf_fragment *f, const cf_solid *s, const cf_solver_settings *set)
+{
+    if (set->criterion == CF_CRITERION_NONE || cf_fragment_cannot_split(f, set, &s->mat))
+        return 0;
+    for (int i = 0; i < f->nt; i++)
+        for (int k = 0; k < 4; k++) {
+            int fc = s->tet_facet[4 * f->tets[i] + k];
+            if (s->facet[4 * fc + 2] >= 0 && !s->cracked[fc])
+                return 1;
+        }
+    return 0;
+}
+
+/* Twice, as a corner's contact radius is smaller than the sphere's and the
+ * time grows as R^(-1/5).  A slower landing is no impact and lasts longer,
+ * but rigid mode would not call it one: a contact that outlasts this is
+ * sustained (the fragment rolls, pivots or rests), and rigid mode takes it
+ * (docs/physics.md §9). */
+double cf_fragment_landing_time(const cf_fragment *f, const cf_material *m, double v)
+{
+    if (!(v > 0))
+        return INFINITY;
+    double R = cbrt(3 * f->volume / (4 * acos(-1.0))), E = m->E / (1 - m->nu * m->nu);
+    double d = pow(15 * f->mass * v * v / (16 * E * sqrt(R)), 0.4);
+    return 2 * 2.94 * d / v;
+}
+
 /* A ratio of crack areas, which refining the mesh leaves alone: on a large
  * ringing body the weakest of its many facets keep giving one at a time
  * long after its break has settled, and a count of none never comes. */

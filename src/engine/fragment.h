@@ -111,6 +111,19 @@ double cf_min_piece_volume(const cf_solver_settings *set);
 int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set,
                              const cf_material *m);
 
+/* Whether an impact can break fragment f (an impact of one that cannot
+ * leaves it in rigid mode): it can split (cf_fragment_cannot_split), its
+ * solid s has a fracture criterion, and it has an uncracked interior
+ * facet.  1 or 0. */
+int cf_fragment_can_break(const cf_fragment *f, const cf_solid *s, const cf_solver_settings *set);
+
+/* The longest a landing of fragment f at speed v (m/s; the impact
+ * threshold) lasts, s: twice the contact time of an elastic sphere of its
+ * mass and volume on a rigid floor of material m (Hertz; Johnson, Contact
+ * Mechanics, 1985, §11.4): 2.94 d / v, d = (15 m v^2 / (16 E* sqrt(R)))^(2/5)
+ * the deepest approach, E* = E / (1 - nu^2).  INFINITY for v <= 0. */
+double cf_fragment_landing_time(const cf_fragment *f, const cf_material *m, double v);
+
 /* Counts a fracture step of f in which `inserted` cohesive elements were
  * inserted or tets crushed into its quiet period (docs/physics.md §9): the
  * count f->quiet goes on while the insertions since it last restarted

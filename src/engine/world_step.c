@@ -46,24 +46,6 @@ static int nodes_sane(const cf_solid *s, const cf_fragment *f)
     return insane == 0;
 }
 
-/* A fragment that cannot split (cf_fragment_cannot_split), and one with no
- * uncracked interior facet, cannot break further: an impact leaves it in
- * rigid mode. */
-static int can_break(const cf_world *w, const cf_fragment *f)
-{
-    const cf_solid *s = &w->solid;
-    const cf_solver_settings *set = &w->def.solver;
-    if (set->criterion == CF_CRITERION_NONE || cf_fragment_cannot_split(f, set, &s->mat))
-        return 0;
-    for (int i = 0; i < f->nt; i++)
-        for (int k = 0; k < 4; k++) {
-            int fc = s->tet_facet[4 * f->tets[i] + k];
-            if (s->facet[4 * fc + 2] >= 0 && !s->cracked[fc])
-                return 1;
-        }
-    return 0;
-}
-
 /* Rigid fragment f is hit: Bullet's contact impulse plus the pushes of
  * fracture-mode nodes, per unit mass (m/s), pass the impact threshold, and
  * the impact is new or stronger (docs/physics.md §9).  New: more than the
@@ -80,7 +62,7 @@ static double impact(const cf_world *w, const cf_fragment *f)
     double dv = J / f->mass, dv_new = (J - cfb_contact_impulse_static(w->bullet, f->body)) / f->mass;
     double threshold = w->def.solver.impact_threshold;
     int hit = dv > threshold && (dv > f->dv_taken || dv_new > threshold);
-    return hit && can_break(w, f) ? dv : 0;
+    return hit && cf_fragment_can_break(f, &w->solid, &w->def.solver) ? dv : 0;
 }
 
 /* One Bullet step.  Fragments hit harder than the impact threshold go to
@@ -168,7 +150,8 @@ static cf_status rigid_step(cf_world *w, double dt, cf_error *err)
         if (w->frag[fi].mode != CF_MODE_RIGID)
             continue;
         cf_step_ctx ctx = cf_world_step_ctx(w);
-        int hit = cf_pbd_impact(&ctx, &w->frag[fi], w->t, dt) && can_break(w, &w->frag[fi]);
+        int hit = cf_pbd_impact(&ctx, &w->frag[fi], w->t, dt) &&
+                  cf_fragment_can_break(&w->frag[fi], &w->solid, &w->def.solver);
         cf_profile_lap(&w->prof, CF_STAGE_RIGID_STEP);
         if (hit) {
             cf_status st = to_fracture(w, fi, NULL, err);
@@ -374,26 +357,6 @@ static cf_status check_energy(cf_world *w, cf_error *err)
 #define CF_CONTACT_SLOP 1e-9 /* m: a node projected onto an obstacle, up to round-off */
 #define CF_IMPACT_OVER 0.01  /* of the kinetic energy at entry: see impact_unfinished */
 
-/* The longest a landing of fragment f lasts, s: twice the contact time of
- * an elastic sphere of its mass and volume on a rigid floor at the impact
- * threshold's speed v (Hertz; Johnson, Contact Mechanics, 1985, §11.4):
- * 2.94 d / v, d = (15 m v^2 / (16 E* sqrt(R)))^(2/5) the deepest approach,
- * E* = E / (1 - nu^2).  Twice, as a corner's contact radius is smaller
- * than the sphere's and the time grows as R^(-1/5).  A slower landing is
- * no impact and lasts longer, but rigid mode would not call it one: a
- * contact that outlasts this is sustained (the fragment rolls, pivots or
- * rests), and rigid mode takes it (docs/physics.md §9). */
-static double landing_time(const cf_world *w, const cf_fragment *f)
-{
-    const cf_material *mt = &w->solid.mat;
-    double v = w->def.solver.impact_threshold;
-    if (!(v > 0))
-        return INFINITY;
-    double R = cbrt(3 * f->volume / (4 * acos(-1.0))), E = mt->E / (1 - mt->nu * mt->nu);
-    double d = pow(15 * f->mass * v * v / (16 * E * sqrt(R)), 0.4);
-    return 2 * 2.94 * d / v;
-}
-
 /* Whether fracture-mode fragment fi is still in the middle of an impact:
  * a node lies on an obstacle (or would reach it within a rigid step at the
  * fragment's rigid-body velocity), and either its rigid-body velocity there
@@ -408,8 +371,8 @@ static double landing_time(const cf_world *w, const cf_fragment *f)
  * wave that breaks a body never built up.  A body that rests on the ground
  * holds next to no strain energy, so it still goes back
  * (docs/physics.md §9).  A fixed obstacle holds it no longer than its
- * landing time (landing_time): a 52,859-tet piece of the 202,231-tet
- * plaster drop that landed pivoting on an edge was held more than 7 ms,
+ * landing time (cf_fragment_landing_time): a 52,859-tet piece of the
+ * 202,231-tet plaster drop that landed pivoting on an edge was held more than 7 ms,
  * 33,000 steps, by nodes of its rigid motion still driving into the floor.
  * A moving one holds it as long as it drives in: it loads the fragment,
  * and rigid mode would hand it back at once as a new impact. */
@@ -417,7 +380,9 @@ static int impact_unfinished(cf_world *w, int fi)
 {
     const cf_fragment *f = &w->frag[fi];
     const cf_solid *s = &w->solid;
-    int landed = w->t - f->t_enter >= landing_time(w, f); /* fixed obstacles no longer hold it */
+    /* fixed obstacles no longer hold it */
+    int landed = w->t - f->t_enter >=
+                 cf_fragment_landing_time(f, &w->solid.mat, w->def.solver.impact_threshold);
     double com[3], R[9], v[3], omega[3], P[3], L[3], r[3], wr[3], vr[3];
     double reach = w->def.solver.dt_rigid;
     cf_fragment_pose(&w->frag[fi], &w->solid, w->bullet, com, R, v, omega);
