@@ -8,6 +8,7 @@
 
 #include "cohfrac/scene.h"
 #include "cohfrac/sim.h"
+#include "check.h"
 #include "fixtures.h"
 #include "handoff.h"
 #include "linalg.h"
@@ -416,10 +417,12 @@ static void test_reentry_keeps_the_family_tree(void **state)
     static cf_fragment_state fs[CAP];
     for (int i = 0; i < CAP; i++)
         parent[i] = -2;
-    int reentered = 0;
+    static cf_landing land[CAP];
+    int reentered = 0, under_way = 0;
     while (!cf_sim_done(sim)) {
         advance(sim);
-        int n = cf_world_fragments(cf_sim_world(sim), fs, CAP);
+        cf_world *w = cf_sim_world(sim);
+        int n = cf_world_fragments(w, fs, CAP), landing = 0, own = 0;
         assert_true(n <= CAP);
         for (int i = 0; i < n; i++) {
             assert_true(fs[i].id < CAP);
@@ -427,7 +430,15 @@ static void test_reentry_keeps_the_family_tree(void **state)
             birth[fs[i].id] = fs[i].birth_time;
             if (fs[i].mode == 1 && fs[i].parent >= 0)
                 reentered = 1;
+            /* a piece struck on its own: a landing under way (the forecast) */
+            own += fs[i].mode == 1 && fs[i].parent >= 0 &&
+                   w->frag[fs[i].id].t_enter >= fs[i].birth_time;
         }
+        int m = cf_world_landings(w, 10.0, land, CAP);
+        for (int i = 0; i < m && i < CAP; i++)
+            landing += land[i].under_way;
+        assert_int_equal(landing, own);
+        under_way += landing;
     }
     int n = cf_world_fragments(cf_sim_world(sim), fs, CAP), tets = 0, grandchildren = 0;
     for (int i = 0; i < n; i++) {
@@ -445,8 +456,10 @@ static void test_reentry_keeps_the_family_tree(void **state)
         }
     }
     printf("FIGURE reentry: %d fragments alive, %d born of a fragment that was itself born "
-           "of a split\n", n, grandchildren);
+           "of a split; %d rigid steps' pieces in fracture mode on strikes of their own\n", n,
+           grandchildren, under_way);
     assert_true(reentered);
+    assert_true(under_way > 0);
     assert_true(grandchildren > 0);
     assert_int_equal(tets, cf_world_tet_count(cf_sim_world(sim)));
     cf_sim_destroy(sim);
@@ -990,6 +1003,77 @@ static void test_handback_in_flight_stays_rigid(void **state)
     cf_scene_free(&sc);
 }
 
+/* The landing forecast (cf_world_landings) on the same cube: dropped with
+ * its lowest face 0.9 m above the floor, it lands at t = sqrt(2 h / g) at
+ * sqrt(2 g h), the forecast of every rigid step of its fall within two
+ * rigid steps of that (Bullet's integration), none before a horizon short
+ * of it; none under way while it takes the impact (a body's break, not a
+ * piece's landing).  Back in rigid mode and rising, its next landing, past the
+ * impact threshold, is no stronger than the one it took whole, so the
+ * impact rule would not send it back: no landing to come. */
+static void test_landing_forecast_follows_the_fall(void **state)
+{
+    (void)state;
+    cf_scene sc;
+    cf_sim *sim = make_sim(cube_drop_scene, &sc);
+    cf_world *w = cf_sim_world(sim);
+    double h = 0.9, g = 9.81, t_land = sqrt(2 * h / g), v_land = sqrt(2 * g * h);
+    double dt = cf_world_dt_outer(w);
+    cf_landing l[2];
+    assert_int_equal(cf_world_landings(w, 0.3, l, 2), 0);
+    assert_int_equal(cf_world_landings(w, 1.0, l, 2), 1);
+    cf_frag_info info;
+    cf_world_fragment_info(w, 0, &info);
+    double m = info.mass, R = cbrt(3 * 0.008 / (4 * acos(-1.0)));
+    double E = w->solid.mat.E / (1 - w->solid.mat.nu * w->solid.mat.nu);
+    double v = w->def.solver.impact_threshold;
+    double hold = 2 * 2.94 * pow(15 * m * v * v / (16 * E * sqrt(R)), 0.4) / v;
+    double e = w->solid.mat.restitution * w->obs.o[0].restitution;
+    printf("FIGURE landing forecast at t = 0: %d tets land at t = %.6f s (closed form %.6f) "
+           "at %.4f m/s (%.4f), impact %.4f m/s ((1 + e) v, flat: %.4f), held at most %.4g s "
+           "(%.4g)\n", l[0].n_tets, l[0].time, t_land, l[0].speed, v_land, l[0].impact,
+           (1 + e) * v_land, l[0].hold, hold);
+    assert_int_equal(l[0].fragment, 0);
+    assert_int_equal(l[0].n_tets, w->solid.n_tets);
+    assert_near(l[0].time, t_land, 1e-9);
+    assert_near(l[0].speed, v_land, 1e-9);
+    assert_near(l[0].impact, (1 + e) * v_land, 1e-9); /* a face lands flat: no turn */
+    assert_near(l[0].hold, hold, 1e-12 * hold);
+    int was = 0, flights = 0;
+    double worst = 0, t_back = -1;
+    while (!cf_sim_done(sim)) {
+        advance(sim);
+        int now = any_in_fracture_mode(sim), n = cf_world_landings(w, 1.0, l, 2);
+        if (was && !now && t_back < 0)
+            t_back = cf_world_time(w);
+        if (!now && t_back < 0 && cf_world_time(w) < t_land - dt) { /* falling */
+            assert_int_equal(n, 1);
+            assert_int_equal(l[0].under_way, 0);
+            worst = fmax(worst, fabs(l[0].time - t_land));
+        }
+        if (now) /* the body's own impact: its cracks tell its length, not a landing */
+            assert_int_equal(n, 0);
+        /* clear of the floor and rising: its next landing is weaker */
+        if (t_back >= 0 && !now && cf_world_time(w) > t_back + dt) {
+            assert_int_equal(n, 0);
+            double taken = w->frag[0].dv_taken; /* one it had not taken would count */
+            w->frag[0].dv_taken = 0;
+            assert_int_equal(cf_world_landings(w, 1.0, l, 2), 1);
+            assert_true(l[0].impact > w->def.solver.impact_threshold && l[0].impact < taken);
+            w->frag[0].dv_taken = taken;
+            flights++;
+        }
+        was = now;
+    }
+    printf("FIGURE falling: forecast within %.2e s of the closed form (rigid step %.0e s); "
+           "%d rigid steps back in flight with no landing to come, dv_taken %.3f m/s\n",
+           worst, dt, flights, w->frag[0].dv_taken);
+    assert_true(worst <= 2 * dt);
+    assert_true(flights > 10);
+    cf_sim_destroy(sim);
+    cf_scene_free(&sc);
+}
+
 /* scenes/expanding_bar.lua (fracture mode only) at twice its length, the
  * same cells (1,920 tets, so that its pieces are enough work to step side
  * by side): pieces alive at the end and the state hash, for a strength
@@ -1104,6 +1188,7 @@ int main(void)
         cmocka_unit_test(test_crushed_tets_leave_as_powder),
         cmocka_unit_test(test_resting_body_stays_rigid),
         cmocka_unit_test(test_handback_in_flight_stays_rigid),
+        cmocka_unit_test(test_landing_forecast_follows_the_fall),
         cmocka_unit_test(test_mesh_obstacle_matches_plane),
         cmocka_unit_test(test_handoff_clears_obstacle_overlap),
         cmocka_unit_test(test_wedged_piece_enters_clear),

@@ -1,7 +1,8 @@
 /* The ETA's model (src/io/eta.h): the end of a spell whose cracks grow
  * exponentially fewer at a time against its closed form, as much again
  * where they do not decay, the quiet and held cases, the cap; the rest of
- * the run at the rate measured outside long spells; the history thinned. */
+ * the run at the rate measured outside long spells; the spells of the
+ * landings to come; the history thinned. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,6 +19,12 @@
 #define NINF 8e4 /* cohesive elements at the end */
 
 static const cf_eta_rule RULE = {.dt = 2e-7, .quiet_time = Q, .quiet_growth = G, .max_spell = 0.05};
+
+static double spell_left(const cf_eta *e, double held)
+{
+    int by_landing;
+    return cf_eta_spell_left(e, held, &by_landing);
+}
 
 /* A spell from t = 0 whose cracks grow as NINF (1 - exp(-t/TAU)), sampled
  * every 10 us of simulated time (one second of wall each) up to `until`. */
@@ -45,7 +52,7 @@ static void test_spell_end_of_an_exponential_decay(void **state)
     cf_eta e;
     for (double s = 6e-4; s < end - Q; s += 2e-4) {
         exponential_spell(&e, s);
-        double left = cf_eta_spell_left(&e), expected = sqrt(fmin(end - s, s) * s);
+        double left = spell_left(&e, -INFINITY), expected = sqrt(fmin(end - s, s) * s);
         assert_near(left / expected, 1.0, 2e-3); /* the samples interpolated */
     }
 }
@@ -61,7 +68,7 @@ static void test_spell_without_decay_runs_as_much_again(void **state)
         cf_eta_sample s = {.wall = 1e5 * t, .t = t, .cracks = 1e7 * t, .spell = t};
         cf_eta_add(&e, &s);
     }
-    assert_near(cf_eta_spell_left(&e), 1e-3, 1e-12);
+    assert_near(spell_left(&e, -INFINITY), 1e-3, 1e-12);
 }
 
 /* Cracks that grew at a steady rate and then stopped.  Quiet for less
@@ -83,13 +90,13 @@ static void test_quiet_held_and_capped_spells(void **state)
     (void)state;
     cf_eta e;
     grow_then_stop(&e, &RULE, 0.24e-3, 0.32e-3);
-    assert_near(cf_eta_spell_left(&e), Q, 1e-15);
+    assert_near(spell_left(&e, -INFINITY), Q, 1e-15);
     grow_then_stop(&e, &RULE, 1e-3, 2e-3);
-    assert_near(cf_eta_spell_left(&e), 1e-3, 5e-5); /* to the samples kept */
+    assert_near(spell_left(&e, -INFINITY), 1e-3, 5e-5); /* to the samples kept */
     cf_eta_rule capped = RULE;
     capped.max_spell = 2.5e-3;
     grow_then_stop(&e, &capped, 1e-3, 2e-3);
-    assert_near(cf_eta_spell_left(&e), 5e-4, 1e-12);
+    assert_near(spell_left(&e, -INFINITY), 5e-4, 1e-12);
 }
 
 /* Rigid steps at 2 s of wall per simulated second; a long spell (1 ms,
@@ -127,7 +134,74 @@ static void test_rest_counts_short_spells_not_long_ones(void **state)
     double rest_wall = 0.02 + 1.0 + 2e-3, rest_t = 0.01 + 2e-4 + 1e-3;
     assert_near(e.rest_wall, rest_wall, 1e-12);
     assert_near(e.rest_t, rest_t, 1e-12);
-    assert_near(cf_eta_left(&e, 0.1, 0, 3.0), 0.1 * rest_wall / rest_t + 3.0, 1e-9);
+    assert_near(cf_eta_left(&e, 0.1, 0, NULL, 0, 3.0), 0.1 * rest_wall / rest_t + 3.0, 1e-9);
+}
+
+/* A run that broke (1e8 tet-steps in 20 s of fracture wall, 0.2 us each)
+ * and now flies (rigid steps at 2 s per simulated second).  Each landing
+ * to come adds its spell, its landing time at the cost per tet-step: a
+ * 30,000-tet piece held 1.7 ms (17 quiet times) costs 30,000 x 1.7 ms /
+ * dt x 0.2 us = 51 s.  A short one (2 quiet times: the rest's rate holds
+ * those) and one after the end add nothing; one near the end counts up
+ * to the end.  Once the piece has landed, its landing time holds the
+ * spell now running. */
+static void test_landings_add_their_spells(void **state)
+{
+    (void)state;
+    cf_eta e;
+    cf_eta_init(&e, &RULE);
+    cf_eta_sample a = {.wall = 0, .t = 0}, b = {.wall = 20, .t = 2e-3, .fracture_wall = 20,
+                                              .tet_steps = 1e8, .spell = 2e-3};
+    cf_eta_add(&e, &a);
+    cf_eta_add(&e, &b);
+    for (int i = 1; i <= 60; i++) { /* the flight, 60 quiet times of rigid steps */
+        cf_eta_sample s = {.wall = 20 + 2 * i * Q, .t = 2e-3 + i * Q, .fracture_wall = 20,
+                           .tet_steps = 1e8};
+        cf_eta_add(&e, &s);
+    }
+    double per = 20 / 1e8, t_left = 0.1, base = cf_eta_left(&e, t_left, 0, NULL, 0, 0);
+    assert_near(base, t_left * 2, 1e-9);
+    cf_eta_landing l[4] = {{.t = 0.05, .tets = 3e4, .hold = 17 * Q},
+                           {.t = 0.01, .tets = 3e4, .hold = 2 * Q},
+                           {.t = 0.2, .tets = 3e4, .hold = 17 * Q},
+                           {.t = t_left - 5 * Q, .tets = 1e3, .hold = 10 * Q}};
+    assert_near(cf_eta_landing_spell(&e, &l[0], t_left), 17 * Q, 1e-15);
+    assert_near(cf_eta_landing_spell(&e, &l[1], t_left), 0, 0);
+    assert_near(cf_eta_landing_spell(&e, &l[2], t_left), 0, 0);
+    assert_near(cf_eta_landing_spell(&e, &l[3], t_left), 5 * Q, 1e-15);
+    double spells = 3e4 * 17 * Q / RULE.dt * per + 1e3 * 5 * Q / RULE.dt * per;
+    assert_near(cf_eta_left(&e, t_left, 0, l, 4, 0), base + spells, 1e-9);
+    assert_near(3e4 * 17 * Q / RULE.dt * per, 51, 1e-9);
+
+    /* The first piece lands: 2 quiet times into its spell, no crack, the
+     * growth says as much again; its landing time says 15 more. */
+    double wall = 20 + 120 * Q, t = 2e-3 + 60 * Q, steps = 1e8, fw = 20;
+    for (int i = 1; i <= 2; i++) {
+        double d = 3e4 * Q / RULE.dt; /* its tet-steps over a quiet time */
+        wall += d * per, fw += d * per, steps += d, t += Q;
+        cf_eta_sample s = {.wall = wall, .t = t, .fracture_wall = fw, .tet_steps = steps,
+                           .spell = i * Q};
+        cf_eta_add(&e, &s);
+    }
+    assert_near(spell_left(&e, -INFINITY), 2 * Q, 1e-15);
+    cf_eta_landing held = {.under_way = 1, .t = -2 * Q, .tets = 3e4, .hold = 17 * Q};
+    assert_near(cf_eta_landing_spell(&e, &held, t_left), 0, 0); /* the spell's own */
+    double rest = e.rest_wall / e.rest_t, fracture = 3e4 / RULE.dt * per; /* s per s */
+    double without = cf_eta_left(&e, t_left, 3e4, NULL, 0, 0);
+    assert_near(cf_eta_left(&e, t_left, 3e4, &held, 1, 0) - without, 13 * Q * (fracture - rest),
+                1e-9);
+    /* Quiet for 6 quiet times: as long again, or what the landing holds
+     * (11 more), or, its landing time over, a quiet time. */
+    for (int i = 3; i <= 6; i++) {
+        double d = 3e4 * Q / RULE.dt;
+        wall += d * per, fw += d * per, steps += d, t += Q;
+        cf_eta_sample s = {.wall = wall, .t = t, .fracture_wall = fw, .tet_steps = steps,
+                           .spell = i * Q};
+        cf_eta_add(&e, &s);
+    }
+    assert_near(spell_left(&e, -INFINITY), 6 * Q, 1e-15);
+    assert_near(spell_left(&e, 11 * Q), 11 * Q, 1e-15);
+    assert_near(spell_left(&e, -Q), Q, 1e-15);
 }
 
 /* A long run's history is thinned, never lost: the first sample stays,
@@ -155,6 +229,7 @@ int main(void)
         cmocka_unit_test(test_spell_without_decay_runs_as_much_again),
         cmocka_unit_test(test_quiet_held_and_capped_spells),
         cmocka_unit_test(test_rest_counts_short_spells_not_long_ones),
+        cmocka_unit_test(test_landings_add_their_spells),
         cmocka_unit_test(test_history_is_thinned),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -239,6 +239,41 @@ int cf_world_fracture_tets(const cf_world *w, int *tets, double *stress, double 
  * fragment. */
 double cf_world_fragment_support(cf_world *w, int id, const double d[3]);
 
+/* A landing to come, a rigid fragment in flight whose ballistic path
+ * meets an obstacle hard enough to send it to fracture mode, or one under
+ * way, a piece in fracture mode since an impact of its own. */
+typedef struct cf_landing {
+    int fragment;            /* id */
+    int n_tets;
+    int under_way;           /* 1: in fracture mode now, 0: to come */
+    double time;             /* s: the simulated time it lands at; under way, when
+                                its spell began */
+    double speed;            /* m/s: its approach along the obstacle's normal then
+                                (0 under way) */
+    double impact;           /* m/s: the contact impulse over its mass that the
+                                impact rule will see, (1 + e) speed m_eff / m, m_eff
+                                the mass its point of contact brings, e the pair's
+                                restitution; under way, the one that began the spell */
+    double hold;             /* s: its landing time, the longest a fixed obstacle
+                                holds it in fracture mode (docs/physics.md §9) */
+} cf_landing;
+
+/* The landings under way, the pieces (not initial bodies) in fracture
+ * mode since an impact of their own (not their parent's spell: a break's
+ * length is its cracks' growth), and those to come before simulated time
+ * `until` (s), the forecast of the impact rule (docs/physics.md §9): each
+ * rigid fragment with a Bullet body that can still break and touches
+ * nothing (no contact in Bullet's last step, and clear of every obstacle
+ * by a thousandth of its size), its centre of mass on its ballistic path
+ * under gravity, its shape at its pose now (its spin is not followed),
+ * against the obstacles; those whose impact passes the impact threshold
+ * and the strongest impact the fragment has taken (a contact it took
+ * whole does not send it back).  Other fragments and bodies are not
+ * looked for.  Writes up to `cap` to out (may be NULL with cap 0) and
+ * returns how many there are; with the pbd rigid backend, those under way
+ * only; none in a fracture-only run.  Reads the world only. */
+int cf_world_landings(cf_world *w, double until, cf_landing *out, int cap);
+
 /* FNV-1a hash of the state's bits: every node's position and velocity,
  * each tet's fragment, each fragment's mode and its Bullet body's state.
  * Two runs of one scene give the same hash at the same step, for any thread

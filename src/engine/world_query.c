@@ -81,20 +81,167 @@ int cf_world_fragments(cf_world *w, cf_fragment_state *out, int cap)
     return n;
 }
 
-double cf_world_fragment_support(cf_world *w, int id, const double d[3])
+/* The largest (R (X - X_cm)).d over fragment f's nodes, m; *arm (may be
+ * NULL) gets R (X - X_cm) at the centre of the nodes within a thousandth
+ * of f's size of it (a face or an edge that lands flat meets the
+ * obstacle there, not at one of its corners). */
+static double support(const cf_world *w, const cf_fragment *f, const double R[9],
+                      const double d[3], double arm[3])
 {
-    if (id < 0 || id >= w->n_frag || w->frag[id].mode == CF_MODE_DEAD)
-        return 0;
-    const cf_fragment *f = &w->frag[id];
-    double com[3], R[9], v[3], omega[3], Rd[3], best = -INFINITY;
-    cf_fragment_pose_peek(f, &w->solid, w->bullet, com, R, v, omega);
+    double Rd[3], best = -INFINITY;
     m3_tmulv(R, d, Rd); /* (R r).d = r.(R^T d), r from the rest centre of mass */
     for (int i = 0; i < f->nodes.n; i++) {
         double r[3];
         v3_sub(&w->solid.X[3 * f->nodes.v[i]], f->com_rest, r);
         best = fmax(best, v3_dot(r, Rd));
     }
-    return f->nodes.n ? best : 0;
+    if (!f->nodes.n)
+        return 0;
+    if (arm) {
+        double sum[3] = {0, 0, 0}, near = 1e-3 * cbrt(f->volume);
+        int k = 0;
+        for (int i = 0; i < f->nodes.n; i++) {
+            double r[3];
+            v3_sub(&w->solid.X[3 * f->nodes.v[i]], f->com_rest, r);
+            if (v3_dot(r, Rd) >= best - near)
+                v3_axpy(1.0, r, sum), k++;
+        }
+        for (int c = 0; c < 3; c++)
+            sum[c] /= k;
+        m3_mulv(R, sum, arm);
+    }
+    return best;
+}
+
+double cf_world_fragment_support(cf_world *w, int id, const double d[3])
+{
+    if (id < 0 || id >= w->n_frag || w->frag[id].mode == CF_MODE_DEAD)
+        return 0;
+    const cf_fragment *f = &w->frag[id];
+    double com[3], R[9], v[3], omega[3];
+    cf_fragment_pose_peek(f, &w->solid, w->bullet, com, R, v, omega);
+    return support(w, f, R, d, NULL);
+}
+
+#define CF_LANDING_ITERATIONS 200
+#define CF_LANDING_GAP 1e-3 /* of the fragment's equal-volume radius: arrived */
+
+/* Where fragment f (rotation R, centre of mass c moving at v now) first
+ * meets an obstacle on its ballistic path within `horizon` s: conservative
+ * advancement, each advance the time in which the centre of mass, at its
+ * speed and gravity's, cannot close the gap to the nearest obstacle (its
+ * signed distance less f's extent toward it), with the obstacles' own
+ * speed.  A contact it leaves (moving away) is stepped over.  Returns the
+ * time from now (s), the approach speed there (*speed, m/s), the
+ * obstacle (*hit), its normal n_hit and f's point of contact from its centre
+ * of mass (arm, m); or -1 when it meets none in time or touches one now. */
+static double first_contact(const cf_world *w, const cf_fragment *f, const double R[9],
+                            const double c[3], const double v[3], double horizon,
+                            double *speed, int *hit, double n_hit[3], double arm[3])
+{
+    const double *g = w->def.gravity;
+    double gn = sqrt(v3_dot(g, g)), umax = 0;
+    for (int j = 0; j < w->obs.n; j++) {
+        double u[3];
+        cf_obstacle_velocity(&w->obs.o[j], u);
+        umax = fmax(umax, sqrt(v3_dot(u, u)));
+    }
+    double tol = fmax(1e-9, CF_LANDING_GAP * cbrt(3 * f->volume / (4 * acos(-1.0))));
+    double tau = 0;
+    for (int it = 0; it < CF_LANDING_ITERATIONS && tau <= horizon; it++) {
+        double p[3], vel[3], gap = INFINITY, approach = 0;
+        for (int k = 0; k < 3; k++) {
+            p[k] = c[k] + tau * (v[k] + 0.5 * tau * g[k]);
+            vel[k] = v[k] + tau * g[k];
+        }
+        for (int j = 0; j < w->obs.n; j++) {
+            double n[3], u[3], vr[3], r[3] = {0, 0, 0};
+            double d = cf_obstacle_distance(&w->obs, j, w->t + tau, p, n);
+            double m[3] = {-n[0], -n[1], -n[2]}; /* toward the obstacle */
+            d -= support(w, f, R, m, r);
+            if (d < gap) {
+                cf_obstacle_velocity(&w->obs.o[j], u);
+                v3_sub(vel, u, vr);
+                gap = d, approach = -v3_dot(vr, n), *hit = j;
+                memcpy(n_hit, n, sizeof n);
+                memcpy(arm, r, sizeof r);
+            }
+        }
+        double s = sqrt(v3_dot(vel, vel)) + umax;
+        if (it == 0 && gap <= tol)
+            return -1; /* touching now (a body just handed back has no contact yet) */
+        if (gap <= tol && approach > 0) {
+            *speed = approach;
+            return tau;
+        }
+        /* the time in which s t + g t^2 / 2 reaches the gap; a contact it
+           leaves, one tolerance's travel on */
+        double need = fmax(gap, tol);
+        tau += gn > 0 ? 2 * need / (s + sqrt(s * s + 2 * gn * need)) : need / fmax(s, 1e-12);
+    }
+    return -1;
+}
+
+/* The impact the rule will see of fragment f (rotation R) striking along
+ * normal n at `speed` at its point `arm` from its centre of mass, m/s:
+ * the contact impulse over its mass, (1 + e) speed m_eff / m, with m_eff
+ * = 1 / (1/m + (r x n).I^-1 (r x n)) the mass the contact point brings
+ * (a corner strike turns the body and moves its centre less) and e the
+ * pair's restitution. */
+static double impact_of(const cf_world *w, const cf_fragment *f, const double R[9], int j,
+                        const double n[3], const double arm[3], double speed)
+{
+    double rn[3], RQ[9], a[3], turn = 0;
+    v3_cross(arm, n, rn);
+    m3_mul(R, f->Q, RQ); /* principal axes in the world */
+    m3_tmulv(RQ, rn, a);
+    for (int k = 0; k < 3; k++)
+        turn += f->principal[k] > 0 ? a[k] * a[k] / f->principal[k] : 0;
+    double e = w->solid.mat.restitution * w->obs.o[j].restitution;
+    return (1 + e) * speed / (1 + f->mass * turn);
+}
+
+int cf_world_landings(cf_world *w, double until, cf_landing *out, int cap)
+{
+    const cf_solver_settings *set = &w->def.solver;
+    int n = 0;
+    if (set->mode == CF_RUN_FRACTURE)
+        return 0; /* no impact began it, and none will come */
+    for (int fi = 0; fi < w->n_frag; fi++) {
+        const cf_fragment *f = &w->frag[fi];
+        if (f->mode == CF_MODE_FRACTURE) {
+            /* under way: a piece's own landing, not a body's break nor a
+               piece's share of its parent's spell, whose length the
+               cracks' growth tells */
+            if (f->parent < 0 || f->t_enter < f->birth_time)
+                continue;
+            if (n < cap)
+                out[n] = (cf_landing){.fragment = fi, .n_tets = f->nt, .under_way = 1,
+                                      .time = f->t_enter, .impact = f->dv_enter,
+                                      .hold = cf_fragment_landing_time(
+                                          f, &w->solid.mat, set->impact_threshold)};
+            n++;
+            continue;
+        }
+        if (!w->bullet || f->mode != CF_MODE_RIGID || f->body < 0 ||
+            cfb_contact_impulse(w->bullet, f->body) > 0 ||
+            !cf_fragment_can_break(f, &w->solid, set))
+            continue;
+        double com[3], R[9], v[3], omega[3], n_hit[3] = {0, 0, 0}, arm[3] = {0, 0, 0}, speed = 0;
+        int j = -1;
+        cf_fragment_pose_peek(f, &w->solid, w->bullet, com, R, v, omega);
+        double tau = first_contact(w, f, R, com, v, until - w->t, &speed, &j, n_hit, arm);
+        double dv = tau < 0 ? 0 : impact_of(w, f, R, j, n_hit, arm, speed);
+        if (dv <= set->impact_threshold || dv <= f->dv_taken)
+            continue;
+        if (n < cap)
+            out[n] = (cf_landing){.fragment = fi, .n_tets = f->nt, .time = w->t + tau,
+                                  .speed = speed, .impact = dv,
+                                  .hold = cf_fragment_landing_time(f, &w->solid.mat,
+                                                                   set->impact_threshold)};
+        n++;
+    }
+    return n;
 }
 
 int cf_world_tet_count(const cf_world *w) { return w->solid.n_tets; }

@@ -553,19 +553,34 @@ static void eta_sample(cf_sim *sim)
     cf_eta_add(&sim->eta, &s);
 }
 
-/* Remaining wall time of the run, s (eta.h): the spell now running, the
- * rest of the simulated time, and the frames left at the wall per frame
- * so far (the rest mesh and the fragments' surfaces are written once, at
- * the start and as fragments are born: over the first millisecond of a
- * drop they read as 50 s per simulated second). */
+/* Remaining wall time of the run, s (eta.h): the spell now running (held
+ * by the landings under way), the landings to come, the rest of the
+ * simulated time, and the frames left at the wall per frame so far (the
+ * rest mesh and the fragments' surfaces are written once, at the start
+ * and as fragments are born: over the first millisecond of a drop they
+ * read as 50 s per simulated second). */
 static double eta(const cf_sim *sim)
 {
-    double left = fmax(0.0, sim->duration - time_reached(sim));
+    cf_world *w = sim->world;
+    double now = time_reached(sim), left = fmax(0.0, sim->duration - now);
     double per_frame = sim->frames_written > 0 ? sim->frame_time / sim->frames_written : 0;
     double frames_left = sim->output.frame_interval > 0 ? ceil(left / sim->output.frame_interval) : 0;
     cf_step_stats st;
-    cf_world_step_stats(sim->world, &st);
-    return cf_eta_left(&sim->eta, left, st.tets, frames_left * per_frame);
+    cf_world_step_stats(w, &st);
+    /* The landings under way and to come; without the memory for them,
+       none (the ETA is a forecast, not part of the run). */
+    int cap = cf_world_fragments_ever(w), n = 0;
+    cf_landing *l = malloc((size_t)cap * sizeof *l);
+    cf_eta_landing *el = malloc((size_t)cap * sizeof *el);
+    if (l && el) {
+        n = cf_world_landings(w, sim->duration, l, cap);
+        for (int i = 0; i < n; i++)
+            el[i] = (cf_eta_landing){.under_way = l[i].under_way, .t = l[i].time - now,
+                                     .tets = l[i].n_tets, .hold = l[i].hold};
+    }
+    double eta = cf_eta_left(&sim->eta, left, st.tets, el, n, frames_left * per_frame);
+    free(l), free(el);
+    return eta;
 }
 
 /* Progress: simulated time, mode, fragments and an ETA (eta). */
