@@ -269,7 +269,8 @@ typedef struct cf_landing {
  * against the obstacles; those whose impact passes the impact threshold
  * and the strongest impact the fragment has taken (a contact it took
  * whole does not send it back).  Other fragments and bodies are not
- * looked for.  Writes up to `cap` to out (may be NULL with cap 0) and
+ * looked for, nor a mesh obstacle farther than its contact query reaches
+ * (5 % of its size).  Writes up to `cap` to out (may be NULL with cap 0) and
  * returns how many there are; with the pbd rigid backend, those under way
  * only; none in a fracture-only run.  Reads the world only. */
 int cf_world_landings(cf_world *w, double until, cf_landing *out, int cap);
