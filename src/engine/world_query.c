@@ -168,6 +168,8 @@ static double first_contact(const cf_world *w, const cf_fragment *f, const doubl
             }
         }
         double s = sqrt(v3_dot(vel, vel)) + umax;
+        if (!isfinite(gap))
+            return -1; /* no obstacle within reach (a far mesh obstacle's query) */
         if (it == 0 && gap <= tol)
             return -1; /* touching now (a body just handed back has no contact yet) */
         if (gap <= tol && approach > 0) {
