@@ -155,16 +155,15 @@ static double first_contact(const cf_world *w, const cf_fragment *f, const doubl
             vel[k] = v[k] + tau * g[k];
         }
         for (int j = 0; j < w->obs.n; j++) {
-            double n[3], u[3], vr[3], r[3] = {0, 0, 0};
+            double n[3], u[3], vr[3];
             double d = cf_obstacle_distance(&w->obs, j, w->t + tau, p, n);
             double m[3] = {-n[0], -n[1], -n[2]}; /* toward the obstacle */
-            d -= support(w, f, R, m, r);
+            d -= support(w, f, R, m, NULL);
             if (d < gap) {
                 cf_obstacle_velocity(&w->obs.o[j], u);
                 v3_sub(vel, u, vr);
                 gap = d, approach = -v3_dot(vr, n), *hit = j;
                 memcpy(n_hit, n, sizeof n);
-                memcpy(arm, r, sizeof r);
             }
         }
         double s = sqrt(v3_dot(vel, vel)) + umax;
@@ -172,7 +171,9 @@ static double first_contact(const cf_world *w, const cf_fragment *f, const doubl
             return -1; /* no obstacle within reach (a far mesh obstacle's query) */
         if (it == 0 && gap <= tol)
             return -1; /* touching now (a body just handed back has no contact yet) */
-        if (gap <= tol && approach > 0) {
+        if (gap <= tol && approach > 0) { /* arrived: where it strikes */
+            double m[3] = {-n_hit[0], -n_hit[1], -n_hit[2]};
+            support(w, f, R, m, arm);
             *speed = approach;
             return tau;
         }
