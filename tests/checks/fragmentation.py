@@ -41,7 +41,7 @@ its range is log10(largest fitted mass / m_min) decades.
 Writes DIR/fragmentation.json (every run's figures), DIR/fragmentation.md
 (the tables) and DIR/fragmentation.png (the cumulative mass distributions
 on log-log axes beside the slopes of tau = 1.45 and 1.85); runs are cached
-in DIR/runs/ (rerun when the program is newer; a variant made with --set,
+in DIR/runs/ (rerun when the program or the scene is newer; a variant made with --set,
 passed to every run as `cohfrac run --set`, is cached under its own name).  Checks named in the
 --known file (one "name reason..." per line; "name@ci" or "name@full" for
 one size only) are known not to hold yet: they must fail, and the exit
@@ -83,7 +83,8 @@ def run(exe, out_dir, extra, diameter, speed, h, seed=1):
     h5 = os.path.join(out_dir, "runs", tag + ".h5")
     R = diameter / 2
     done = h5 + ".done"  # written after a run that finished
-    if not os.path.exists(done) or os.path.getmtime(done) < os.path.getmtime(exe):
+    newest = max(os.path.getmtime(exe), os.path.getmtime(SCENE))  # the program or the scene
+    if not os.path.exists(done) or os.path.getmtime(done) < newest:
         sets = [f"bodies[1].mesh.radius={R!r}", f"bodies[1].mesh.mesh_size={h!r}",
                 f"bodies[1].position={{0,0,{R + 0.0005!r}}}",
                 f"bodies[1].velocity={{0,0,{-speed!r}}}", f"material.strength.seed={seed}"]
