@@ -1174,6 +1174,101 @@ static void test_values_exact_from_the_floor_take_the_same_facets(void **state)
     assert_true(taken >= 1 && skipped >= 1);
 }
 
+/* Three checks of growing cracks on the box of `weibull` (0: box_with_crack
+ * under sy = 0.6 of the threshold, uniform strength; 1: the deformed
+ * Weibull box with a crack at `strength`) with K_IC = K: with the floors
+ * of the cracks there are (`floors`, hot flags from the tet bound and its
+ * s1_tet), or with every tet hot and each vertex's lowest front floor
+ * wherever it lies.  The facets taken go to picks[round]; returns the
+ * checks with fewer tets hot than all.  Each tet's count of the cracked
+ * facets on its edges must equal a count of the facets. */
+static int checks_with_floors(int weibull, double strength, double K, int floors,
+                              cf_int_list picks[3])
+{
+    cf_mesh m;
+    cf_solid s;
+    int *all = weibull ? weibull_box_with_crack(&s, &m, strength)
+                       : box_with_crack(&m, &s, 0.6 * 0.9 * strength);
+    s.mat.G_I = K * K / s.mat.E;
+    assert_int_equal(cf_solid_init_front_toughness(&s, NULL), CF_OK);
+    if (floors)
+        cf_insertion_init_front_floors(&s);
+    int cooler = 0;
+    for (int round = 0; round < 3; round++) {
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1};
+        cf_stress_check bound = cf_insertion_bound(&s, CF_CRITERION_SOURCE);
+        int n_hot = s.n_tets;
+        if (floors && weibull) /* the kernel's flags */
+            cf_tet4_forces(&s, all, s.n_tets, CF_ELASTICITY_COROTATIONAL, &bound, 0, &n_hot);
+        else if (floors) /* the same test on the box's given stress */
+            for (int t = n_hot = 0; t < s.n_tets; t++)
+                n_hot += s.hot[t] = cf_tet4_max_principal_bound(&s.sigma[9 * t]) >=
+                                    fmax(bound.s1, bound.s1_tet[t]);
+        else
+            memset(s.hot, 1, (size_t)s.n_tets);
+        cooler += n_hot < s.n_tets;
+        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, n_hot, &g,
+                                        &picks[round]);
+        picks[round].n = n > 0 ? cf_insertion_select(&s, &picks[round], CF_CRITERION_SOURCE, &g) : n;
+    }
+    if (floors) { /* near a crack: sharing a tet with a vertex a facet ever cracked on */
+        unsigned char *near = calloc((size_t)s.n_verts0, 1);
+        for (int t = 0; t < s.n_tets; t++)
+            for (int i = 0; i < 4; i++)
+                for (int j = 0; j < 4; j++)
+                    near[s.tet0[4 * t + i]] |= s.vert_cracks[s.tet0[4 * t + j]] > 0;
+        for (int o = 0; o < s.n_verts0; o++)
+            assert_int_equal(s.vert_front_near[o], near[o]);
+        for (int t = 0; t < s.n_tets; t++) {
+            const int *T = &s.tet0[4 * t];
+            assert_true((s.tet_floor[t] == 0) == (near[T[0]] || near[T[1]] || near[T[2]] || near[T[3]]));
+        }
+        free(near);
+    }
+    static const int edge[4][4] = {{0, 0, 1, 2}, {0, 0, 3, 4}, {1, 3, 0, 5}, {2, 4, 5, 0}};
+    for (int t = 0; t < s.n_tets; t++)
+        for (int i = 0; i < 4; i++)
+            for (int j = i + 1; j < 4; j++)
+                assert_int_equal(s.edge_cracks[6 * t + edge[i][j]],
+                                 cracked_on_edge(&s, s.tet0[4 * t + i], s.tet0[4 * t + j]));
+    free(all);
+    cf_solid_free(&s), cf_mesh_free(&m);
+    return cooler;
+}
+
+/* With a front threshold from the toughness, a vertex that no cracked edge
+ * faces keeps its strength's floor and a tet away from the cracks its own
+ * hot bound (cf_insertion_init_front_floors): three checks of growing
+ * cracks take the same facets as with every tet hot and each vertex's
+ * lowest front floor wherever it lies, while fewer tets are hot.  On the
+ * box under uniform tension below every strength only fronts grow (K_IC
+ * as in test_front_threshold_from_the_toughness); on the deformed Weibull
+ * box, with K_IC such that a tip's field a cell ahead is half the
+ * threshold, fronts and nuclei. */
+static void test_toughness_floors_take_the_same_facets(void **state)
+{
+    (void)state;
+    int taken[2] = {0, 0}, cooler = 0;
+    for (int level = 0; level < 5; level++) {
+        int weibull = level > 0;
+        double strength = weibull ? 0.2 * (1 << (level - 1)) * 0.02 * mat.E : 1.0;
+        double K = weibull ? 0.45 * strength * sqrt(2 * acos(-1.0) * 0.25) : 0.4;
+        cf_int_list picks[2][3] = {{{0}}};
+        for (int floors = 0; floors < 2; floors++)
+            cooler += checks_with_floors(weibull, strength, K, floors, picks[floors]);
+        for (int round = 0; round < 3; round++) {
+            assert_int_equal(picks[0][round].n, picks[1][round].n);
+            for (int i = 0; i < picks[0][round].n; i++)
+                assert_int_equal(picks[0][round].v[i], picks[1][round].v[i]);
+            taken[weibull] += picks[0][round].n;
+            free(picks[0][round].v), free(picks[1][round].v);
+        }
+    }
+    printf("FIGURE toughness floors: %d facets taken alike under tension, %d on the Weibull "
+           "box, %d checks with fewer tets hot\n", taken[0], taken[1], cooler);
+    assert_true(taken[0] >= 3 && taken[1] >= 3 && cooler >= 3);
+}
+
 /* The size-free strength factor of facet f of area A_f on the box of
  * `cells` per edge (seed `seed`, reference area A0, modulus m), its rest
  * centroid and (A_f / A0) w_f^m (for a facet larger than A0).  Returns the
@@ -1297,6 +1392,7 @@ int main(void)
         cmocka_unit_test(test_values_exact_from_the_floor_take_the_same_facets),
         cmocka_unit_test(test_front_rank_reads_this_check_only),
         cmocka_unit_test(test_front_threshold_from_the_toughness),
+        cmocka_unit_test(test_toughness_floors_take_the_same_facets),
         cmocka_unit_test(test_contact_memo_changes_nothing),
         cmocka_unit_test(test_strength_is_a_field_of_the_material),
     };

@@ -512,7 +512,7 @@ static void test_lanes_equal_one_tet_at_a_time(void **state)
             memcpy(&s.rq[4 * t], qt, sizeof qt);
             memcpy(&q0[4 * t], qt, sizeof qt);
         }
-        cf_stress_check check = {INFINITY, INFINITY};
+        cf_stress_check check = {INFINITY, INFINITY, NULL};
         cf_tet4_forces(&s, list, nt, el, &check, 0, NULL);
         for (int i = 0; i < nt; i++) {
             int t = list[i];

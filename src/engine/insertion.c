@@ -155,17 +155,25 @@ static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
  * than CF_NODES_PARALLEL_MIN's loops. */
 enum { STAR_PARALLEL_MIN = 256 };
 
+/* The threshold of the source's rule of the weakest interior facet on
+ * original vertex o, Pa (INFINITY where none). */
+static double strength_floor(const cf_solid *s, int o)
+{
+    return source_threshold(s->mat.sigma_max, s->vert_wmin ? s->vert_wmin[o] : s->strength_min);
+}
+
 /* The lowest threshold of the source's rule among the facets on node n's
- * original vertex, Pa: `lowest`, the weakest facet's of the solid, where
- * the strength is uniform; with a front threshold from the toughness, no
- * more than the vertex's lowest as the vertex ahead of a front.  A nodal
- * value below it passes no facet there (source_threshold grows with the
- * strength, rounding included). */
-static double vertex_floor(const cf_solid *s, int n, double lowest)
+ * original vertex, Pa: its weakest facet's (strength_floor); with a front
+ * threshold from the toughness, no more than the lowest of the fronts it
+ * now has ahead (s->vert_front_active: a front needs a cracked edge, so a
+ * vertex that none faces passes only at its strength).  A nodal value below
+ * it passes no facet there (source_threshold grows with the strength,
+ * rounding included). */
+static double vertex_floor(const cf_solid *s, int n)
 {
     int o = s->origin[n];
-    double floor = s->vert_wmin ? source_threshold(s->mat.sigma_max, s->vert_wmin[o]) : lowest;
-    return s->vert_front_floor ? fmin(floor, s->vert_front_floor[o]) : floor;
+    double floor = strength_floor(s, o);
+    return s->vert_front_active ? fmin(floor, s->vert_front_active[o]) : floor;
 }
 
 /* The source's nodal values at the marked nodes (each node writes its
@@ -194,7 +202,7 @@ static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowe
         for (int i = 0; i < marked->n; i++) {
             int n = marked->v[i], o = s->origin[n];
             if (__atomic_exchange_n(&s->vert_check[o], stamp, __ATOMIC_RELAXED) != stamp) {
-                double from = floor_exact ? vertex_floor(s, n, lowest) : lowest;
+                double from = floor_exact ? vertex_floor(s, n) : lowest;
                 s->vert_node[o] = n;
                 s->nodal[n] = nodal_principal(s, n, frag, from);
             }
@@ -210,12 +218,19 @@ static void nodal_values(cf_solid *s, cf_int_list *marked, int frag, double lowe
     int kept = 0;
     for (int i = 0; i < marked->n; i++) {
         int n = marked->v[i];
-        if (s->nodal[n] < vertex_floor(s, n, lowest)) /* a NaN stays, as source_rule lets it pass */
+        if (s->nodal[n] < vertex_floor(s, n)) /* a NaN stays, as source_rule lets it pass */
             s->node_mark[n] = 0;
         else
             marked->v[kept++] = n;
     }
     marked->n = kept;
+}
+
+/* The original vertices of face k of tet t. */
+static void face_vertices(const cf_solid *s, int t, int k, int o[3])
+{
+    for (int j = 0; j < 3; j++)
+        o[j] = s->tet0[4 * t + CF_TET_FACE[k][j]];
 }
 
 /* Slot of original vertex o in tet t, or -1. */
@@ -227,23 +242,26 @@ static int slot_of(const cf_solid *s, int t, int o)
     return -1;
 }
 
-/* Whether a cracked facet other than f holds the edge of original
- * vertices a and b: a face with both of them, of a tet in a's star. */
-static int edge_cracked(const cf_solid *s, int f, int a, int b)
+/* The edge of corners i and j of a tet, as s->edge_cracks numbers it. */
+static const unsigned char CF_TET_EDGE[4][4] = {{0, 0, 1, 2}, {0, 0, 3, 4}, {1, 3, 0, 5},
+                                               {2, 4, 5, 0}};
+
+/* Whether a cracked facet other than f holds the edge of corners i and j
+ * of tet t, which facet f holds. */
+static int edge_cracked(const cf_solid *s, int f, int t, int i, int j)
 {
-    if (!s->vert_cracks[a] || !s->vert_cracks[b]) /* no cracked facet was ever on one end */
-        return 0;
+    return s->edge_cracks[6 * t + CF_TET_EDGE[i][j]] > s->cracked[f];
+}
+
+/* Adds d to the crack count of the edge of original vertices a and b in
+ * every tet around it. */
+static void count_edge(cf_solid *s, int a, int b, int d)
+{
     for (int j = s->vt_start[a]; j < s->vt_start[a + 1]; j++) {
         int slot = s->vt_slot[j], t = slot / 4, sb = slot_of(s, t, b);
-        if (sb < 0)
-            continue;
-        for (int q = 0; q < 4; q++) { /* face q holds every corner but q */
-            int g = s->tet_facet[4 * t + q];
-            if (q != slot % 4 && q != sb && g != f && s->cracked[g])
-                return 1;
-        }
+        if (sb >= 0)
+            s->edge_cracks[6 * t + CF_TET_EDGE[slot % 4][sb]] += (unsigned char)d;
     }
-    return 0;
 }
 
 /* The threshold of the vertex at corner j of face k of tet ta as the vertex
@@ -269,11 +287,16 @@ static int front_rule(const cf_solid *s, int ta, int k, double threshold)
     int f = s->tet_facet[4 * ta + k];
     for (int j = 0; j < 3; j++) {
         int n = s->tet[4 * ta + CF_TET_FACE[k][j]];
-        if (!s->node_mark[n] || s->nodal[n] < front_threshold(s, ta, k, j, threshold))
+        /* The cheap tests first: the mark, the edge, the vertex's lowest
+         * front floor; then the threshold's square root. */
+        if (!s->node_mark[n] ||
+            !edge_cracked(s, f, ta, CF_TET_FACE[k][(j + 1) % 3], CF_TET_FACE[k][(j + 2) % 3]))
             continue;
-        if (edge_cracked(s, f, s->tet0[4 * ta + CF_TET_FACE[k][(j + 1) % 3]],
-                         s->tet0[4 * ta + CF_TET_FACE[k][(j + 2) % 3]]))
-            return 1;
+        double v = s->nodal[n]; /* a NaN passes, as in source_rule */
+        if (v < threshold && ((s->vert_front_active && v < s->vert_front_active[s->origin[n]]) ||
+                              v < front_threshold(s, ta, k, j, threshold)))
+            continue;
+        return 1;
     }
     return 0;
 }
@@ -314,11 +337,12 @@ static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion ru
 
 cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule)
 {
-    cf_stress_check c = {INFINITY, INFINITY};
+    cf_stress_check c = {INFINITY, INFINITY, NULL};
     double w = s->strength ? s->strength_min : 1.0; /* the weakest facet */
     if (rule == CF_CRITERION_SOURCE) /* and no front's below the weakest vertex's */
         c.s1 = fmin(source_threshold(s->mat.sigma_max, w),
-                    s->vert_front_floor ? s->front_floor_min : INFINITY);
+                    s->vert_front_floor ? s->front_floor_min : INFINITY),
+        c.s1_tet = s->tet_floor; /* away from the cracks, no front's */
     else if (rule == CF_CRITERION_TRACTION)
         c.s1 = s->mat.sigma_max * w, c.tau = s->mat.tau_max * w;
     return c;
@@ -509,12 +533,100 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes, cf_int_list
     return rc;
 }
 
+/* s->tet_floor of tet t: the lowest strength floor at its vertices,
+ * rounded down to a float (a hot tet's bound then reaches every vertex
+ * floor it must), or 0 with a vertex near a crack. */
+static float tet_floor(const cf_solid *s, int t)
+{
+    double floor = INFINITY;
+    for (int j = 0; j < 4; j++) {
+        int o = s->tet0[4 * t + j];
+        if (s->vert_front_near[o])
+            return 0;
+        floor = fmin(floor, strength_floor(s, o));
+    }
+    float f = (float)floor;
+    return (double)f > floor ? nextafterf(f, 0.0f) : f;
+}
+
+/* The vertices sharing a tet with original vertex o become near a crack,
+ * and every tet of theirs loses its own floor. */
+static void near_crack(cf_solid *s, int o)
+{
+    for (int j = s->vt_start[o]; j < s->vt_start[o + 1]; j++) {
+        const int *T = &s->tet0[4 * (s->vt_slot[j] / 4)];
+        for (int k = 0; k < 4; k++) {
+            int u = T[k];
+            if (s->vert_front_near[u])
+                continue;
+            s->vert_front_near[u] = 1;
+            for (int i = s->vt_start[u]; i < s->vt_start[u + 1]; i++)
+                s->tet_floor[s->vt_slot[i] / 4] = 0;
+        }
+    }
+}
+
+/* Facet f now holds the edge of original vertices a and b: each other
+ * interior facet on that edge has a front there, whose threshold at its
+ * vertex off the edge (front_threshold, rounded down to a float) bounds
+ * that vertex's s->vert_front_active. */
+static void front_edge(cf_solid *s, int f, int a, int b)
+{
+    for (int j = s->vt_start[a]; j < s->vt_start[a + 1]; j++) {
+        int slot = s->vt_slot[j], t = slot / 4, sb = slot_of(s, t, b);
+        if (sb < 0)
+            continue;
+        for (int q = 0; q < 4; q++) { /* face q holds every corner but q */
+            int g = s->tet_facet[4 * t + q];
+            const int *G = &s->facet[4 * g];
+            if (q == slot % 4 || q == sb || g == f || G[2] < 0)
+                continue;
+            /* the vertex off the edge as the facet's own tet names it */
+            int c = s->tet0[4 * t + (6 - q - slot % 4 - sb)], jc = 0;
+            while (s->tet0[4 * G[0] + CF_TET_FACE[G[1]][jc]] != c)
+                jc++;
+            float th = nextafterf((float)cf_front_toughness(s, G[0], G[1], jc), 0.0f);
+            s->vert_front_active[c] = fminf(s->vert_front_active[c], th);
+        }
+    }
+}
+
 void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked)
 {
     const int *F = &s->facet[4 * f];
+    int o[3];
+    face_vertices(s, F[0], F[1], o);
+    int d = (int)cracked - (int)s->cracked[f];
     s->cracked[f] = cracked;
-    for (int i = 0; i < 3; i++)
-        s->vert_cracks[s->tet0[4 * F[0] + CF_TET_FACE[F[1]][i]]]++;
+    for (int i = 0; d && i < 3; i++)
+        count_edge(s, o[(i + 1) % 3], o[(i + 2) % 3], d);
+    for (int i = 0; i < 3; i++) {
+        if (s->vert_front_near && s->vert_cracks[o[i]] == 0)
+            near_crack(s, o[i]);
+        s->vert_cracks[o[i]]++;
+    }
+    for (int i = 0; cracked && s->vert_front_active && i < 3; i++)
+        front_edge(s, f, o[(i + 1) % 3], o[(i + 2) % 3]);
+}
+
+void cf_insertion_init_front_floors(cf_solid *s)
+{
+    if (!s->vert_front_near)
+        return;
+    for (int o = 0; o < s->n_verts0; o++) {
+        s->vert_front_active[o] = INFINITY;
+        if (s->vert_cracks[o])
+            near_crack(s, o);
+    }
+    for (int f = 0; f < s->n_facets; f++)
+        if (s->cracked[f])
+            for (int i = 0; i < 3; i++) {
+                const int *F = &s->facet[4 * f], *K = CF_TET_FACE[F[1]];
+                front_edge(s, f, s->tet0[4 * F[0] + K[(i + 1) % 3]],
+                           s->tet0[4 * F[0] + K[(i + 2) % 3]]);
+            }
+    for (int t = 0; t < s->n_tets; t++)
+        s->tet_floor[t] = tet_floor(s, t);
 }
 
 /* Mark facet f cracked and duplicate the nodes whose star it disconnects;
@@ -617,18 +729,11 @@ static double front_stress_ratio(const cf_solid *s, int f)
         sn = fmax(sn, t);
         /* With the toughness each vertex ahead of a cracked edge has a
          * threshold of its own: the largest ratio among those. */
-        const int *T = &s->tet0[4 * F[0]], *K = CF_TET_FACE[F[1]];
-        if (s->front_K > 0 && edge_cracked(s, f, T[K[(j + 1) % 3]], T[K[(j + 2) % 3]]))
+        const int *K = CF_TET_FACE[F[1]];
+        if (s->front_K > 0 && edge_cracked(s, f, F[0], K[(j + 1) % 3], K[(j + 2) % 3]))
             ratio = fmax(ratio, t / front_threshold(s, F[0], F[1], j, th));
     }
     return s->front_K > 0 ? fmax(ratio, sn / th) : sn / th;
-}
-
-/* The original vertices of face k of tet t. */
-static void face_vertices(const cf_solid *s, int t, int k, int o[3])
-{
-    for (int j = 0; j < 3; j++)
-        o[j] = s->tet0[4 * t + CF_TET_FACE[k][j]];
 }
 
 /* Rest centroid of a triangle of original vertices, m. */

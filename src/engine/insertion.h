@@ -22,7 +22,9 @@ void cf_ints_sort(int *v, int n); /* v[0..n) ascending */
  * rules need a principal or shear stress at or above these in at least one
  * tet next to the facet (the largest eigenvalue of a volume average is at
  * most the largest of the averaged ones), so facets away from hot tets are
- * never looked at. */
+ * never looked at.  With the toughness's floors (source), s1 is the lowest
+ * front floor, and s1_tet = s->tet_floor raises it away from the cracks
+ * (cf_insertion_init_front_floors). */
 cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule);
 
 /* How a check chooses among the facets that meet the criterion
@@ -62,9 +64,23 @@ typedef struct cf_growth {
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
                             const cf_growth *g, cf_int_list *out);
 
+/* With a front threshold from the toughness (s->vert_front_floor), the
+ * floors of the check from the cracks there are (docs/performance.md): a
+ * front needs a cracked edge, so a vertex's nodal value need reach only
+ * the lowest threshold of the fronts it has ahead now, or its strength's
+ * (s->vert_front_active), and a tet with no vertex near a crack is hot
+ * only near its vertices' strength (s->tet_floor, cf_stress_check's
+ * s1_tet; s->vert_front_near).  cf_mark_cracked keeps them up as facets
+ * crack.  The same candidates from fewer nodes; until this is called
+ * every vertex takes its lowest front floor and every tet the solid's
+ * bound. */
+void cf_insertion_init_front_floors(cf_solid *s);
+
 /* Set facet f's cracked flag (1 or 0), and move on the crack version of
- * its three original vertices, which the growth rule's memo keys on: every
- * change of a facet's flag goes through here. */
+ * its three original vertices, which the growth rule's memo keys on, and
+ * the crack counts of its edges (s->edge_cracks): every change of a
+ * facet's flag goes through here; with the toughness's floors, also those
+ * (cf_insertion_init_front_floors). */
 void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked);
 
 /* The facets of `cand` (cf_insertion_candidates) that a check inserts,

@@ -68,11 +68,12 @@ static int build_facets(cf_solid *s)
     free(k);
     s->n_facets = nf;
     s->cracked = calloc((size_t)nf, 1);
+    s->edge_cracks = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), 6);
     s->crack_time = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
     s->contact_key = calloc((size_t)(nf > 0 ? nf : 1), sizeof(uint64_t));
     s->contact_kind = calloc((size_t)(nf > 0 ? nf : 1), 1);
     s->contact_until = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
-    return s->cracked && s->crack_time && s->contact_key && s->contact_kind &&
+    return s->cracked && s->edge_cracks && s->crack_time && s->contact_key && s->contact_kind &&
                    s->contact_until
                ? 0
                : -1;
@@ -324,7 +325,10 @@ cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
 {
     s->front_K = sqrt(s->mat.E * s->mat.G_I);
     s->vert_front_floor = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
-    if (!s->vert_front_floor)
+    s->vert_front_active = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
+    s->vert_front_near = calloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1), 1);
+    s->tet_floor = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), sizeof(float));
+    if (!s->vert_front_floor || !s->vert_front_active || !s->vert_front_near || !s->tet_floor)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for front thresholds");
     for (int o = 0; o < s->n_verts0; o++)
         s->vert_front_floor[o] = INFINITY;
@@ -341,6 +345,8 @@ cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
             s->front_floor_min = fmin(s->front_floor_min, th);
         }
     }
+    /* until cf_insertion_init_front_floors: every front's, wherever it lies */
+    memcpy(s->vert_front_active, s->vert_front_floor, (size_t)s->n_verts0 * sizeof(float));
     return CF_OK;
 }
 
@@ -508,7 +514,7 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->nodal_stress, s->nodal_check, s->vert_check, s->vert_node, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_floor, s->vt_start, s->vt_slot, s->coh,
+                    s->cracked, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_floor, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until,
                     s->bv_eta, s->bv_rate, s->bv_work};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)

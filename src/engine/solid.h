@@ -102,6 +102,9 @@ typedef struct cf_solid {
     int *facet;               /* [nf][4] tetA, faceA, tetB, faceB (tetB = -1 on the boundary) */
     int *tet_facet;           /* [nt][4] facet of face k */
     unsigned char *cracked;   /* [nf] */
+    unsigned char *edge_cracks; /* [nt][6] the cracked facets holding each edge of the
+                                 tet (corners 01 02 03 12 13 23): an edge's count,
+                                 kept in every tet around it */
     double *crack_time;       /* [nf] s, when each cracked facet was inserted */
     unsigned *vert_cracks;    /* [n_verts0] times a facet on each original vertex was
                                  marked cracked (or unmarked): a version of the cracks
@@ -129,6 +132,19 @@ typedef struct cf_solid {
                                  threshold K_IC / sqrt(2 pi r) over the interior
                                  facets with the vertex ahead (INFINITY where none) */
     double front_floor_min;   /* Pa, the smallest of them (INFINITY when off) */
+    float *vert_front_active; /* [n_verts0] Pa, with front_K: the lowest front threshold
+                                 over the interior facets with the vertex ahead of an
+                                 edge a cracked facet holds (ever; INFINITY where none),
+                                 the floor of its nodal value with the strength's
+                                 (cf_insertion_init_front_floors) */
+    unsigned char *vert_front_near; /* [n_verts0] with front_K: 1 where the vertex shares
+                                 a tet with a vertex of a cracked facet (ever), the
+                                 only vertices a front can have ahead; elsewhere the
+                                 front floor does not apply (insertion.c) */
+    float *tet_floor;         /* [nt] Pa, with front_K: a tet's own hot bound where no
+                                 vertex of it is near a crack, the lowest strength
+                                 threshold at its vertices (rounded down); 0 where one
+                                 is, and before cf_insertion_init_front_floors */
     unsigned char *node_mark; /* [cap_nodes] scratch of the insertion check (the
                                  nodes of hot tets) and of a split (the nodes
                                  taken); all 0 between uses (fracture state) */
@@ -204,8 +220,9 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
  * "toughness", docs/physics.md §5.1): s->front_K = K_IC = sqrt(E G_I) (Pa
  * m^1/2), and each original vertex's lowest threshold K_IC / sqrt(2 pi r)
  * as the vertex ahead of a front, r (m) its rest distance from the line of
- * the opposite edge of an interior facet.  After cf_solid_init_facets.
- * Errors: CF_ERR_NOMEM. */
+ * the opposite edge of an interior facet; the check's floors as if every
+ * front were there (cf_insertion_init_front_floors sets them).  After
+ * cf_solid_init_facets.  Errors: CF_ERR_NOMEM. */
 cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err);
 
 /* The field of a crack tip at the toughness, Pa: K_IC / sqrt(2 pi r) at the

@@ -452,9 +452,12 @@ CF_LANE_CLONES static void tet_block(cf_solid *s, const int *tets, int n, cf_ela
         lane9 sigma;
         lanes_mul_nt(P, L.R, sigma); /* R sigma R^T */
         lanes_store(sigma, 9, s->sigma, t, n);
-        vd lo, hi;
+        vd lo, hi, s1 = splat(check->s1);
         principal_bounds(L.sig, &lo, &hi);
-        is_hot = ((vm)(hi >= splat(check->s1)) | (vm)(0.5 * (hi - lo) >= splat(check->tau))) &
+        if (check->s1_tet)
+            for (int l = 0; l < LANES; l++)
+                s1[l] = fmax(s1[l], check->s1_tet[t[l]]);
+        is_hot = ((vm)(hi >= s1) | (vm)(0.5 * (hi - lo) >= splat(check->tau))) &
                  (vm)(live > 0);
     }
     for (int l = 0; l < n; l++) {

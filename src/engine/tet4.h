@@ -33,6 +33,8 @@ static inline void cf_tet4_gradients(const cf_solid *s, int t, double g[4][3])
  * insertion only near a hot tet, so with no hot tet the check costs nothing. */
 typedef struct cf_stress_check {
     double s1, tau;
+    const float *s1_tet; /* [nt] Pa or NULL: a tet's own s1 where it is above s1
+                            (s->tet_floor, insertion.h) */
 } cf_stress_check;
 
 /* For each tet of the list: internal nodal forces into s->tf ([4][3] per

@@ -2,6 +2,7 @@
  * joined into one solid, boundary conditions, the crack plane, obstacles,
  * the initial fragments and their Bullet bodies; and destroying it. */
 #include "handoff.h"
+#include "insertion.h"
 #include "world_events.h"
 
 #include "linalg.h"
@@ -447,6 +448,8 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
             scene->solver.crack_growth == CF_GROWTH_FRONTS &&
             scene->solver.front_threshold == CF_FRONT_TOUGHNESS)
             st = cf_solid_init_front_toughness(&w->solid, err);
+        if (st == CF_OK)
+            cf_insertion_init_front_floors(&w->solid);
         cf_mesh_free(&all);
     }
     free(bc);

@@ -449,10 +449,12 @@ void cf_world_memory(const cf_world *w, cf_memory *m)
                ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I + (s->ep ? nt * 7 * D : 0) +
                (s->bv_eta ? nt * 3 * D : 0); /* the bulk viscosity's eta, rate, work */
     if (s->facet)
-        m->fracture = nt * (9 * D + 2 + 20 * I) + cn * (1 + 7 * D + sizeof(unsigned)) +
+        m->fracture = nt * (9 * D + 2 + 6 + 20 * I) + cn * (1 + 7 * D + sizeof(unsigned)) +
                       (unsigned long long)s->n_facets * (1 + (s->candidate != NULL)) +
                       (unsigned long long)s->n_verts0 * (sizeof(unsigned) + sizeof(int)) +
-                      (s->vert_front_floor ? (unsigned long long)s->n_verts0 * sizeof(float) : 0);
+                      (s->vert_front_floor ? (unsigned long long)s->n_verts0 * (2 * sizeof(float) + 1) +
+                                                   (unsigned long long)nt * sizeof(float)
+                                             : 0);
     m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
     m->fragments = (unsigned long long)w->cap_frag * sizeof(cf_fragment);
     for (int i = 0; i < w->n_frag; i++) {
