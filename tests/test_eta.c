@@ -57,6 +57,23 @@ static void test_spell_end_of_an_exponential_decay(void **state)
     }
 }
 
+/* A landing under way holds a decaying spell at least as long as its
+ * landing time has left, and then the answer is the landing's; a hold
+ * shorter than the decay's end leaves it as it was. */
+static void test_decaying_spell_held_by_a_landing(void **state)
+{
+    (void)state;
+    cf_eta e;
+    exponential_spell(&e, 1e-3);
+    int by_landing;
+    double free_left = spell_left(&e, -INFINITY);
+    assert_true(free_left > 5e-4 && free_left < 1e-3); /* the decay's answer */
+    assert_near(cf_eta_spell_left(&e, 1.2e-3, &by_landing), 1.2e-3, 1e-15);
+    assert_int_equal(by_landing, 1);
+    assert_near(cf_eta_spell_left(&e, 1e-4, &by_landing), free_left, 1e-15);
+    assert_int_equal(by_landing, 0);
+}
+
 /* Cracks that grow at a steady rate say nothing of the end: as much
  * again as the spell has run. */
 static void test_spell_without_decay_runs_as_much_again(void **state)
@@ -226,6 +243,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_spell_end_of_an_exponential_decay),
+        cmocka_unit_test(test_decaying_spell_held_by_a_landing),
         cmocka_unit_test(test_spell_without_decay_runs_as_much_again),
         cmocka_unit_test(test_quiet_held_and_capped_spells),
         cmocka_unit_test(test_rest_counts_short_spells_not_long_ones),

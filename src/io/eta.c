@@ -121,6 +121,8 @@ double cf_eta_spell_left(const cf_eta *e, double held, int *by_landing)
             none = fmax(e->rule.quiet_growth * (now->cracks + rate * tau), 1.0) / q;
             double decay = fmin(s, (rate > none ? tau * log(rate / none) : 0) + q);
             left = sqrt(decay * s);
+            *by_landing = held > left; /* the landings under way hold it at least that long */
+            left = fmax(left, held);
         }
     }
     return fmax(0.0, fmin(left, e->rule.max_spell - s));
