@@ -1191,7 +1191,7 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
                        : box_with_crack(&m, &s, 0.6 * 0.9 * strength);
     s.mat.G_I = K * K / s.mat.E;
     assert_int_equal(cf_solid_init_front_toughness(&s, NULL), CF_OK);
-    if (floors)
+    if (floors) /* without: every vertex's lowest front floor, the solid's hot bound */
         cf_insertion_init_front_floors(&s);
     int cooler = 0;
     for (int round = 0; round < 3; round++) {

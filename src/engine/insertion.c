@@ -253,17 +253,6 @@ static int edge_cracked(const cf_solid *s, int f, int t, int i, int j)
     return s->edge_cracks[6 * t + CF_TET_EDGE[i][j]] > s->cracked[f];
 }
 
-/* Adds d to the crack count of the edge of original vertices a and b in
- * every tet around it. */
-static void count_edge(cf_solid *s, int a, int b, int d)
-{
-    for (int j = s->vt_start[a]; j < s->vt_start[a + 1]; j++) {
-        int slot = s->vt_slot[j], t = slot / 4, sb = slot_of(s, t, b);
-        if (sb >= 0)
-            s->edge_cracks[6 * t + CF_TET_EDGE[slot % 4][sb]] += (unsigned char)d;
-    }
-}
-
 /* The threshold of the vertex at corner j of face k of tet ta as the vertex
  * ahead of a front, Pa: the facet's `threshold`, or with
  * solver.front_threshold "toughness" at most the field of a crack tip at
@@ -341,7 +330,7 @@ cf_stress_check cf_insertion_bound(const cf_solid *s, cf_criterion rule)
     double w = s->strength ? s->strength_min : 1.0; /* the weakest facet */
     if (rule == CF_CRITERION_SOURCE) /* and no front's below the weakest vertex's */
         c.s1 = fmin(source_threshold(s->mat.sigma_max, w),
-                    s->vert_front_floor ? s->front_floor_min : INFINITY),
+                    s->vert_front_active ? s->front_floor_min : INFINITY),
         c.s1_tet = s->tet_floor; /* away from the cracks, no front's */
     else if (rule == CF_CRITERION_TRACTION)
         c.s1 = s->mat.sigma_max * w, c.tau = s->mat.tau_max * w;
@@ -566,17 +555,20 @@ static void near_crack(cf_solid *s, int o)
     }
 }
 
-/* Facet f now holds the edge of original vertices a and b: each other
- * interior facet on that edge has a front there, whose threshold at its
- * vertex off the edge (front_threshold, rounded down to a float) bounds
- * that vertex's s->vert_front_active. */
-static void front_edge(cf_solid *s, int f, int a, int b)
+/* Facet f's crack flag moved by d (+1, -1 or 0) on the edge of original
+ * vertices a and b: d added to the edge's crack count in every tet around
+ * it (s->edge_cracks); with `fronts`, each other interior facet on the
+ * edge has a front there, whose threshold at its vertex off the edge
+ * (front_threshold, rounded down to a float) bounds that vertex's
+ * s->vert_front_active. */
+static void crack_edge(cf_solid *s, int f, int a, int b, int d, int fronts)
 {
     for (int j = s->vt_start[a]; j < s->vt_start[a + 1]; j++) {
         int slot = s->vt_slot[j], t = slot / 4, sb = slot_of(s, t, b);
         if (sb < 0)
             continue;
-        for (int q = 0; q < 4; q++) { /* face q holds every corner but q */
+        s->edge_cracks[6 * t + CF_TET_EDGE[slot % 4][sb]] += (unsigned char)d;
+        for (int q = 0; fronts && q < 4; q++) { /* face q holds every corner but q */
             int g = s->tet_facet[4 * t + q];
             const int *G = &s->facet[4 * g];
             if (q == slot % 4 || q == sb || g == f || G[2] < 0)
@@ -598,15 +590,14 @@ void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked)
     face_vertices(s, F[0], F[1], o);
     int d = (int)cracked - (int)s->cracked[f];
     s->cracked[f] = cracked;
+    /* a facet marked again (taken, then opened) changes nothing on its edges */
     for (int i = 0; d && i < 3; i++)
-        count_edge(s, o[(i + 1) % 3], o[(i + 2) % 3], d);
+        crack_edge(s, f, o[(i + 1) % 3], o[(i + 2) % 3], d, d > 0 && s->vert_front_active);
     for (int i = 0; i < 3; i++) {
         if (s->vert_front_near && s->vert_cracks[o[i]] == 0)
             near_crack(s, o[i]);
         s->vert_cracks[o[i]]++;
     }
-    for (int i = 0; cracked && s->vert_front_active && i < 3; i++)
-        front_edge(s, f, o[(i + 1) % 3], o[(i + 2) % 3]);
 }
 
 void cf_insertion_init_front_floors(cf_solid *s)
@@ -620,10 +611,10 @@ void cf_insertion_init_front_floors(cf_solid *s)
     }
     for (int f = 0; f < s->n_facets; f++)
         if (s->cracked[f])
-            for (int i = 0; i < 3; i++) {
+            for (int i = 0; i < 3; i++) { /* its counts are there already */
                 const int *F = &s->facet[4 * f], *K = CF_TET_FACE[F[1]];
-                front_edge(s, f, s->tet0[4 * F[0] + K[(i + 1) % 3]],
-                           s->tet0[4 * F[0] + K[(i + 2) % 3]]);
+                crack_edge(s, f, s->tet0[4 * F[0] + K[(i + 1) % 3]],
+                           s->tet0[4 * F[0] + K[(i + 2) % 3]], 0, 1);
             }
     for (int t = 0; t < s->n_tets; t++)
         s->tet_floor[t] = tet_floor(s, t);

@@ -64,7 +64,7 @@ typedef struct cf_growth {
 int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion rule, int n_hot,
                             const cf_growth *g, cf_int_list *out);
 
-/* With a front threshold from the toughness (s->vert_front_floor), the
+/* With a front threshold from the toughness (s->vert_front_active), the
  * floors of the check from the cracks there are (docs/performance.md): a
  * front needs a cracked edge, so a vertex's nodal value need reach only
  * the lowest threshold of the fronts it has ahead now, or its strength's

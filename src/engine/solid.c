@@ -324,14 +324,13 @@ double cf_front_toughness(const cf_solid *s, int t, int k, int j)
 cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
 {
     s->front_K = sqrt(s->mat.E * s->mat.G_I);
-    s->vert_front_floor = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
     s->vert_front_active = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
     s->vert_front_near = calloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1), 1);
     s->tet_floor = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), sizeof(float));
-    if (!s->vert_front_floor || !s->vert_front_active || !s->vert_front_near || !s->tet_floor)
+    if (!s->vert_front_active || !s->vert_front_near || !s->tet_floor)
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory for front thresholds");
     for (int o = 0; o < s->n_verts0; o++)
-        s->vert_front_floor[o] = INFINITY;
+        s->vert_front_active[o] = INFINITY;
     s->front_floor_min = INFINITY;
     for (int f = 0; f < s->n_facets; f++) {
         if (s->facet[4 * f + 2] < 0) /* a boundary face never cracks */
@@ -341,12 +340,10 @@ cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
             int o = s->tet0[4 * t + CF_TET_FACE[k][j]];
             /* rounded down, so that the float never lies above a threshold */
             float th = nextafterf((float)cf_front_toughness(s, t, k, j), 0.0f);
-            s->vert_front_floor[o] = fminf(s->vert_front_floor[o], th);
+            s->vert_front_active[o] = fminf(s->vert_front_active[o], th);
             s->front_floor_min = fmin(s->front_floor_min, th);
         }
     }
-    /* until cf_insertion_init_front_floors: every front's, wherever it lies */
-    memcpy(s->vert_front_active, s->vert_front_floor, (size_t)s->n_verts0 * sizeof(float));
     return CF_OK;
 }
 
@@ -514,7 +511,7 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->nodal_stress, s->nodal_check, s->vert_check, s->vert_node, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_floor, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh,
+                    s->cracked, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until,
                     s->bv_eta, s->bv_rate, s->bv_work};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)

@@ -128,15 +128,15 @@ typedef struct cf_solid {
                                  nodal value passes no facet there */
     double front_K;           /* Pa m^1/2: K_IC = sqrt(E G_I) of a front's threshold
                                  (solver.front_threshold "toughness"), 0 off */
-    float *vert_front_floor;  /* [n_verts0] Pa, with front_K: the lowest front
-                                 threshold K_IC / sqrt(2 pi r) over the interior
-                                 facets with the vertex ahead (INFINITY where none) */
-    double front_floor_min;   /* Pa, the smallest of them (INFINITY when off) */
+    double front_floor_min;   /* Pa, with front_K: the lowest front threshold
+                                 K_IC / sqrt(2 pi r) of any vertex ahead of any
+                                 interior facet (INFINITY when off) */
     float *vert_front_active; /* [n_verts0] Pa, with front_K: the lowest front threshold
                                  over the interior facets with the vertex ahead of an
                                  edge a cracked facet holds (ever; INFINITY where none),
                                  the floor of its nodal value with the strength's
-                                 (cf_insertion_init_front_floors) */
+                                 (cf_insertion_init_front_floors); until then over
+                                 every interior facet with the vertex ahead */
     unsigned char *vert_front_near; /* [n_verts0] with front_K: 1 where the vertex shares
                                  a tet with a vertex of a cracked facet (ever), the
                                  only vertices a front can have ahead; elsewhere the
@@ -220,8 +220,9 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
  * "toughness", docs/physics.md §5.1): s->front_K = K_IC = sqrt(E G_I) (Pa
  * m^1/2), and each original vertex's lowest threshold K_IC / sqrt(2 pi r)
  * as the vertex ahead of a front, r (m) its rest distance from the line of
- * the opposite edge of an interior facet; the check's floors as if every
- * front were there (cf_insertion_init_front_floors sets them).  After
+ * the opposite edge of an interior facet (s->vert_front_active, their
+ * least s->front_floor_min): the check's floors as if every front were
+ * there (cf_insertion_init_front_floors sets them from the cracks).  After
  * cf_solid_init_facets.  Errors: CF_ERR_NOMEM. */
 cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err);
 

@@ -452,7 +452,7 @@ void cf_world_memory(const cf_world *w, cf_memory *m)
         m->fracture = nt * (9 * D + 2 + 6 + 20 * I) + cn * (1 + 7 * D + sizeof(unsigned)) +
                       (unsigned long long)s->n_facets * (1 + (s->candidate != NULL)) +
                       (unsigned long long)s->n_verts0 * (sizeof(unsigned) + sizeof(int)) +
-                      (s->vert_front_floor ? (unsigned long long)s->n_verts0 * (2 * sizeof(float) + 1) +
+                      (s->vert_front_active ? (unsigned long long)s->n_verts0 * (sizeof(float) + 1) +
                                                    (unsigned long long)nt * sizeof(float)
                                              : 0);
     m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
