@@ -83,6 +83,11 @@ typedef struct cf_fragment {
     double dv_taken;         /* m/s: the strongest impact it has taken in fracture
                                 mode and come back from whole; only a stronger
                                 one sends it back (docs/physics.md §9) */
+    double dv_sustained;     /* m/s: the impact in a rigid step at most of the
+                                fixed contacts its landing time no longer holds,
+                                (1 + e) times their fastest approach plus g dt,
+                                at its last check; rigid mode takes them on
+                                (world_step.c, impact_unfinished) */
 } cf_fragment;
 
 /* Appends a new fragment to the table frag[0..*n) of capacity *cap (grown

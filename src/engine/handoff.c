@@ -524,11 +524,12 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
     cf_fragment_momenta(f, &sim->solid, sim->bullet, P0, L0);
 
     /* One component: the fragment stays itself, and has taken the impact
-     * it entered with (a weaker one leaves it rigid); several: children,
-     * new bodies whose next impact is their own. */
+     * it entered with and the sustained contacts rigid mode takes on (a
+     * weaker one leaves it rigid); several: children, new bodies whose
+     * next impact is their own. */
     int first = fi;
     if (k == 1)
-        f->dv_taken = fmax(f->dv_taken, f->dv_enter);
+        f->dv_taken = fmax(f->dv_taken, fmax(f->dv_enter, f->dv_sustained));
     if (k > 1) {
         f->mode = CF_MODE_DEAD;
         first = sim->n_frag;
