@@ -167,8 +167,11 @@ cf_status cf_surface_load(const char *path, cf_surface *s, cf_error *err)
     if (!sc || ai_first_error[0]) {
         const char *why = ai_first_error[0] ? ai_first_error : aiGetErrorString();
         int index = strstr(why, "out of range") != NULL;
-        /* assimp reports a failed allocation as the exception's text */
-        int nomem = strstr(why, "bad_alloc") != NULL || strstr(why, "out of memory") != NULL;
+        /* assimp reports a failed allocation as the exception's text, or
+         * with no text at all when its C entry point caught the exception
+         * of its first allocation, the importer that would hold the text */
+        int nomem = why[0] == '\0' || strstr(why, "bad_alloc") != NULL ||
+                    strstr(why, "out of memory") != NULL;
         st = cf_error_set(err, nomem ? CF_ERR_NOMEM : index ? CF_ERR_MESH_INDEX : CF_ERR_MESH_PARSE,
                           "%s: %s (read with assimp)", path, nomem ? "out of memory" : why);
     } else {
