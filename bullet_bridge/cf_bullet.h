@@ -110,10 +110,10 @@ int cfb_apply_impulse(cfb_world *w, int id, const double J[3], const double p[3]
 
 /* World-frame bounding box (m) of body `id`'s shape now, collision margin
  * included: the smallest one for hulls, compounds, spheres and boxes, the
- * vertices' box for a triangle mesh; for a plane whose normal lies along an
- * axis the half-space behind it and Bullet's contact breaking threshold
- * (1 mm, as cfb_world_create sets it) in front, +-1e30 elsewhere, and +-1e30 in every direction for
- * any other plane.  Returns 0 or -1. */
+ * vertices' box for a triangle mesh.  A plane whose normal lies along an
+ * axis: the half-space behind it and Bullet's contact breaking threshold
+ * (1 mm, as cfb_world_create sets it) in front, +-1e30 along the other
+ * axes; any other plane: +-1e30 in every direction.  Returns 0 or -1. */
 int cfb_get_aabb(const cfb_world *w, int id, double lo[3], double hi[3]);
 
 /* Deepest penetration (m, > 0) between the shapes of bodies a and b in
