@@ -80,6 +80,11 @@ int cf_fragment_can_break(const cf_fragment *f, const cf_solid *s, const cf_solv
     return 0;
 }
 
+double cf_fragment_margin(const cf_fragment *f, const cf_material *m)
+{
+    return 1e-3 * cbrt(f->mass / m->rho);
+}
+
 /* Twice, as a corner's contact radius is smaller than the sphere's and the
  * time grows as R^(-1/5).  A slower landing is no impact and lasts longer,
  * but rigid mode would not call it one: a contact that outlasts this is

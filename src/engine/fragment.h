@@ -122,6 +122,13 @@ int cf_fragment_cannot_split(const cf_fragment *f, const cf_solver_settings *set
  * facet.  1 or 0. */
 int cf_fragment_can_break(const cf_fragment *f, const cf_solid *s, const cf_solver_settings *set);
 
+/* Bullet collision margin of fragment f's convex hulls, m: 0.1 % of its
+ * size, the cube root of its volume (mass over the density of material m;
+ * Bullet's default 4 cm would hold a small fragment off the ground).
+ * Bullet's shape is the hull grown by it, so its contacts begin that far
+ * out. */
+double cf_fragment_margin(const cf_fragment *f, const cf_material *m);
+
 /* The longest a landing of fragment f at speed v (m/s; the impact
  * threshold) lasts, s: twice the contact time of an elastic sphere of its
  * mass and volume on a rigid floor of material m (Hertz; Johnson, Contact

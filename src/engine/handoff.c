@@ -68,13 +68,6 @@ static double debris_radius(const cf_world *sim, const cf_fragment *f, const dou
     return r;
 }
 
-/* Bullet collision margin of fragment f's hulls: 0.1% of its size, m
- * (Bullet's default 4 cm would hold small fragments off the ground). */
-static double collision_margin(const cf_world *sim, const cf_fragment *f)
-{
-    return 1e-3 * cbrt(f->mass / sim->solid.mat.rho);
-}
-
 /* Rotation of the Bullet body frame: rest->current R times principal axes Q. */
 cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const double R[9],
                                const double v[3], const double w[3], cf_error *err)
@@ -96,7 +89,7 @@ cf_status cf_fragment_add_body(cf_world *sim, int fi, const double pos[3], const
     else
         f->body = cfb_add_compound_body(sim->bullet, f->mass, f->principal, f->hulls.pts,
                                         f->hulls.start, f->hulls.n_hulls,
-                                        collision_margin(sim, f), &st, s->mat.friction,
+                                        cf_fragment_margin(f, &s->mat), &st, s->mat.friction,
                                         s->mat.restitution);
     if (f->body < 0)
         return cf_error_set(err, CF_ERR_EXTERNAL, "Bullet refused fragment %d: %s", fi,
@@ -303,7 +296,8 @@ static void clear_obstacles(cf_world *sim, const cf_fragment *f)
  * §9).  A debris sphere's radius already stops at the floor. */
 static void lift_clear(cf_world *sim, const cf_fragment *g, double com[3], const double R[9])
 {
-    double shift[3], gap = cf_fragment_is_debris(g, &sim->def.solver) ? 0 : collision_margin(sim, g);
+    int sphere = cf_fragment_is_debris(g, &sim->def.solver);
+    double shift[3], gap = sphere ? 0 : cf_fragment_margin(g, &sim->solid.mat);
     clearing_shift(sim, g, com, R, gap, shift);
     v3_axpy(1.0, shift, com);
     put_in(sim, lift_energy(sim, g->mass, shift));
