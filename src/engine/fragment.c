@@ -80,6 +80,17 @@ int cf_fragment_can_break(const cf_fragment *f, const cf_solid *s, const cf_solv
     return 0;
 }
 
+void cf_fragment_release(cf_fragment *f, int dead)
+{
+    free(f->contact), free(f->vn_pre), free(f->v_old), free(f->term), free(f->pairs);
+    f->contact = NULL, f->vn_pre = f->v_old = f->term = NULL, f->pairs = NULL;
+    f->scratch_cap = f->pairs_cap = 0;
+    if (!dead)
+        return;
+    free(f->nodes.v), free(f->coh.v);
+    f->nodes = (cf_int_list){0}, f->coh = (cf_int_list){0};
+}
+
 double cf_fragment_margin(const cf_fragment *f, const cf_material *m)
 {
     return 1e-3 * cbrt(f->mass / m->rho);

@@ -482,7 +482,8 @@ int cf_fragment_split_fracture(cf_world *sim, int fi, int *first)
     if (rc == 0) {
         f = &sim->frag[fi];
         f->mode = CF_MODE_DEAD;
-        f->tets = NULL, f->nt = 0, f->nodes.n = 0, f->coh.n = 0;
+        f->tets = NULL, f->nt = 0;
+        cf_fragment_release(f, 1);
         cf_bars_free(&f->bars);
         free(tets);
     }
@@ -599,6 +600,7 @@ cf_status cf_handoff_to_rigid(cf_world *sim, int fi, cf_handoff_record *rec, cf_
         v3_axpy(1.0, P, P1);
         v3_axpy(1.0, L, L1);
     }
+    cf_fragment_release(&sim->frag[fi], k > 1);
     double loss = before.ke - ke_after;
     if (sim->bullet) /* the pbd rigid backend keeps the nodes' velocities: damping removes it */
         sim->flow.handoff += loss;
