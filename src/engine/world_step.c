@@ -362,9 +362,8 @@ static cf_status check_energy(cf_world *w, cf_error *err)
  * a node lies on an obstacle (or would reach it within a rigid step at the
  * fragment's rigid-body velocity, or lies within the collision margin of
  * its hulls, where Bullet's contact begins), and either its rigid-body
- * velocity there
- * approaches the obstacle faster than the impact threshold (rigid mode would
- * see an impact at once), or the energy a hand-off would drop,
+ * velocity there approaches the obstacle faster than the impact threshold
+ * (rigid mode would see an impact at once), or the energy a hand-off would drop,
  * the strain energy and the kinetic energy beyond the rigid-body motion,
  * is more than CF_IMPACT_OVER of the kinetic energy it entered with.
  * Handed back in the middle of its impact, a fragment hits again at once:
@@ -389,7 +388,7 @@ static cf_status check_energy(cf_world *w, cf_error *err)
  * margin over a rigid step enters fracture mode with its nodes that far
  * off the floor: counted as clear, it went back after its quiet period
  * and Bullet's contact sent it in again, a 0.3 m cube landing on its
- * corner at 1 m/s 44 times in 6 ms (docs/physics.md §9). */
+ * corner at 1 m/s 926 times in 0.3 s (docs/physics.md §9). */
 static int impact_unfinished(cf_world *w, int fi)
 {
     cf_fragment *f = &w->frag[fi];
