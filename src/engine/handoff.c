@@ -342,7 +342,8 @@ cf_status cf_handoff_to_fracture(cf_world *sim, int fi, const cfb_state *st, cf_
     f->t_enter = sim->t;
     cf_fragment_ledger_reset(f, &sim->solid, &sim->flow);
     f->e_enter = f->e_kin;
-    if (collect_cohesive(sim, f, NULL, 0) || cf_bars_build(&f->bars, s, f->tets, f->nt))
+    if (collect_cohesive(sim, f, NULL, 0) ||
+        (cf_world_reads_bars(sim) && cf_bars_build(&f->bars, s, f->tets, f->nt)))
         return cf_error_set(err, CF_ERR_NOMEM, "out of memory entering fracture mode");
     cf_fragment_momenta(f, &sim->solid, sim->bullet, P1, L1);
     record_handoff(sim, fi, 0, P0, L0, P1, L1, loss, rec);

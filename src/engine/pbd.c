@@ -242,7 +242,7 @@ enum { TOUCHED = 1, NEIGHBOUR = 2 };
 int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touched,
                   cf_bars_scratch *w)
 {
-    if (n_touched == 0)
+    if (n_touched == 0 || !b->color_start) /* no bars kept: none to patch */
         return 0;
     if (scratch_reserve(w, s->n_nodes, 0))
         return -1;
@@ -330,9 +330,12 @@ int cf_bars_patch(cf_bars *b, const cf_solid *s, const int *touched, int n_touch
 int cf_bars_split(const cf_bars *src, const int *piece_of_node, int k, cf_bars *const *dst)
 {
     int rc = 0;
+    for (int p = 0; p < k; p++)
+        cf_bars_free(dst[p]);
+    if (!src->color_start) /* no bars kept: the pieces keep none */
+        return 0;
     for (int p = 0; p < k; p++) {
         cf_bars *d = dst[p];
-        cf_bars_free(d);
         d->color_start = calloc(CF_BARS_COLORS + 2, sizeof(int));
         rc |= !d->color_start;
     }

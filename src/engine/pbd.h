@@ -47,6 +47,9 @@ typedef struct cf_bars_scratch {
 } cf_bars_scratch;
 void cf_bars_scratch_free(cf_bars_scratch *w);
 
+/* A fragment keeps bars only where a step reads them (cf_world_reads_bars):
+ * an empty cf_bars (color_start NULL) is patched and split as no bars. */
+
 /* The bars after node duplication, patched where the mesh changed instead
  * of rebuilt: the bars at the `touched` nodes (the nodes whose star of tets
  * changed: each split node and its new copies; repeats allowed) are dropped

@@ -67,6 +67,16 @@ struct cf_world {
     int n_ev, cap_ev;
 };
 
+/* Whether any step of world w reads the bars: the pbd backend's rigid
+ * steps, and fracture steps with constraints.  Explicit fracture mode
+ * beside Bullet never does, and building and patching them for it cost
+ * the 202,231-tet plaster drop a serial hundredth of its break
+ * (docs/performance.md). */
+static inline int cf_world_reads_bars(const cf_world *w)
+{
+    return !w->bullet || w->def.solver.constraints != CF_CONSTRAINTS_NONE;
+}
+
 /* The narrow view of world w that the solver step gets (fracture.h); made
  * for each use, as the fragment count changes. */
 static inline cf_step_ctx cf_world_step_ctx(cf_world *w)
