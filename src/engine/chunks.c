@@ -4,11 +4,19 @@
 
 #include <string.h>
 
-void cf_sum_chunks(int n, int w, int threads, cf_chunk_sum_fn *sum, void *ctx, double *out)
+/* Items per chunk, and how many chunks, for n items. */
+static long chunking(int n, int *count)
 {
     long size = ((long)n + CF_CHUNKS_MAX - 1) / CF_CHUNKS_MAX;
     size = size < CF_CHUNK_MIN ? CF_CHUNK_MIN : size;
-    int count = n > 0 ? (int)((n + size - 1) / size) : 0;
+    *count = n > 0 ? (int)((n + size - 1) / size) : 0;
+    return size;
+}
+
+void cf_sum_chunks(int n, int w, int threads, cf_chunk_sum_fn *sum, void *ctx, double *out)
+{
+    int count;
+    long size = chunking(n, &count);
     double part[CF_CHUNKS_MAX][CF_SUMS_MAX];
     memset(part, 0, sizeof part);
     CF_PARALLEL(threads && count > 1, "omp parallel for schedule(static)",
@@ -21,4 +29,29 @@ void cf_sum_chunks(int n, int w, int threads, cf_chunk_sum_fn *sum, void *ctx, d
         for (int c = 0; c < count; c++)
             out[k] += part[c][k];
     }
+}
+
+int cf_flagged_chunks(const int *v, int lo, int n, const unsigned char *flag, int threads,
+                      int *out)
+{
+    int count, at[CF_CHUNKS_MAX + 1] = {0};
+    long size = chunking(n, &count);
+#define CF_ITEM_(i) (v ? v[i] : lo + (i))
+    CF_PARALLEL(threads && count > 1, "omp parallel for schedule(static)",
+        for (int c = 0; c < count; c++) {
+            int i1 = (int)((c + 1) * size < n ? (c + 1) * size : n);
+            for (int i = (int)(c * size); i < i1; i++)
+                at[c + 1] += flag[CF_ITEM_(i)] != 0;
+        });
+    for (int c = 0; c < count; c++)
+        at[c + 1] += at[c];
+    CF_PARALLEL(threads && count > 1, "omp parallel for schedule(static)",
+        for (int c = 0; c < count; c++) {
+            int i1 = (int)((c + 1) * size < n ? (c + 1) * size : n), k = at[c];
+            for (int i = (int)(c * size); i < i1; i++)
+                if (flag[CF_ITEM_(i)])
+                    out[k++] = CF_ITEM_(i);
+        });
+#undef CF_ITEM_
+    return at[count];
 }

@@ -21,4 +21,12 @@ typedef void cf_chunk_sum_fn(void *ctx, int i0, int i1, double *acc);
  * bits either way. */
 void cf_sum_chunks(int n, int w, int threads, cf_chunk_sum_fn *sum, void *ctx, double *out);
 
+/* The items whose byte in `flag` is set, in order, into out (room for
+ * all of them): of v[0..n) with v, flag[v[i]]; of lo..lo+n-1 without,
+ * flag[i].  The chunks of cf_sum_chunks are counted, and then written,
+ * on the threads when `threads` is set: the same list either way.
+ * Returns how many. */
+int cf_flagged_chunks(const int *v, int lo, int n, const unsigned char *flag, int threads,
+                      int *out);
+
 #endif

@@ -1,10 +1,12 @@
 #include "insertion.h"
 
+#include "chunks.h"
 #include "grow.h"
 #include "linalg.h"
 #include "parallel.h"
 #include "tet4.h"
 
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -129,23 +131,48 @@ static void clear_marks(cf_solid *s, const int *nodes, int n)
 
 /* Marks the nodes of hot tets, listing each once in `marked`; out of
  * memory: -1, with no mark left set.  The hot tets lie between positions
- * first and last of the list: the serial scan for them (whose order the
- * list keeps) starts and ends there. */
-static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last,
+ * first and last of the list: the scan for them starts and ends there.
+ * On one thread (par unset) the list is in the scan's order; on the
+ * threads the marks are set first and the list is read from them in node
+ * order.  Each loop that reads the list treats every node on its own, so
+ * its order never shows (the state hashes of the plaster drops are the
+ * same); the serial list was a fortieth of the 202,231-tet drop's break
+ * on the main thread. */
+static int mark_hot_nodes(cf_solid *s, const int *tets, int first, int last, int par,
                           cf_int_list *marked)
 {
-    for (int i = first; i <= last; i++)
-        if (s->hot[tets[i]])
-            for (int j = 0; j < 4; j++) {
-                int n = s->tet[4 * tets[i] + j];
-                if (s->node_mark[n])
-                    continue;
-                if (cf_int_list_push(marked, n)) {
-                    clear_marks(s, marked->v, marked->n);
-                    return -1;
+    if (!par) {
+        for (int i = first; i <= last; i++)
+            if (s->hot[tets[i]])
+                for (int j = 0; j < 4; j++) {
+                    int n = s->tet[4 * tets[i] + j];
+                    if (s->node_mark[n])
+                        continue;
+                    if (cf_int_list_push(marked, n)) {
+                        clear_marks(s, marked->v, marked->n);
+                        return -1;
+                    }
+                    s->node_mark[n] = 1;
                 }
-                s->node_mark[n] = 1;
-            }
+        return 0;
+    }
+    int lo = INT_MAX, hi = -1;
+    CF_PARALLEL(last >= first,
+                "omp parallel for schedule(static) reduction(min : lo) reduction(max : hi)",
+        for (int i = first; i <= last; i++)
+            if (s->hot[tets[i]])
+                for (int j = 0; j < 4; j++) {
+                    int n = s->tet[4 * tets[i] + j];
+                    __atomic_store_n(&s->node_mark[n], 1, __ATOMIC_RELAXED);
+                    lo = n < lo ? n : lo, hi = n > hi ? n : hi;
+                });
+    if (hi < lo)
+        return 0;
+    if (cf_int_list_reserve(marked, marked->n + (hi - lo + 1))) {
+        memset(s->node_mark + lo, 0, (size_t)(hi - lo + 1)); /* only this check's marks */
+        return -1;
+    }
+    marked->n += cf_flagged_chunks(NULL, lo, hi - lo + 1, s->node_mark, 1, marked->v + marked->n);
     return 0;
 }
 
@@ -369,18 +396,16 @@ static int qualify_near_marks(cf_solid *s, const cf_int_list *marked, cf_criteri
 }
 
 /* Appends to `out` the tets of tets[0..nt) whose s->qualify is set, in
- * list order (ascending), `count` of them: a scan of the fragment's bytes,
- * where the stars of the marked nodes, walked again and sorted, cost a
- * serial tenth of the 202,231-tet drop's check (docs/performance.md).
- * 0, or -1 out of memory. */
-static int list_qualified(const cf_solid *s, const int *tets, int nt, int count, cf_int_list *out)
+ * list order (ascending), `count` of them: a scan of the fragment's bytes
+ * (on the threads with par), where the stars of the marked nodes, walked
+ * again and sorted, cost a serial tenth of the 202,231-tet drop's check
+ * (docs/performance.md).  0, or -1 out of memory. */
+static int list_qualified(const cf_solid *s, const int *tets, int nt, int count, int par,
+                          cf_int_list *out)
 {
     if (cf_int_list_reserve(out, out->n + count))
         return -1;
-    for (int i = 0, at = out->n; i < nt && at < out->n + count; i++)
-        if (s->qualify[tets[i]])
-            out->v[at++] = tets[i];
-    out->n += count;
+    out->n += cf_flagged_chunks(tets, 0, nt, s->qualify, par, out->v + out->n);
     return 0;
 }
 
@@ -406,7 +431,7 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
         for (int i = 0; i < nt; i++)
             if (s->hot[tets[i]])
                 first = i < first ? i : first, last = i;);
-    if (mark_hot_nodes(s, tets, first, last, out))
+    if (mark_hot_nodes(s, tets, first, last, par, out))
         return -1;
     if (++s->check_stamp == 0) { /* wrapped: no node was valued in check 0 */
         memset(s->nodal_check, 0, (size_t)s->cap_nodes * sizeof(unsigned));
@@ -420,7 +445,7 @@ int cf_insertion_candidates(cf_solid *s, const int *tets, int nt, cf_criterion r
      * tets listed after the nodes. */
     int m = out->n, rc = 0, nq = qualify_near_marks(s, out, rule);
     if (nq > 0)
-        rc = list_qualified(s, tets, nt, nq, out); /* the tets, after the nodes */
+        rc = list_qualified(s, tets, nt, nq, par, out); /* the tets, after the nodes */
     for (int i = 0; rc && i < m; i++) /* out of memory: no qualify byte left set */
         star_unqualify(s, out->v[i]);
     clear_marks(s, out->v, m);
