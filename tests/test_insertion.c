@@ -5,6 +5,7 @@
 #include <cmocka.h>
 
 #include "check.h"
+#include "chunks.h"
 #include "cohesive.h"
 #include "cohesive_law.h"
 #include "cohesive_ppr.h"
@@ -17,6 +18,7 @@
 #include "tet4.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -410,57 +412,106 @@ static double jacobi_max_eigenvalue(const double S[9])
 static void test_source_rule_equals_brute_force(void **state)
 {
     (void)state;
-    cf_mesh m;
-    fixture_box(&m, 3, 3, 3, 1, 1, 1);
-    int checked = 0;
-    for (int level = 0; level < 5; level++) {
-        cf_solid s;
-        int n_hot;
-        int *all =
-            deformed_box(&s, &m, CF_CRITERION_SOURCE, 0.15 * (1 << level) * 0.02 * mat.E, &n_hot);
-        double *avg = calloc((size_t)s.n_nodes * 10, sizeof(double)), *value =
-            malloc((size_t)s.n_nodes * sizeof(double));
-        for (int t = 0; t < s.n_tets; t++)
-            for (int j = 0; j < 4; j++) {
-                double *a = &avg[10 * s.tet[4 * t + j]];
+    /* 162 tets, and 4,374: a fragment of CF_TET4_PARALLEL_MIN tets or more
+     * lists its marked nodes and qualifying tets on the threads. */
+    static const int cells[2] = {3, 9};
+    for (int box = 0; box < 2; box++) {
+        cf_mesh m;
+        fixture_box(&m, cells[box], cells[box], cells[box], 1, 1, 1);
+        int checked = 0;
+        for (int level = 0; level < 5; level++) {
+            cf_solid s;
+            int n_hot;
+            /* the strains grow as the cells shrink: the strengths with them */
+            double strength = 0.15 * (1 << level) * 0.02 * mat.E * cells[box] / 3;
+            int *all = deformed_box(&s, &m, CF_CRITERION_SOURCE, strength, &n_hot);
+            double *avg = calloc((size_t)s.n_nodes * 10, sizeof(double)), *value =
+                malloc((size_t)s.n_nodes * sizeof(double));
+            for (int t = 0; t < s.n_tets; t++)
+                for (int j = 0; j < 4; j++) {
+                    double *a = &avg[10 * s.tet[4 * t + j]];
+                    for (int k = 0; k < 9; k++)
+                        a[k] += s.vol[t] * s.sigma[9 * t + k];
+                    a[9] += s.vol[t];
+                }
+            double thr = 0.9 * s.mat.sigma_max;
+            int near = 0;
+            for (int n = 0; n < s.n_nodes; n++) {
+                double S[9];
                 for (int k = 0; k < 9; k++)
-                    a[k] += s.vol[t] * s.sigma[9 * t + k];
-                a[9] += s.vol[t];
+                    S[k] = avg[10 * n + k] / avg[10 * n + 9];
+                value[n] = jacobi_max_eigenvalue(S);
+                near += fabs(value[n] - thr) <= 1e-9 * thr;
             }
-        double thr = 0.9 * s.mat.sigma_max;
-        int near = 0;
-        for (int n = 0; n < s.n_nodes; n++) {
-            double S[9];
-            for (int k = 0; k < 9; k++)
-                S[k] = avg[10 * n + k] / avg[10 * n + 9];
-            value[n] = jacobi_max_eigenvalue(S);
-            near += fabs(value[n] - thr) <= 1e-9 * thr;
+            assert_int_equal(near, 0);
+            cf_int_list want = {0}, got = {0};
+            for (int t = 0; t < s.n_tets; t++)
+                for (int k = 0; k < 4; k++) {
+                    int f = s.tet_facet[4 * t + k], ok = 1;
+                    if (s.facet[4 * f] != t || s.facet[4 * f + 2] < 0)
+                        continue; /* a boundary facet, or seen from its other tet */
+                    for (int j = 0; j < 3; j++)
+                        ok &= value[s.tet[4 * t + CF_TET_FACE[k][j]]] >= thr;
+                    if (ok)
+                        assert_int_equal(cf_int_list_push(&want, f), 0);
+                }
+            memset(s.hot, 1, (size_t)s.n_tets);
+            int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, NULL, &got);
+            printf("FIGURE source rule: %d tets, level %d: %d facets by brute force, %d by the "
+                   "check\n", s.n_tets, level, want.n, n);
+            assert_int_equal(n, want.n);
+            for (int i = 0; i < n; i++)
+                assert_int_equal(got.v[i], want.v[i]);
+            checked += n > 0;
+            free(all), free(avg), free(value), free(want.v), free(got.v);
+            cf_solid_free(&s);
         }
-        assert_int_equal(near, 0);
-        cf_int_list want = {0}, got = {0};
-        for (int t = 0; t < s.n_tets; t++)
-            for (int k = 0; k < 4; k++) {
-                int f = s.tet_facet[4 * t + k], ok = 1;
-                if (s.facet[4 * f] != t || s.facet[4 * f + 2] < 0)
-                    continue; /* a boundary facet, or seen from its other tet */
-                for (int j = 0; j < 3; j++)
-                    ok &= value[s.tet[4 * t + CF_TET_FACE[k][j]]] >= thr;
-                if (ok)
-                    assert_int_equal(cf_int_list_push(&want, f), 0);
-            }
-        memset(s.hot, 1, (size_t)s.n_tets);
-        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, NULL, &got);
-        printf("FIGURE source rule: level %d: %d facets by brute force, %d by the check\n", level,
-               want.n, n);
-        assert_int_equal(n, want.n);
-        for (int i = 0; i < n; i++)
-            assert_int_equal(got.v[i], want.v[i]);
-        checked += n > 0;
-        free(all), free(avg), free(value), free(want.v), free(got.v);
-        cf_solid_free(&s);
+        assert_true(checked >= 2); /* some levels really insert */
+        cf_mesh_free(&m);
     }
-    assert_true(checked >= 2); /* some levels really insert */
-    cf_mesh_free(&m);
+}
+
+/* cf_flagged_chunks keeps exactly the flagged items, in order, the same
+ * list on one thread and on two: items of a shuffled list, and a range. */
+static void test_flagged_chunks_keep_order(void **state)
+{
+    (void)state;
+    enum { N = 200003, LO = 17 };
+    unsigned char *flag = malloc(N + LO);
+    int *v = malloc(N * sizeof(int)), *want = malloc(N * sizeof(int)),
+        *got = malloc(N * sizeof(int));
+    unsigned r = 12345;
+    for (int i = 0; i < N + LO; i++) {
+        r = r * 1103515245u + 12345u;
+        flag[i] = (r >> 16) % 7 == 0; /* about one in seven */
+    }
+    for (int i = 0; i < N; i++)
+        v[i] = N - 1 - i;
+    for (int i = N - 1; i > 0; i--) { /* Fisher-Yates */
+        r = r * 1103515245u + 12345u;
+        int j = (int)((r >> 8) % (unsigned)(i + 1)), t = v[i];
+        v[i] = v[j], v[j] = t;
+    }
+    int threads = omp_get_max_threads();
+    for (int list = 0; list < 2; list++) {
+        int nw = 0;
+        for (int i = 0; i < N; i++) {
+            int item = list ? v[i] : LO + i;
+            if (flag[item])
+                want[nw++] = item;
+        }
+        for (int t = 1; t <= 2; t++) {
+            omp_set_num_threads(t);
+            memset(got, 0xff, N * sizeof(int));
+            int n = cf_flagged_chunks(list ? v : NULL, LO, N, flag, 1, got);
+            assert_int_equal(n, nw);
+            assert_memory_equal(got, want, (size_t)nw * sizeof(int));
+        }
+        assert_true(nw > N / 10 && nw < N / 5);
+    }
+    omp_set_num_threads(threads);
+    assert_int_equal(cf_flagged_chunks(NULL, 0, 0, flag, 1, got), 0);
+    free(flag), free(v), free(want), free(got);
 }
 
 /* Bars sorted by their ends, for comparing bar sets. */
@@ -1384,6 +1435,7 @@ int main(void)
         cmocka_unit_test(test_criterion_selects_facets_normal_to_tension),
         cmocka_unit_test(test_bound_never_misses_a_facet),
         cmocka_unit_test(test_source_rule_equals_brute_force),
+        cmocka_unit_test(test_flagged_chunks_keep_order),
         cmocka_unit_test(test_fronts_close_no_small_piece),
         cmocka_unit_test(test_front_moves_no_faster_than_its_speed),
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
