@@ -181,6 +181,9 @@ cf_status cf_visual_embed(const cf_world_def *def, const cf_body_source *src,
             break;
         }
         cf_body_place(bd, &meshes->bodies[b], s.v, s.n_verts, &V[3 * v0]); /* as the mesh */
+        /* Each triangle on its own: on the threads, the same tets.  The
+         * 70,000 triangles of `make run`'s bunny took a tenth of its run. */
+#pragma omp parallel for schedule(dynamic, 256)
         for (int i = 0; i < s.n_tris; i++) {
             double c[3] = {0, 0, 0};
             for (int j = 0; j < 3; j++) {
