@@ -456,7 +456,8 @@ static void test_source_rule_equals_brute_force(void **state)
                         assert_int_equal(cf_int_list_push(&want, f), 0);
                 }
             memset(s.hot, 1, (size_t)s.n_tets);
-            int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, NULL, &got);
+            int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets,
+                                            NULL, &got);
             printf("FIGURE source rule: %d tets, level %d: %d facets by brute force, %d by the "
                    "check\n", s.n_tets, level, want.n, n);
             assert_int_equal(n, want.n);

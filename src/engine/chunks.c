@@ -13,6 +13,13 @@ static long chunking(int n, int *count)
     return size;
 }
 
+/* One past the last item of chunk c. */
+static int chunk_end(int c, long size, int n)
+{
+    long i1 = (c + 1) * size;
+    return (int)(i1 < n ? i1 : n);
+}
+
 void cf_sum_chunks(int n, int w, int threads, cf_chunk_sum_fn *sum, void *ctx, double *out)
 {
     int count;
@@ -20,10 +27,8 @@ void cf_sum_chunks(int n, int w, int threads, cf_chunk_sum_fn *sum, void *ctx, d
     double part[CF_CHUNKS_MAX][CF_SUMS_MAX];
     memset(part, 0, sizeof part);
     CF_PARALLEL(threads && count > 1, "omp parallel for schedule(static)",
-        for (int c = 0; c < count; c++) {
-            long i1 = (c + 1) * size;
-            sum(ctx, (int)(c * size), (int)(i1 < n ? i1 : n), part[c]);
-        });
+        for (int c = 0; c < count; c++)
+            sum(ctx, (int)(c * size), chunk_end(c, size, n), part[c]););
     for (int k = 0; k < w; k++) {
         out[k] = 0;
         for (int c = 0; c < count; c++)
@@ -38,17 +43,15 @@ int cf_flagged_chunks(const int *v, int lo, int n, const unsigned char *flag, in
     long size = chunking(n, &count);
 #define CF_ITEM_(i) (v ? v[i] : lo + (i))
     CF_PARALLEL(threads && count > 1, "omp parallel for schedule(static)",
-        for (int c = 0; c < count; c++) {
-            int i1 = (int)((c + 1) * size < n ? (c + 1) * size : n);
-            for (int i = (int)(c * size); i < i1; i++)
-                at[c + 1] += flag[CF_ITEM_(i)] != 0;
-        });
+        for (int c = 0; c < count; c++)
+            for (int i = (int)(c * size); i < chunk_end(c, size, n); i++)
+                at[c + 1] += flag[CF_ITEM_(i)] != 0;);
     for (int c = 0; c < count; c++)
         at[c + 1] += at[c];
     CF_PARALLEL(threads && count > 1, "omp parallel for schedule(static)",
         for (int c = 0; c < count; c++) {
-            int i1 = (int)((c + 1) * size < n ? (c + 1) * size : n), k = at[c];
-            for (int i = (int)(c * size); i < i1; i++)
+            int k = at[c];
+            for (int i = (int)(c * size); i < chunk_end(c, size, n); i++)
                 if (flag[CF_ITEM_(i)])
                     out[k++] = CF_ITEM_(i);
         });

@@ -20,7 +20,9 @@ typedef struct cf_bars {
     int n_colors;       /* colour groups used */
     int *color_start;   /* [CF_BARS_COLORS + 2]: bars of colour c are color_start[c] ..
                            color_start[c+1] - 1; the serial group from
-                           color_start[CF_BARS_COLORS] to n - 1 */
+                           color_start[CF_BARS_COLORS] to n - 1; NULL where the
+                           fragment keeps no bars, as no step reads them
+                           (cf_world_reads_bars): patched and split as none */
     int *ends;          /* [n][2] node indices, ascending pairs, grouped by colour */
     double *rest;       /* [n] m */
     double *compliance; /* [n] m/N */
@@ -46,9 +48,6 @@ typedef struct cf_bars_scratch {
     unsigned char *colour;
 } cf_bars_scratch;
 void cf_bars_scratch_free(cf_bars_scratch *w);
-
-/* A fragment keeps bars only where a step reads them (cf_world_reads_bars):
- * an empty cf_bars (color_start NULL) is patched and split as no bars. */
 
 /* The bars after node duplication, patched where the mesh changed instead
  * of rebuilt: the bars at the `touched` nodes (the nodes whose star of tets
