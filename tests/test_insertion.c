@@ -1283,6 +1283,12 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
             for (int j = i + 1; j < 4; j++)
                 assert_int_equal(s.edge_cracks[6 * t + edge[i][j]],
                                  cracked_on_edge(&s, s.tet0[4 * t + i], s.tet0[4 * t + j]));
+    /* and the faces the criterion asks: interior, owned, not cracked */
+    for (int t = 0; t < s.n_tets; t++)
+        for (int k = 0; k < 4; k++) {
+            const int f = s.tet_facet[4 * t + k], *F = &s.facet[4 * f];
+            assert_int_equal(s.tet_open[t] >> k & 1, F[2] >= 0 && F[0] == t && !s.cracked[f]);
+        }
     free(all);
     cf_solid_free(&s), cf_mesh_free(&m);
     return cooler;

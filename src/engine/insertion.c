@@ -292,22 +292,36 @@ static double front_threshold(const cf_solid *s, int ta, int k, int j, double th
     return s->front_K > 0 ? fmin(threshold, cf_front_toughness(s, ta, k, j)) : threshold;
 }
 
+/* The vertices of face k of tet ta, an uncracked facet, that may lie ahead
+ * of a front, as bits 1 << j (j the corner in CF_TET_FACE[k]): marked, and
+ * the edge off them cracked (any cracked facet on it is another, as this
+ * one is not).  Only the tet's own bytes, no facet's. */
+static unsigned ahead_of_fronts(const cf_solid *s, int ta, int k)
+{
+    const int *K = CF_TET_FACE[k];
+    unsigned ahead = 0;
+    for (int j = 0; j < 3; j++)
+        if (s->node_mark[s->tet[4 * ta + K[j]]] &&
+            s->edge_cracks[6 * ta + CF_TET_EDGE[K[(j + 1) % 3]][K[(j + 2) % 3]]])
+            ahead |= 1u << j;
+    return ahead;
+}
+
 /* The source's rule at a crack front (docs/physics.md §5.1): face k of tet
  * ta shares an edge with a cracked facet, and its vertex off that edge,
- * the one ahead of the front, reaches the threshold.  The two vertices on
- * the edge sit on the crack, whose faces carry no traction, so their
- * averages read half a star of unloaded tets: the stress ahead of the front
- * is the third vertex's. */
-static int front_rule(const cf_solid *s, int ta, int k, double threshold)
+ * the one ahead of the front, reaches the threshold; `ahead` holds the
+ * vertices that may (ahead_of_fronts).  The two vertices on the edge sit
+ * on the crack, whose faces carry no traction, so their averages read half
+ * a star of unloaded tets: the stress ahead of the front is the third
+ * vertex's. */
+static int front_rule(const cf_solid *s, int ta, int k, unsigned ahead, double threshold)
 {
-    int f = s->tet_facet[4 * ta + k];
     for (int j = 0; j < 3; j++) {
-        int n = s->tet[4 * ta + CF_TET_FACE[k][j]];
-        /* The cheap tests first: the mark, the edge, the vertex's lowest
-         * front floor; then the threshold's square root. */
-        if (!s->node_mark[n] ||
-            !edge_cracked(s, f, ta, CF_TET_FACE[k][(j + 1) % 3], CF_TET_FACE[k][(j + 2) % 3]))
+        if (!(ahead >> j & 1))
             continue;
+        /* The vertex's lowest front floor first, then the threshold's
+         * square root. */
+        int n = s->tet[4 * ta + CF_TET_FACE[k][j]];
         double v = s->nodal[n]; /* a NaN passes, as in source_rule */
         if (v < threshold && ((s->vert_front_active && v < s->vert_front_active[s->origin[n]]) ||
                               v < front_threshold(s, ta, k, j, threshold)))
@@ -330,19 +344,26 @@ static unsigned char qualifying_faces(const cf_solid *s, int ta, cf_criterion ru
     if (rule != CF_CRITERION_SOURCE && mark[T[0]] + mark[T[1]] + mark[T[2]] + mark[T[3]] < 3)
         return 0;
     double smax = s->mat.sigma_max, tmax = s->mat.tau_max;
-    unsigned char bits = 0;
+    unsigned char bits = 0, open = s->tet_open[ta];
     for (int k = 0; k < 4; k++) {
-        int f = s->tet_facet[4 * ta + k];
-        const int *F = &s->facet[4 * f];
-        if (F[2] < 0 || s->cracked[f] || F[0] != ta || (s->candidate && !s->candidate[f]))
+        if (!(open >> k & 1)) /* not an uncracked candidate facet that ta owns */
             continue;
-        double w = s->strength ? s->strength[f] : 1.0; /* this facet's strength */
         if (rule == CF_CRITERION_SOURCE) {
-            double th = source_threshold(smax, w);
-            bits |= (unsigned char)((source_rule(s, ta, k, th) || front_rule(s, ta, k, th)) << k);
+            /* Both rules need marked nodes: the facet's strength is read
+             * only where they are. */
+            const int *K = CF_TET_FACE[k];
+            unsigned ahead = ahead_of_fronts(s, ta, k);
+            if (!ahead && !(mark[T[K[0]]] && mark[T[K[1]]] && mark[T[K[2]]]))
+                continue;
+            int f = s->tet_facet[4 * ta + k];
+            double th = source_threshold(smax, s->strength ? s->strength[f] : 1.0);
+            bits |= (unsigned char)((source_rule(s, ta, k, th) ||
+                                     front_rule(s, ta, k, ahead, th)) << k);
             continue;
         }
-        if (!s->hot[ta] && !s->hot[F[2]]) /* the mean stress is below both bounds */
+        int f = s->tet_facet[4 * ta + k];
+        double w = s->strength ? s->strength[f] : 1.0; /* this facet's strength */
+        if (!s->hot[ta] && !s->hot[s->facet[4 * f + 2]]) /* the mean stress is below both bounds */
             continue;
         double sn, tau;
         facet_traction(s, ta, k, &sn, &tau);
@@ -615,6 +636,11 @@ void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked)
     face_vertices(s, F[0], F[1], o);
     int d = (int)cracked - (int)s->cracked[f];
     s->cracked[f] = cracked;
+    unsigned char bit = (unsigned char)(1u << F[1]);
+    if (cracked)
+        s->tet_open[F[0]] &= (unsigned char)~bit;
+    else if (F[2] >= 0 && (!s->candidate || s->candidate[f]))
+        s->tet_open[F[0]] |= bit;
     /* a facet marked again (taken, then opened) changes nothing on its edges */
     for (int i = 0; d && i < 3; i++)
         crack_edge(s, f, o[(i + 1) % 3], o[(i + 2) % 3], d, d > 0 && s->vert_front_active);

@@ -68,12 +68,16 @@ static int build_facets(cf_solid *s)
     free(k);
     s->n_facets = nf;
     s->cracked = calloc((size_t)nf, 1);
+    s->tet_open = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), 1);
+    for (int f = 0; s->tet_open && f < nf; f++)
+        if (s->facet[4 * f + 2] >= 0)
+            s->tet_open[s->facet[4 * f]] |= (unsigned char)(1u << s->facet[4 * f + 1]);
     s->edge_cracks = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), 6);
     s->crack_time = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
     s->contact_key = calloc((size_t)(nf > 0 ? nf : 1), sizeof(uint64_t));
     s->contact_kind = calloc((size_t)(nf > 0 ? nf : 1), 1);
     s->contact_until = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
-    return s->cracked && s->edge_cracks && s->crack_time && s->contact_key && s->contact_kind &&
+    return s->cracked && s->tet_open && s->edge_cracks && s->crack_time && s->contact_key && s->contact_kind &&
                    s->contact_until
                ? 0
                : -1;
@@ -511,7 +515,7 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->nodal_stress, s->nodal_check, s->vert_check, s->vert_node, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh,
+                    s->cracked, s->tet_open, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until,
                     s->bv_eta, s->bv_rate, s->bv_work};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)

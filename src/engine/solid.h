@@ -102,6 +102,10 @@ typedef struct cf_solid {
     int *facet;               /* [nf][4] tetA, faceA, tetB, faceB (tetB = -1 on the boundary) */
     int *tet_facet;           /* [nt][4] facet of face k */
     unsigned char *cracked;   /* [nf] */
+    unsigned char *tet_open;  /* [nt] bit k: face k of the tet is an interior facet it
+                                 owns (facet[4 f] == t), not cracked, and a candidate:
+                                 the faces the criterion asks of it, without reading
+                                 the facets (cf_mark_cracked keeps it) */
     unsigned char *edge_cracks; /* [nt][6] the cracked facets holding each edge of the
                                  tet (corners 01 02 03 12 13 23): an edge's count,
                                  kept in every tet around it */
