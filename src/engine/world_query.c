@@ -449,7 +449,7 @@ void cf_world_memory(const cf_world *w, cf_memory *m)
                ((unsigned long long)s->n_verts0 + 1 + 4 * nt) * I + (s->ep ? nt * 7 * D : 0) +
                (s->bv_eta ? nt * 3 * D : 0); /* the bulk viscosity's eta, rate, work */
     if (s->facet)
-        m->fracture = nt * (9 * D + 2 + 6 + 20 * I) + cn * (1 + 7 * D + sizeof(unsigned)) +
+        m->fracture = nt * (9 * D + 3 + 6 + 20 * I) + cn * (1 + 7 * D + sizeof(unsigned)) +
                       (unsigned long long)s->n_facets * (1 + (s->candidate != NULL)) +
                       (unsigned long long)s->n_verts0 * (sizeof(unsigned) + sizeof(int)) +
                       (s->vert_front_active ? (unsigned long long)s->n_verts0 * (sizeof(float) + 1) +
