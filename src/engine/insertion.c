@@ -636,11 +636,7 @@ void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked)
     face_vertices(s, F[0], F[1], o);
     int d = (int)cracked - (int)s->cracked[f];
     s->cracked[f] = cracked;
-    unsigned char bit = (unsigned char)(1u << F[1]);
-    if (cracked)
-        s->tet_open[F[0]] &= (unsigned char)~bit;
-    else if (F[2] >= 0 && (!s->candidate || s->candidate[f]))
-        s->tet_open[F[0]] |= bit;
+    cf_solid_update_open(s, f);
     /* a facet marked again (taken, then opened) changes nothing on its edges */
     for (int i = 0; d && i < 3; i++)
         crack_edge(s, f, o[(i + 1) % 3], o[(i + 2) % 3], d, d > 0 && s->vert_front_active);

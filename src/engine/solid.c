@@ -31,6 +31,16 @@ static void sort3(int v[3])
     if (v[0] > v[1]) t = v[0], v[0] = v[1], v[1] = t;
 }
 
+void cf_solid_update_open(cf_solid *s, int f)
+{
+    const int *F = &s->facet[4 * f];
+    unsigned char bit = (unsigned char)(1u << F[1]);
+    if (F[2] >= 0 && !s->cracked[f] && (!s->candidate || s->candidate[f]))
+        s->tet_open[F[0]] |= bit;
+    else
+        s->tet_open[F[0]] &= (unsigned char)~bit;
+}
+
 /* Facets by sorting the 4 faces of every tet on their vertex triple. */
 static int build_facets(cf_solid *s)
 {
@@ -69,9 +79,8 @@ static int build_facets(cf_solid *s)
     s->n_facets = nf;
     s->cracked = calloc((size_t)nf, 1);
     s->tet_open = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), 1);
-    for (int f = 0; s->tet_open && f < nf; f++)
-        if (s->facet[4 * f + 2] >= 0)
-            s->tet_open[s->facet[4 * f]] |= (unsigned char)(1u << s->facet[4 * f + 1]);
+    for (int f = 0; s->cracked && s->tet_open && f < nf; f++)
+        cf_solid_update_open(s, f);
     s->edge_cracks = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), 6);
     s->crack_time = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
     s->contact_key = calloc((size_t)(nf > 0 ? nf : 1), sizeof(uint64_t));

@@ -105,7 +105,7 @@ typedef struct cf_solid {
     unsigned char *tet_open;  /* [nt] bit k: face k of the tet is an interior facet it
                                  owns (facet[4 f] == t), not cracked, and a candidate:
                                  the faces the criterion asks of it, without reading
-                                 the facets (cf_mark_cracked keeps it) */
+                                 the facets (kept by cf_solid_update_open) */
     unsigned char *edge_cracks; /* [nt][6] the cracked facets holding each edge of the
                                  tet (corners 01 02 03 12 13 23): an edge's count,
                                  kept in every tet around it */
@@ -219,6 +219,11 @@ cf_status cf_solid_init_bulk_viscosity(cf_solid *s, double b1, cf_error *err);
  * crack flags and the stress of the checks: the fracture state, built only for a scene that may insert
  * cohesive elements (criterion other than "none").  Errors: CF_ERR_NOMEM. */
 cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
+
+/* Facet f's bit in s->tet_open, from what it is now: set where it is
+ * interior, not cracked and a candidate (s->candidate NULL: every one).
+ * Whoever changes s->cracked or s->candidate calls it. */
+void cf_solid_update_open(cf_solid *s, int f);
 
 /* A crack front's threshold from the toughness (solver.front_threshold
  * "toughness", docs/physics.md §5.1): s->front_K = K_IC = sqrt(E G_I) (Pa

@@ -192,8 +192,7 @@ static cf_status select_crack_plane(cf_world *w, cf_error *err)
             on = fabs(v3_dot(d, set->crack_plane_normal)) <= set->crack_plane_tolerance;
         }
         s->candidate[fc] = (unsigned char)on;
-        if (!on)
-            s->tet_open[F[0]] &= (unsigned char)~(1u << F[1]);
+        cf_solid_update_open(s, fc);
         n += on;
     }
     if (n == 0)
