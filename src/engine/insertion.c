@@ -273,11 +273,17 @@ static int slot_of(const cf_solid *s, int t, int o)
 static const unsigned char CF_TET_EDGE[4][4] = {{0, 0, 1, 2}, {0, 0, 3, 4}, {1, 3, 0, 5},
                                                {2, 4, 5, 0}};
 
+/* How many cracked facets hold the edge of corners i and j of tet t. */
+static int edge_count(const cf_solid *s, int t, int i, int j)
+{
+    return s->edge_cracks[6 * t + CF_TET_EDGE[i][j]];
+}
+
 /* Whether a cracked facet other than f holds the edge of corners i and j
  * of tet t, which facet f holds. */
 static int edge_cracked(const cf_solid *s, int f, int t, int i, int j)
 {
-    return s->edge_cracks[6 * t + CF_TET_EDGE[i][j]] > s->cracked[f];
+    return edge_count(s, t, i, j) > s->cracked[f];
 }
 
 /* The threshold of the vertex at corner j of face k of tet ta as the vertex
@@ -301,8 +307,7 @@ static unsigned ahead_of_fronts(const cf_solid *s, int ta, int k)
     const int *K = CF_TET_FACE[k];
     unsigned ahead = 0;
     for (int j = 0; j < 3; j++)
-        if (s->node_mark[s->tet[4 * ta + K[j]]] &&
-            s->edge_cracks[6 * ta + CF_TET_EDGE[K[(j + 1) % 3]][K[(j + 2) % 3]]])
+        if (s->node_mark[s->tet[4 * ta + K[j]]] && edge_count(s, ta, K[(j + 1) % 3], K[(j + 2) % 3]))
             ahead |= 1u << j;
     return ahead;
 }
