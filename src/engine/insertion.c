@@ -307,7 +307,8 @@ static unsigned ahead_of_fronts(const cf_solid *s, int ta, int k)
     const int *K = CF_TET_FACE[k];
     unsigned ahead = 0;
     for (int j = 0; j < 3; j++)
-        if (s->node_mark[s->tet[4 * ta + K[j]]] && edge_count(s, ta, K[(j + 1) % 3], K[(j + 2) % 3]))
+        if (s->node_mark[s->tet[4 * ta + K[j]]] &&
+            edge_count(s, ta, K[(j + 1) % 3], K[(j + 2) % 3]))
             ahead |= 1u << j;
     return ahead;
 }

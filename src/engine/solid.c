@@ -86,8 +86,8 @@ static int build_facets(cf_solid *s)
     s->contact_key = calloc((size_t)(nf > 0 ? nf : 1), sizeof(uint64_t));
     s->contact_kind = calloc((size_t)(nf > 0 ? nf : 1), 1);
     s->contact_until = calloc((size_t)(nf > 0 ? nf : 1), sizeof(double));
-    return s->cracked && s->tet_open && s->edge_cracks && s->crack_time && s->contact_key && s->contact_kind &&
-                   s->contact_until
+    return s->cracked && s->tet_open && s->edge_cracks && s->crack_time && s->contact_key &&
+                   s->contact_kind && s->contact_until
                ? 0
                : -1;
 }
