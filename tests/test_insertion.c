@@ -736,7 +736,7 @@ static void test_fronts_close_no_small_piece(void **state)
         for (int t = 0; t < s.n_tets; t++) /* hydrostatic tension: every normal */
             s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
         cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4,
-                       rule == 2 ? two_cells : 0, 0, 0};
+                       rule == 2 ? two_cells : 0, 0, 0, 0};
         cracked[rule] = grow(&s, all, g, 1.0, 200);
         least[rule] = smallest_closed_piece(&s, &least_vol[rule]);
         free(all);
@@ -779,7 +779,7 @@ static void test_contact_memo_changes_nothing(void **state)
             if (scene == 0)
                 for (int t = 0; t < s.n_tets; t++)
                     s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
-            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0, 0};
             n[forget] = grow_memo(&s, all, g, scene == 0 ? 1.0 : 0.01, 200, forget);
             nf = s.n_facets;
             cracked[forget] = malloc((size_t)nf), when[forget] = malloc((size_t)nf * sizeof(double));
@@ -816,7 +816,7 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid s;
     int *all = stressed_box(&s, &m, 1.4, 1.0, 100.0);
     double speed = 10.0, dt = 0.01, cell = sqrt(3.0);
-    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0, 0};
     cf_int_list cand = {0}, nodes = {0}, touched = {0};
     double first[3] = {0, 0, 0}, worst = -INFINITY;
     int nuclei = 0, total = 0;
@@ -976,7 +976,7 @@ static void test_fronts_do_not_branch(void **state)
     cf_mark_cracked(&s, f1, 1);
     s.crack_time[f1] = -1e9;
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, 0};
     cf_int_list cand = {0};
     int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, NULL, &cand);
     assert_true(n > 0);
@@ -1019,7 +1019,7 @@ static int *box_with_crack(cf_mesh *m, cf_solid *s, double sy)
  * when `along`); the facets taken, in cand. */
 static int check_fronts(cf_solid *s, const int *all, int along, cf_int_list *cand)
 {
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along, 0};
     int n = cf_insertion_candidates(s, all, s->n_tets, CF_CRITERION_SOURCE, s->n_tets, &g, cand);
     return n > 0 ? cf_insertion_select(s, cand, CF_CRITERION_SOURCE, &g) : n;
 }
@@ -1069,6 +1069,71 @@ static void test_fronts_run_across_the_tension(void **state)
     assert_true(taken[1] >= 1);
     assert_int_equal(below[1], 0);
     assert_true(below[0] >= 1);
+}
+
+/* The rest angle, in degrees, by which facet f turns from facet g across
+ * the edge they share: 0 straight ahead of g, 180 folded back onto it. */
+static double kink_degrees(const cf_solid *s, int f, int g)
+{
+    int of[3], og[3], e[2], n = 0, pf = -1, pg = -1;
+    facet_vertices(s, f, of), facet_vertices(s, g, og);
+    for (int j = 0; j < 3; j++) {
+        if (of[j] != og[0] && of[j] != og[1] && of[j] != og[2])
+            pf = of[j];
+        else if (n < 2)
+            e[n++] = of[j];
+        else
+            n++;
+        if (og[j] != of[0] && og[j] != of[1] && og[j] != of[2])
+            pg = og[j];
+    }
+    assert_int_equal(n, 2);
+    double edge[3], a[3], b[3];
+    v3_sub(&s->X[3 * e[1]], &s->X[3 * e[0]], edge);
+    v3_sub(&s->X[3 * pf], &s->X[3 * e[0]], a), v3_sub(&s->X[3 * pg], &s->X[3 * e[0]], b);
+    double ee = v3_dot(edge, edge), ka = v3_dot(a, edge) / ee, kb = v3_dot(b, edge) / ee;
+    v3_axpy(-ka, edge, a), v3_axpy(-kb, edge, b); /* each facet's direction away from the edge */
+    double phi = acos(v3_dot(a, b) / (v3_norm(a) * v3_norm(b))) * 180 / acos(-1.0);
+    return 180 - phi;
+}
+
+/* A front turns from its crack by at most solver.front_max_kink
+ * (docs/physics.md §5.1 rule 3).  In the box under a uniaxial tension of
+ * 1.5 thresholds with a crack of one facet normal to it, one check of the
+ * source's front rule ("any": every facet across a front edge whose vertex
+ * ahead is loaded) takes facets that turn from the crack by more than 45
+ * degrees; with a limit of 45 degrees the crack still grows, and no facet
+ * it takes turns by more.  Every facet taken is a front of the crack (the
+ * nucleation radius is longer than the box). */
+static void test_fronts_kink_no_further_than_the_limit(void **state)
+{
+    (void)state;
+    int taken[2], sharp[2];
+    double most[2];
+    for (int limit = 0; limit < 2; limit++) {
+        cf_mesh m;
+        cf_solid s;
+        int *all = box_with_crack(&m, &s, 1.35), f0 = middle_facet(&s);
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, limit ? acos(-1.0) / 4 : 0};
+        cf_int_list cand = {0};
+        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
+                                        &cand);
+        n = n > 0 ? cf_insertion_select(&s, &cand, CF_CRITERION_SOURCE, &g) : n;
+        taken[limit] = n, sharp[limit] = 0, most[limit] = 0;
+        for (int i = 0; i < n; i++) {
+            double k = kink_degrees(&s, cand.v[i], f0);
+            sharp[limit] += k > 45 + 1e-9;
+            most[limit] = fmax(most[limit], k);
+        }
+        free(cand.v), free(all);
+        cf_solid_free(&s), cf_mesh_free(&m);
+    }
+    printf("FIGURE front kink: no limit %d facets taken, %d turning by more than 45 deg (at "
+           "most %.1f); limit 45 deg %d taken, %d (at most %.1f)\n",
+           taken[0], sharp[0], most[0], taken[1], sharp[1], most[1]);
+    assert_true(sharp[0] >= 1);
+    assert_true(taken[1] >= 1);
+    assert_int_equal(sharp[1], 0);
 }
 
 /* A front's rank reads only this check's nodal values (facet_ratio): a
@@ -1196,7 +1261,7 @@ static void test_values_exact_from_the_floor_take_the_same_facets(void **state)
             cf_mesh m;
             cf_solid s;
             int *all = weibull_box_with_crack(&s, &m, strength);
-            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1};
+            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0};
             cf_int_list cand = {0};
             int nc = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets,
                                              exact_from_floor ? &g : NULL, &cand);
@@ -1247,7 +1312,7 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
         cf_insertion_init_front_floors(&s);
     int cooler = 0;
     for (int round = 0; round < 3; round++) {
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0};
         cf_stress_check bound = cf_insertion_bound(&s, CF_CRITERION_SOURCE);
         int n_hot = s.n_tets;
         if (floors && weibull) /* the kernel's flags */
@@ -1448,6 +1513,7 @@ int main(void)
         cmocka_unit_test(test_front_rule_reads_the_stress_ahead),
         cmocka_unit_test(test_fronts_do_not_branch),
         cmocka_unit_test(test_fronts_run_across_the_tension),
+        cmocka_unit_test(test_fronts_kink_no_further_than_the_limit),
         cmocka_unit_test(test_values_exact_from_the_floor_take_the_same_facets),
         cmocka_unit_test(test_front_rank_reads_this_check_only),
         cmocka_unit_test(test_front_threshold_from_the_toughness),

@@ -40,6 +40,7 @@ typedef enum {
 #define CF_R_ITERATIONS 1.0, CF_MAX_ITERATIONS, 1, 1, NULL
 #define CF_R_PIECE_TETS 0.0, CF_MAX_PIECE_TETS, 1, 1, NULL
 #define CF_R_FRICTION_ANGLE 0.0, 60.0, 1, 1, NULL
+#define CF_R_KINK 0.0, 180.0, 0, 1, NULL
 #define CF_R_POISSON -1.0, 0.5, 0, 0, "(Poisson's ratio of a stable isotropic solid)"
 #define CF_R_PPR_SHAPE                                                                         \
     1.0, INFINITY, 0, 0, "(the PPR cohesive law needs shape parameters alpha, beta > 1)"
@@ -138,6 +139,9 @@ typedef enum {
     X("solver", "front_threshold", ENUM, solver.front_threshold, 0, NULL, cf_names_front_threshold, \
       CF_R_NONE, "",                                                                           \
       "a front's threshold: the strength's, or at most the toughness's (docs/physics.md 5.1)") \
+    X("solver", "front_max_kink", NUM, solver.front_max_kink, 180, NULL, NULL, CF_R_KINK,      \
+      "degree", "fronts: the most a front may turn from the crack facet it extends "          \
+      "(docs/physics.md 5.1); 180 no limit")                                                   \
     X("solver", "obstacle_contact", ENUM, solver.obstacle_contact, 0, NULL,                   \
       cf_names_obstacle_contact, CF_R_NONE, "",                                                \
       "explicit runs: project nodes onto obstacles, or a penalty force (docs/physics.md 7.1)") \

@@ -146,6 +146,9 @@ typedef struct cf_solver_settings {
     cf_crack_growth crack_growth;
     cf_front_direction front_direction;
     cf_front_threshold front_threshold;
+    double front_max_kink;        /* degrees, (0, 180]: the most a front may turn from the
+                                     crack facet it extends (docs/physics.md §5.1); 180:
+                                     no limit */
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
     double min_piece_size;        /* m: nor one whose equal-volume sphere is narrower;

@@ -797,17 +797,53 @@ static double centroid_distance(const cf_solid *s, const double c[3], const int 
     return v3_norm(d);
 }
 
+/* Unit vector in the rest plane of the edge e0-e1 and vertex p, normal to
+ * the edge, pointing to p. */
+static void away_from_edge(const cf_solid *s, int e0, int e1, int p, double u[3])
+{
+    double e[3], d[3];
+    v3_sub(&s->X[3 * e1], &s->X[3 * e0], e);
+    v3_sub(&s->X[3 * p], &s->X[3 * e0], d);
+    double along = v3_dot(d, e) / v3_dot(e, e);
+    for (int k = 0; k < 3; k++)
+        u[k] = d[k] - along * e[k];
+    double n = v3_norm(u);
+    for (int k = 0; k < 3; k++)
+        u[k] /= n;
+}
+
+/* Whether facet f (original vertices o) continues cracked facet g (og)
+ * across their shared edge, the one opposite o[off], turning from g's
+ * plane by at most max_kink (rad, rest shape; 0: any turn): a facet
+ * straight ahead of g turns by 0, one folded back onto it by pi. */
+static int within_kink(const cf_solid *s, const int o[3], int off, const int og[3],
+                       double max_kink)
+{
+    if (max_kink <= 0)
+        return 1;
+    int e0 = o[(off + 1) % 3], e1 = o[(off + 2) % 3], pg = og[0];
+    for (int p = 0; p < 3; p++)
+        if (og[p] != e0 && og[p] != e1)
+            pg = og[p];
+    double uf[3], ug[3];
+    away_from_edge(s, e0, e1, o[off], uf);
+    away_from_edge(s, e0, e1, pg, ug);
+    return -v3_dot(uf, ug) >= cos(max_kink);
+}
+
 /* How facet f (original vertices o, rest centroid c) meets the cracks at
  * time t: CF_FRONT when one of its edges is the edge of exactly one cracked
  * facet (the crack surface ends there: a front), inserted at least d / speed
  * earlier (d between their rest centroids: a front moves no faster than
- * `speed`); CF_TOUCH when it meets a cracked facet otherwise (at a vertex,
+ * `speed`), from whose plane f turns by at most max_kink (rad; 0 any);
+ * CF_TOUCH when it meets a cracked facet otherwise (at a vertex,
  * across an edge the crack reached too recently, this check's insertions
- * included, or across an edge inside a crack surface, which two cracked
- * facets already share: a branch); CF_CLEAR when it meets none. */
+ * included, across an edge inside a crack surface, which two cracked
+ * facets already share: a branch, or across an edge where the crack would
+ * kink further); CF_CLEAR when it meets none. */
 enum { CF_CLEAR, CF_TOUCH, CF_FRONT };
 static int crack_contact(cf_solid *s, int f, const int o[3], const double c[3], double t,
-                         double speed)
+                         double speed, double max_kink)
 {
     /* The answer holds while no facet on f's vertices cracks: a front stays
      * a front, and a facet that only touches stays so until a crack on one
@@ -849,6 +885,9 @@ static int crack_contact(cf_solid *s, int f, const int o[3], const double c[3], 
                     /* when it may be ready, a little early (the test's rounding) */
                     at[off] = s->crack_time[g] + wait;
                     at[off] -= 1e-12 * (fabs(at[off]) + wait) + 1e-300;
+                    /* a front that would kink too far never is one */
+                    if (!within_kink(s, o, off, og, max_kink))
+                        ready[off] = 0, at[off] = INFINITY;
                 } else if (first[off] != g) {
                     n_edge[off] = 2;
                 }
@@ -932,7 +971,7 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
             double c[3];
             face_vertices(s, s->facet[4 * f], s->facet[4 * f + 1], o);
             centroid(s, o, c);
-            int kind = crack_contact(s, f, o, c, g->t, g->front_speed);
+            int kind = crack_contact(s, f, o, c, g->t, g->front_speed, g->max_kink);
             double q = 0;
             if (kind == CF_FRONT && g->along_stress && rule == CF_CRITERION_SOURCE)
                 q = front_stress_ratio(s, f), kind = q >= 1 ? kind : CF_TOUCH;
@@ -960,7 +999,7 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
         double c[3], q = r[i].ratio;
         face_vertices(s, ta, s->facet[4 * f + 1], o);
         centroid(s, o, c);
-        int contact = crack_contact(s, f, o, c, g->t, g->front_speed);
+        int contact = crack_contact(s, f, o, c, g->t, g->front_speed, g->max_kink);
         /* A crack shields a radius that shrinks as 1/ratio^2 (Irwin: the
          * flaw that is critical at a stress sigma grows as
          * l_ch (sigma_max / sigma)^2), so an overloaded solid still

@@ -38,6 +38,8 @@ typedef struct cf_growth {
     int along_stress;      /* a front takes only a facet whose normal stress reaches its
                               threshold (solver.front_direction "stress"; criterion
                               source) */
+    double max_kink;       /* rad: the most a front turns from the cracked facet on its
+                              edge (solver.front_max_kink); 0: any */
 } cf_growth;
 
 /* Insertion criterion on the interior, uncracked facets of `tets` (a

@@ -167,6 +167,10 @@
  *       threshold, or at most K_IC / sqrt(2 pi r), K_IC = sqrt(E G_I) and r
  *       the rest distance of the vertex ahead from the front's edge: the
  *       field of a crack tip at the toughness (docs/physics.md §5.1)
+ *     front_max_kink [180] degrees, (0, 180]: with "fronts", the most a
+ *       front may turn from the crack facet whose edge it extends (in the
+ *       rest shape; 0 straight ahead, 180 folded back onto it); 180: any
+ *       (docs/physics.md §5.1)
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
