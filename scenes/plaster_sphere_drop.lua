@@ -1,8 +1,10 @@
--- A gypsum plaster sphere strikes a rigid floor: the drop ladder of Wu,
+-- A gypsum plaster sphere strikes a rigid floor: the drop ladder after Wu,
 -- Chau and Yu (Powder Technology 2004), who broke more than 140 plaster
--- spheres of 50-75 mm at 1-9 m/s.  The sphere (50 mm here) starts 0.5 mm
--- above the floor at the impact speed (5 m/s here); the run ends 4 ms
--- later, when the pieces have left the floor.
+-- spheres of 50-75 mm at 1-9 m/s (theirs lay on an anvil and a falling
+-- weight struck them, docs/physics.md §15 and §14.35; here the sphere
+-- itself falls, so that a threshold speed exists).  The sphere (50 mm
+-- here) starts 0.5 mm above the floor at the impact speed (5 m/s here);
+-- the run ends 4 ms later, when the pieces have left the floor.
 -- Material: the plaster of plaster_bunny_drop.lua (E 5 GPa, nu 0.2,
 -- rho 1200 kg/m^3, tensile strength 2 MPa with a Weibull strength field
 -- correlated over l_ch, G_I 10 N/m, compressive strength 15 MPa), whose

@@ -5,8 +5,10 @@ usage: fragmentation.py COHFRAC [--size ci|full] [--seeds N] [-o DIR] [-j N]
                           [--known FILE] [--set KEY=VALUE ...]
 
 Runs scenes/plaster_sphere_drop.lua (a gypsum plaster sphere striking a
-rigid floor) as Wu, Chau and Yu (Powder Technology 2004) dropped theirs:
-spheres of 50 and 75 mm at 1-9 m/s and more, and checks
+rigid floor) after Wu, Chau and Yu (Powder Technology 2004), who broke
+spheres of 50 and 75 mm at 1-9 m/s (struck on an anvil by a falling
+weight, docs/physics.md section 15), at their sizes and those speeds and
+more, and checks
   threshold   the threshold speed (the lowest speed of the ladder at which
               the largest piece is below 90 % of the mass, on average over
               the seeds) of the 50 mm
