@@ -804,9 +804,8 @@ static void away_from_edge(const cf_solid *s, int e0, int e1, int p, double u[3]
     double e[3], d[3];
     v3_sub(&s->X[3 * e1], &s->X[3 * e0], e);
     v3_sub(&s->X[3 * p], &s->X[3 * e0], d);
-    double along = v3_dot(d, e) / v3_dot(e, e);
-    for (int k = 0; k < 3; k++)
-        u[k] = d[k] - along * e[k];
+    memcpy(u, d, sizeof d);
+    v3_axpy(-v3_dot(d, e) / v3_dot(e, e), e, u);
     double n = v3_norm(u);
     for (int k = 0; k < 3; k++)
         u[k] /= n;
