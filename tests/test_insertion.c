@@ -736,7 +736,7 @@ static void test_fronts_close_no_small_piece(void **state)
         for (int t = 0; t < s.n_tets; t++) /* hydrostatic tension: every normal */
             s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
         cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4,
-                       rule == 2 ? two_cells : 0, 0, 0, 0};
+                       rule == 2 ? two_cells : 0, 0, 0, 0, 0};
         cracked[rule] = grow(&s, all, g, 1.0, 200);
         least[rule] = smallest_closed_piece(&s, &least_vol[rule]);
         free(all);
@@ -779,7 +779,7 @@ static void test_contact_memo_changes_nothing(void **state)
             if (scene == 0)
                 for (int t = 0; t < s.n_tets; t++)
                     s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
-            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0, 0, 0};
             n[forget] = grow_memo(&s, all, g, scene == 0 ? 1.0 : 0.01, 200, forget);
             nf = s.n_facets;
             cracked[forget] = malloc((size_t)nf), when[forget] = malloc((size_t)nf * sizeof(double));
@@ -816,7 +816,7 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid s;
     int *all = stressed_box(&s, &m, 1.4, 1.0, 100.0);
     double speed = 10.0, dt = 0.01, cell = sqrt(3.0);
-    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0, 0, 0};
     cf_int_list cand = {0}, nodes = {0}, touched = {0};
     double first[3] = {0, 0, 0}, worst = -INFINITY;
     int nuclei = 0, total = 0;
@@ -976,7 +976,7 @@ static void test_fronts_do_not_branch(void **state)
     cf_mark_cracked(&s, f1, 1);
     s.crack_time[f1] = -1e9;
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, 0, 0};
     cf_int_list cand = {0};
     int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, NULL, &cand);
     assert_true(n > 0);
@@ -1019,7 +1019,7 @@ static int *box_with_crack(cf_mesh *m, cf_solid *s, double sy)
  * when `along`); the facets taken, in cand. */
 static int check_fronts(cf_solid *s, const int *all, int along, cf_int_list *cand)
 {
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along, 0, 0};
     int n = cf_insertion_candidates(s, all, s->n_tets, CF_CRITERION_SOURCE, s->n_tets, &g, cand);
     return n > 0 ? cf_insertion_select(s, cand, CF_CRITERION_SOURCE, &g) : n;
 }
@@ -1114,7 +1114,7 @@ static void test_fronts_kink_no_further_than_the_limit(void **state)
         cf_mesh m;
         cf_solid s;
         int *all = box_with_crack(&m, &s, 1.35), f0 = middle_facet(&s);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, limit ? acos(-1.0) / 4 : 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, limit ? acos(-1.0) / 4 : 0, 0};
         cf_int_list cand = {0};
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
                                         &cand);
@@ -1134,6 +1134,83 @@ static void test_fronts_kink_no_further_than_the_limit(void **state)
     assert_true(sharp[0] >= 1);
     assert_true(taken[1] >= 1);
     assert_int_equal(sharp[1], 0);
+}
+
+/* Copies of original vertex o among the solid's tets' nodes. */
+static int copies_of(const cf_solid *s, int o)
+{
+    int seen[64], n = 0;
+    for (int i = s->vt_start[o]; i < s->vt_start[o + 1]; i++) {
+        int c = s->tet[s->vt_slot[i]], dup = 0;
+        for (int j = 0; j < n; j++)
+            dup |= seen[j] == c;
+        if (!dup && n < 64)
+            seen[n++] = c;
+    }
+    return n;
+}
+
+/* A front splits the vertices behind it along its plane
+ * (solver.front_split "plane", docs/physics.md §5.1 rule 3).  In the box
+ * under a uniaxial tension along y of 1.5 thresholds, a crack of one
+ * facet on the plane y = 0.5 at the box's centre grows in one check by
+ * fronts across the tension, and each facet taken is inserted with node
+ * duplication.  Without the split, no vertex of the crack gets a second
+ * copy: the facets round each of them do not yet cut its star, so the
+ * crack cannot open anywhere.  With it, the two vertices on the cracked
+ * edge of the first front taken have two copies each (the third may wait
+ * for a front of its own: the first split took the facets across its
+ * edges), more facets are taken, and every one lies on the plane y = 0.5:
+ * the split cuts each star along the crack's plane, and the crack stays
+ * one surface. */
+static void test_front_split_opens_the_crack_to_its_front(void **state)
+{
+    (void)state;
+    int taken[2], off_plane[2], parted[2];
+    for (int split = 0; split < 2; split++) {
+        cf_mesh m;
+        cf_solid s;
+        fixture_box(&m, 4, 4, 4, 1, 1, 1);
+        int *all = stressed_box(&s, &m, 1.35, 1.0, 1e9), f0 = -1, o0[3];
+        double best = INFINITY; /* the facet on y = 0.5 nearest the centre */
+        for (int f = 0; f < s.n_facets; f++) {
+            int o[3];
+            facet_vertices(&s, f, o);
+            double d = 0;
+            for (int k = 0; k < 3; k++) {
+                double c = (s.X[3 * o[0] + k] + s.X[3 * o[1] + k] + s.X[3 * o[2] + k]) / 3 - 0.5;
+                d += c * c;
+            }
+            if (fabs(facet_normal_y(&s, f)) == 1 && d < best)
+                best = d, f0 = f;
+        }
+        assert_true(f0 >= 0);
+        old_crack(&s, f0);
+        facet_vertices(&s, f0, o0);
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, split};
+        cf_int_list cand = {0}, nodes = {0}, touched = {0};
+        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
+                                        &cand);
+        n = n > 0 ? cf_insertion_select(&s, &cand, CF_CRITERION_SOURCE, &g) : n;
+        taken[split] = n, off_plane[split] = 0, parted[split] = 0;
+        assert_int_equal(cf_crack_facet(&s, f0, &nodes, &touched), 0);
+        for (int i = 0; i < n; i++) {
+            off_plane[split] += fabs(facet_normal_y(&s, cand.v[i])) != 1;
+            assert_int_equal(cf_crack_facet(&s, cand.v[i], &nodes, &touched), 0);
+        }
+        for (int j = 0; j < 3; j++)
+            parted[split] += copies_of(&s, o0[j]) == 2;
+        free(cand.v), free(nodes.v), free(touched.v), free(all);
+        cf_solid_free(&s), cf_mesh_free(&m);
+    }
+    printf("FIGURE front split: without, %d facets taken, %d of the crack's 3 first vertices "
+           "parted; with, %d taken (%d off its plane), %d parted\n",
+           taken[0], parted[0], taken[1], off_plane[1], parted[1]);
+    assert_true(taken[0] >= 1);
+    assert_int_equal(parted[0], 0);
+    assert_true(taken[1] > taken[0]);
+    assert_int_equal(off_plane[1], 0);
+    assert_true(parted[1] >= 2);
 }
 
 /* A front's rank reads only this check's nodal values (facet_ratio): a
@@ -1261,7 +1338,7 @@ static void test_values_exact_from_the_floor_take_the_same_facets(void **state)
             cf_mesh m;
             cf_solid s;
             int *all = weibull_box_with_crack(&s, &m, strength);
-            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, 0};
             cf_int_list cand = {0};
             int nc = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets,
                                              exact_from_floor ? &g : NULL, &cand);
@@ -1312,7 +1389,7 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
         cf_insertion_init_front_floors(&s);
     int cooler = 0;
     for (int round = 0; round < 3; round++) {
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0};
         cf_stress_check bound = cf_insertion_bound(&s, CF_CRITERION_SOURCE);
         int n_hot = s.n_tets;
         if (floors && weibull) /* the kernel's flags */
@@ -1514,6 +1591,7 @@ int main(void)
         cmocka_unit_test(test_fronts_do_not_branch),
         cmocka_unit_test(test_fronts_run_across_the_tension),
         cmocka_unit_test(test_fronts_kink_no_further_than_the_limit),
+        cmocka_unit_test(test_front_split_opens_the_crack_to_its_front),
         cmocka_unit_test(test_values_exact_from_the_floor_take_the_same_facets),
         cmocka_unit_test(test_front_rank_reads_this_check_only),
         cmocka_unit_test(test_front_threshold_from_the_toughness),

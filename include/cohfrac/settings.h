@@ -142,6 +142,10 @@ typedef enum {
     X("solver", "front_max_kink", NUM, solver.front_max_kink, 180, NULL, NULL, CF_R_KINK,      \
       "degree", "fronts: the most a front may turn from the crack facet it extends "          \
       "(docs/physics.md 5.1); 180 no limit")                                                   \
+    X("solver", "front_split", ENUM, solver.front_split, 0, NULL, cf_names_front_split,       \
+      CF_R_NONE, "",                                                                           \
+      "fronts: split the vertices behind a new front facet along its plane, or none "         \
+      "(docs/physics.md 5.1)")                                                                 \
     X("solver", "obstacle_contact", ENUM, solver.obstacle_contact, 0, NULL,                   \
       cf_names_obstacle_contact, CF_R_NONE, "",                                                \
       "explicit runs: project nodes onto obstacles, or a penalty force (docs/physics.md 7.1)") \

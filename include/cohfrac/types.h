@@ -124,6 +124,10 @@ typedef enum { CF_GROWTH_FRONTS, CF_GROWTH_ALL } cf_crack_growth;
  * criterion; criterion "source"). */
 typedef enum { CF_FRONT_ANY, CF_FRONT_STRESS } cf_front_direction;
 typedef enum { CF_FRONT_STRENGTH, CF_FRONT_TOUGHNESS } cf_front_threshold;
+/* Where a crack front's vertices are duplicated (docs/physics.md §5.1):
+ * only where cracked facets cut a vertex's star, or also the vertices
+ * behind a new front facet, split along its plane. */
+typedef enum { CF_FRONT_SPLIT_NONE, CF_FRONT_SPLIT_PLANE } cf_front_split;
 /* How fracture-mode nodes meet obstacles in explicit runs (docs/physics.md §7.1). */
 typedef enum { CF_OBSTACLE_CONTACT_KINEMATIC, CF_OBSTACLE_CONTACT_PENALTY } cf_obstacle_contact;
 
@@ -149,6 +153,7 @@ typedef struct cf_solver_settings {
     double front_max_kink;        /* degrees, (0, 180]: the most a front may turn from the
                                      crack facet it extends (docs/physics.md §5.1); 180:
                                      no limit */
+    cf_front_split front_split;
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
     double min_piece_size;        /* m: nor one whose equal-volume sphere is narrower;

@@ -510,6 +510,33 @@ static int uf_find(int *parent, int i)
     return i;
 }
 
+/* Join the tets of a vertex's star (star[i]: the slot 4 t + j of the
+ * vertex in tet t, ns of them) through their uncracked facets that contain
+ * the vertex: parent[] of a union-find, each root the lowest of its part. */
+static void join_star(const cf_solid *s, const int *star, int ns, int *parent)
+{
+    for (int i = 0; i < ns; i++)
+        parent[i] = i;
+    for (int i = 0; i < ns; i++) {
+        int t = star[i] / 4, j = star[i] % 4;
+        for (int k = 0; k < 4; k++) {
+            if (k == j) /* the face opposite the vertex does not contain it */
+                continue;
+            int f = s->tet_facet[4 * t + k];
+            const int *F = &s->facet[4 * f];
+            if (F[2] < 0 || s->cracked[f])
+                continue;
+            int other = F[0] == t ? F[2] : F[0];
+            for (int q = 0; q < ns; q++)
+                if (star[q] / 4 == other) {
+                    int ra = uf_find(parent, i), rb = uf_find(parent, q);
+                    if (ra != rb)
+                        parent[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+                }
+        }
+    }
+}
+
 /* Split the star of node copy `n` of original vertex `o` into its
  * components (tets joined through uncracked facets containing o); every
  * component but the one with the lowest tet gets a new copy of the node. */
@@ -526,26 +553,7 @@ static int split_star(cf_solid *s, int o, int n, cf_int_list *nodes, cf_int_list
     for (int i = lo; i < hi; i++)
         if (s->tet[s->vt_slot[i]] == n)
             star[ns++] = s->vt_slot[i];
-    for (int i = 0; i < ns; i++)
-        parent[i] = i;
-    for (int i = 0; i < ns; i++) {
-        int t = star[i] / 4, j = star[i] % 4;
-        for (int k = 0; k < 4; k++) {
-            if (k == j) /* the face opposite o does not contain o */
-                continue;
-            int f = s->tet_facet[4 * t + k];
-            const int *F = &s->facet[4 * f];
-            if (F[2] < 0 || s->cracked[f])
-                continue;
-            int other = F[0] == t ? F[2] : F[0];
-            for (int q = 0; q < ns; q++)
-                if (star[q] / 4 == other) {
-                    int ra = uf_find(parent, i), rb = uf_find(parent, q);
-                    if (ra != rb)
-                        parent[ra > rb ? ra : rb] = ra < rb ? ra : rb;
-                }
-        }
-    }
+    join_star(s, star, ns, parent);
     int keep = uf_find(parent, 0);
     for (int i = 0; i < ns; i++)
         copy_of_root[i] = -1;
@@ -934,6 +942,95 @@ static int closes_small_piece(cf_solid *s, int f, int most, double least_volume)
     return 0;
 }
 
+/* Crack facet f (rest centroid c) at time t: on the crack grid, marked,
+ * and appended to cand at *kept.  Returns 0, or -1 out of memory. */
+static int take_facet(cf_solid *s, int f, const double c[3], double t, cf_int_list *cand,
+                      int *kept)
+{
+    if (cf_int_list_reserve(cand, *kept + 1) || cf_crack_grid_add(&s->cracks, c))
+        return -1;
+    cf_mark_cracked(s, f, 1), s->crack_time[f] = t;
+    cand->v[(*kept)++] = f;
+    return 0;
+}
+
+/* Which side of the plane through original vertex o with normal n (rest
+ * shape) tet t lies on: its rest centroid's distance from the plane, m. */
+static double tet_side(const cf_solid *s, int t, int o, const double n[3])
+{
+    double d = 0;
+    for (int k = 0; k < 3; k++) {
+        double c = 0;
+        for (int a = 0; a < 4; a++)
+            c += 0.25 * s->X[3 * s->tet0[4 * t + a] + k];
+        d += (c - s->X[3 * o + k]) * n[k];
+    }
+    return d;
+}
+
+/* Whether original vertex o's star is whole: its tets all joined through
+ * uncracked facets that contain o (no copy of o would part).  -1 out of
+ * memory. */
+static int star_whole(const cf_solid *s, int o)
+{
+    int lo = s->vt_start[o], ns = s->vt_start[o + 1] - lo, local[2 * 256];
+    int *buf = ns <= 256 ? local : malloc(2 * (size_t)ns * sizeof(int));
+    if (!buf)
+        return -1;
+    memcpy(buf, &s->vt_slot[lo], (size_t)ns * sizeof(int));
+    join_star(s, buf, ns, buf + ns);
+    int whole = 1;
+    for (int i = 1; i < ns; i++)
+        whole &= uf_find(buf + ns, i) == 0;
+    if (buf != local)
+        free(buf);
+    return whole;
+}
+
+/* solver.front_split "plane" (docs/physics.md §5.1 rule 3): front facet f
+ * (original vertices o, of tet ta), just taken, splits each of its
+ * vertices that lies on its crack (on an edge another cracked facet holds)
+ * and whose star the cracks do not part yet: the uncracked interior facets
+ * of that star between its tets on the two sides of f's rest plane
+ * through the vertex (tet_side) are taken at time t, each unless it would
+ * close a small piece.  Returns 0, or -1 out of memory. */
+static int split_front(cf_solid *s, int f, int ta, const int o[3], const cf_growth *g,
+                       cf_int_list *cand, int *kept)
+{
+    const int *K = CF_TET_FACE[s->facet[4 * f + 1]];
+    double e1[3], e2[3], n[3];
+    v3_sub(&s->X[3 * o[1]], &s->X[3 * o[0]], e1), v3_sub(&s->X[3 * o[2]], &s->X[3 * o[0]], e2);
+    v3_cross(e1, e2, n);
+    unsigned behind = 0;
+    for (int e = 0; e < 3; e++) /* f itself holds each of its edges */
+        if (edge_count(s, ta, K[(e + 1) % 3], K[(e + 2) % 3]) > 1)
+            behind |= 1u << (e + 1) % 3 | 1u << (e + 2) % 3;
+    for (int a = 0; a < 3; a++) {
+        int whole = behind >> a & 1 ? star_whole(s, o[a]) : 0;
+        if (whole < 0)
+            return -1;
+        for (int i = s->vt_start[o[a]]; whole && i < s->vt_start[o[a] + 1]; i++) {
+            int t = s->vt_slot[i] / 4;
+            if (tet_side(s, t, o[a], n) <= 0) /* each facet from its tet on the + side */
+                continue;
+            for (int k = 0; k < 4; k++) {
+                int h = s->tet_facet[4 * t + k], oh[3];
+                const int *H = &s->facet[4 * h];
+                if (k == s->vt_slot[i] % 4 || H[2] < 0 || s->cracked[h] ||
+                    tet_side(s, H[0] == t ? H[2] : H[0], o[a], n) > 0 ||
+                    closes_small_piece(s, h, g->min_piece_tets, g->min_piece_volume))
+                    continue;
+                double c[3];
+                face_vertices(s, H[0], H[1], oh);
+                centroid(s, oh, c);
+                if (take_facet(s, h, c, g->t, cand, kept))
+                    return -1;
+            }
+        }
+    }
+    return 0;
+}
+
 typedef struct {
     double ratio;
     int facet;
@@ -988,7 +1085,8 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
     int kept = 0;
     for (int i = 0; i < nc; i++) {
         int f = r[i].facet, ta = s->facet[4 * f], tb = s->facet[4 * f + 2];
-        if (s->qualify[ta] || s->qualify[tb]) /* one new facet per tet and check */
+        /* one new facet per tet and check; a front's split may have taken f */
+        if (s->qualify[ta] || s->qualify[tb] || s->cracked[f])
             continue;
         /* A front extends its crack; a facet clear of every crack nucleates
          * one (the largest ratio around it, as the ratios come in falling
@@ -1008,17 +1106,17 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
             (contact == CF_CLEAR && cf_crack_grid_near(&s->cracks, c, shield)) ||
             closes_small_piece(s, f, g->min_piece_tets, g->min_piece_volume))
             continue;
-        if (cf_crack_grid_add(&s->cracks, c)) {
+        if (take_facet(s, f, c, g->t, cand, &kept) ||
+            (g->split_plane && contact == CF_FRONT && split_front(s, f, ta, o, g, cand, &kept))) {
             for (int j = 0; j < kept; j++) { /* nothing marked */
                 const int *F = &s->facet[4 * cand->v[j]];
                 cf_mark_cracked(s, cand->v[j], 0), s->qualify[F[0]] = s->qualify[F[2]] = 0;
             }
+            s->qualify[ta] = s->qualify[tb] = 0;
             free(r);
             return -1;
         }
-        cf_mark_cracked(s, f, 1), s->crack_time[f] = g->t;
         s->qualify[ta] = s->qualify[tb] = 1;
-        cand->v[kept++] = f;
     }
     free(r);
     for (int i = 0; i < kept; i++) {

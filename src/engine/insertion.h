@@ -40,6 +40,8 @@ typedef struct cf_growth {
                               source) */
     double max_kink;       /* rad: the most a front turns from the cracked facet on its
                               edge (solver.front_max_kink); 0: any */
+    int split_plane;       /* a front facet's vertices on its crack are split along its
+                              plane at once (solver.front_split "plane") */
 } cf_growth;
 
 /* Insertion criterion on the interior, uncracked facets of `tets` (a
@@ -96,7 +98,10 @@ void cf_mark_cracked(cf_solid *s, int f, unsigned char cracked);
  * one (a nucleus, the largest ratio around it), and when it closes no piece of at
  * most min_piece_tets tets.  With along_stress (criterion source) a front
  * ranks by its normal stress over its threshold instead, and is taken only
- * where that reaches 1 (docs/physics.md §5.1 rule 3).  Returns how many, or
+ * where that reaches 1 (docs/physics.md §5.1 rule 3).  With split_plane a
+ * front also takes, in `cand` (which may grow past its length), the
+ * facets that split its vertices on its crack along its plane
+ * (solver.front_split "plane").  Returns how many, or
  * -1 out of memory (nothing marked; the crack grid may hold the centroids
  * of facets it refused). */
 int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const cf_growth *g);

@@ -171,6 +171,12 @@
  *       front may turn from the crack facet whose edge it extends (in the
  *       rest shape; 0 straight ahead, 180 folded back onto it); 180: any
  *       (docs/physics.md §5.1)
+ *     front_split ["none"] | "plane": with "fronts", "plane" duplicates
+ *       each vertex of a new front facet that lies on its crack at once,
+ *       cracking with the facet the facets of the vertex's star that part
+ *       its tets on the two sides of the facet's plane (rest shape); "none"
+ *       duplicates a vertex only once cracked facets cut its star
+ *       (docs/physics.md §5.1)
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
