@@ -35,13 +35,19 @@ def view(ax, run, frame, share):
     total = sum(mass[i] for i in alive)
     large = [i for i in sorted(alive, key=lambda i: -mass[i])[:len(COLOURS)]
              if mass[i] >= share * total]
-    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    # The view frames the large pieces, or every piece when none is large
+    # (a body shattered into crumbs), or a unit box when nothing is drawn.
+    framed = []
     for pid, verts, tris, _ in run.surfaces_at(frame):
         colour = COLOURS[large.index(pid)] if pid in large else "#999999"
-        if pid in large:
-            lo, hi = np.minimum(lo, verts.min(0)), np.maximum(hi, verts.max(0))
+        if pid in large or not large:
+            framed.append(verts)
         ax.add_collection3d(Poly3DCollection(verts[tris], facecolor=colour, edgecolor="k",
                                              linewidths=0.1, alpha=0.9))
+    if framed:
+        lo, hi = np.min([v.min(0) for v in framed], 0), np.max([v.max(0) for v in framed], 0)
+    else:
+        lo, hi = np.full(3, -0.5), np.full(3, 0.5)
     mid, r = (lo + hi) / 2, 0.65 * float(np.max(hi - lo))
     ax.set_xlim(mid[0] - r, mid[0] + r)
     ax.set_ylim(mid[1] - r, mid[1] + r)
