@@ -1112,7 +1112,6 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
                 const int *F = &s->facet[4 * cand->v[j]];
                 cf_mark_cracked(s, cand->v[j], 0), s->qualify[F[0]] = s->qualify[F[2]] = 0;
             }
-            s->qualify[ta] = s->qualify[tb] = 0;
             free(r);
             return -1;
         }
