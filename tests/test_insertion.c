@@ -109,8 +109,9 @@ static void cracked_two_tets(cf_solid *s, cf_mesh *m, cf_int_list *nodes, cf_int
 
 /* Moves the lower tet's copies of the cracked facet's vertices to an overlap
  * `depth` (m) into the upper tet and a slide `slide` (m) along x, evaluates
- * the cohesive element once and returns the largest |f_z| (N) on them. */
-static double squeeze(cf_solid *s, const cf_ppr *law, double depth, double slide)
+ * the cohesive element once (its normal traction rising from zero when
+ * `rises`: time_continuity "both") and returns the largest |f_z| (N) on them. */
+static double squeeze(cf_solid *s, const cf_ppr *law, double depth, double slide, int rises)
 {
     memset(s->f, 0, sizeof(double) * 3 * (size_t)s->n_nodes);
     for (int j = 0; j < 3; j++) { /* tet 1 = {0, 2, 1, 4}: slots 0-2 on the facet */
@@ -120,7 +121,7 @@ static double squeeze(cf_solid *s, const cf_ppr *law, double depth, double slide
     }
     cf_pair_force pairs[3];
     int elems[1] = {0};
-    cf_cohesive_forces(s, &cf_law_ppr, law, elems, 1, 1e-4, 0, pairs);
+    cf_cohesive_forces(s, &cf_law_ppr, law, elems, 1, 1e-4, 0, rises, pairs);
     double fz = 0;
     for (int j = 0; j < 3; j++)
         fz = fmax(fz, fabs(s->f[3 * s->tet[4 + j] + 2]));
@@ -142,17 +143,17 @@ static void test_penalty_engages_only_on_approach(void **state)
         cf_solid s;
         cf_int_list nodes = {0}, touched = {0};
         cracked_two_tets(&s, &m, &nodes, &touched);
-        assert_true(squeeze(&s, &law, -1e-5, 0) > 0); /* open: the cohesive traction */
+        assert_true(squeeze(&s, &law, -1e-5, 0, 0) > 0); /* open: the cohesive traction */
         double fz;
         if (path == 0) { /* closes while facing: the penalty pushes back */
-            fz = squeeze(&s, &law, 1e-4, 0);
+            fz = squeeze(&s, &law, 1e-4, 0, 0);
             assert_true(fz > 0);
         } else {         /* slides past (|d|^2 > A/4), overlaps, comes back */
-            assert_true(squeeze(&s, &law, 1e-4, 0.8) == 0);
-            fz = squeeze(&s, &law, 1e-4, 0.1);
+            assert_true(squeeze(&s, &law, 1e-4, 0.8, 0) == 0);
+            fz = squeeze(&s, &law, 1e-4, 0.1, 0);
             assert_true(fz == 0);
-            squeeze(&s, &law, -1e-5, 0.1);                 /* reopens (failed by the slide) */
-            assert_true(squeeze(&s, &law, 1e-4, 0.1) > 0); /* and closes facing */
+            squeeze(&s, &law, -1e-5, 0.1, 0);                 /* reopens (failed by the slide) */
+            assert_true(squeeze(&s, &law, 1e-4, 0.1, 0) > 0); /* and closes facing */
         }
         double stored, dissipated;
         cf_cohesive_energy(&s, NULL, 0, &stored, &dissipated);
@@ -162,6 +163,48 @@ static void test_penalty_engages_only_on_approach(void **state)
         free(nodes.v), free(touched.v);
         cf_solid_free(&s), cf_mesh_free(&m);
     }
+}
+
+/* solver.time_continuity "both": an extrinsic element's normal traction
+ * rises from zero with the capped stiffness K_cap, as its tangential one
+ * always does, where the PPR envelope would start at the strength: a pair
+ * whose bulk pulls at less than that is otherwise pulled shut by the
+ * difference at its first opening (time continuity, Papoulia, Sam and
+ * Vavasis 2003; docs/physics.md §6, regularisation 2).  The fixture's
+ * facet: A = 0.5 m^2, sigma_max = 1 kPa, copies of 100 kg, dt = 0.1 ms, so
+ * K_cap = 1.5e10 Pa/m, and the branch meets the envelope at 67 nm of the
+ * law's 44 mm. */
+static void test_normal_traction_rises_from_zero(void **state)
+{
+    (void)state;
+    cf_ppr law;
+    cf_ppr_init(&law, &mat);
+    const double k = 3.0 / (4.0 * 0.5 * 1e-8 * (1.0 / 100 + 1.0 / 100)) * 0.5 / 3.0; /* N/m */
+    double f[2][3], env[3];
+    const double open[3] = {1e-9, 2e-9, 1e-6}; /* m, rising */
+    for (int i = 0; i < 3; i++) {
+        double Tn, Tt;
+        cf_ppr_envelope(&law, open[i], 0, &Tn, &Tt);
+        env[i] = Tn * 0.5 / 3.0;
+    }
+    for (int rises = 0; rises < 2; rises++) {
+        cf_mesh m;
+        cf_solid s;
+        cf_int_list nodes = {0}, touched = {0};
+        cracked_two_tets(&s, &m, &nodes, &touched);
+        for (int i = 0; i < 3; i++)
+            f[rises][i] = squeeze(&s, &law, -open[i], 0, rises);
+        free(nodes.v), free(touched.v);
+        cf_solid_free(&s), cf_mesh_free(&m);
+    }
+    for (int i = 0; i < 3; i++) /* the source's law: the envelope from the start */
+        assert_true(fabs(f[0][i] - env[i]) <= 1e-9 * env[i]);
+    for (int i = 0; i < 2; i++) /* K_cap A/3 times the opening */
+        assert_true(fabs(f[1][i] - k * open[i]) <= 1e-6 * k * open[i]);
+    assert_true(fabs(f[1][2] - env[2]) <= 1e-9 * env[2]); /* past the branch: the envelope */
+    printf("FIGURE normal continuity: at 1 nm, 2 nm and 1 um of opening %.4g, %.4g, %.4g N "
+           "(tangential only: %.4g, %.4g, %.4g N, the envelope)\n",
+           f[1][0], f[1][1], f[1][2], f[0][0], f[0][1], f[0][2]);
 }
 
 /* Sets the six facet node copies of the cracked two-tet fixture at loop
@@ -209,7 +252,7 @@ static void test_cohesive_work_is_the_forces_work(void **state)
         double th = step <= 1000 ? 0 : 8.0 * atan(1.0) * (step - 1000) / 3000.0;
         loop_pose(&s, depth * fmin(1.0, step / 1000.0) - (step == 0) * 1e-6, th); /* from open */
         memset(s.f, 0, sizeof(double) * 3 * (size_t)n);
-        cf_cohesive_forces(&s, &cf_law_ppr, &law, elems, 1, dt, 0, pairs);
+        cf_cohesive_forces(&s, &cf_law_ppr, &law, elems, 1, dt, 0, 0, pairs);
         for (int q = 0; step > 0 && q < 3 * n; q++)
             w_nodes -= 0.5 * (f_old[q] + s.f[q]) * (s.x[q] - x_old[q]);
         memcpy(f_old, s.f, sizeof(double) * 3 * (size_t)n);
@@ -1578,6 +1621,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_two_tets_split_into_two_fragments),
         cmocka_unit_test(test_penalty_engages_only_on_approach),
+        cmocka_unit_test(test_normal_traction_rises_from_zero),
         cmocka_unit_test(test_cohesive_work_is_the_forces_work),
         cmocka_unit_test(test_box_split_along_a_plane),
         cmocka_unit_test(test_bars_patched_after_insertion_equal_a_rebuild),

@@ -179,6 +179,10 @@ typedef enum {
       CF_R_POSITIVE, "", "bar compliance = scale L^2 / (E V_trib)")                            \
     X("solver", "contact_stiffness", NUM, solver.contact_stiffness, 0, NULL, NULL,            \
       CF_R_NON_NEGATIVE, "Pa/m", "crack-face penalty of explicit runs; 0 the stability cap")  \
+    X("solver", "time_continuity", ENUM, solver.time_continuity, 0, NULL,                     \
+      cf_names_time_continuity, CF_R_NONE, "",                                                 \
+      "cohesive tractions that rise from zero with the capped stiffness: the tangential "     \
+      "only, or the normal too (docs/physics.md 6)")                                           \
     X("solver", "guard", TABLE, solver, 0, NULL, NULL, CF_R_NONE, "", "the divergence guard")\
     X("solver.guard", "max_inverted_fraction", NUM, solver.max_inverted_fraction, 0.01, NULL, \
       NULL, CF_R_UNIT, "", "stop when more of a body's fracture-mode tets are inverted")      \

@@ -128,6 +128,10 @@ typedef enum { CF_FRONT_STRENGTH, CF_FRONT_TOUGHNESS } cf_front_threshold;
  * only where cracked facets cut a vertex's star, or also the vertices
  * behind a new front facet, split along its plane. */
 typedef enum { CF_FRONT_SPLIT_NONE, CF_FRONT_SPLIT_PLANE } cf_front_split;
+/* Where a cohesive element's traction rises from zero with the capped
+ * stiffness instead of starting at the strength (time continuity,
+ * docs/physics.md §6): the tangential traction only, or the normal too. */
+typedef enum { CF_CONTINUITY_TANGENTIAL, CF_CONTINUITY_BOTH } cf_time_continuity;
 /* How fracture-mode nodes meet obstacles in explicit runs (docs/physics.md §7.1). */
 typedef enum { CF_OBSTACLE_CONTACT_KINEMATIC, CF_OBSTACLE_CONTACT_PENALTY } cf_obstacle_contact;
 
@@ -171,6 +175,7 @@ typedef struct cf_solver_settings {
     int iteration_independent;
     double compliance_scale;
     double contact_stiffness;     /* Pa/m, 0 = stability cap */
+    cf_time_continuity time_continuity;
     cf_obstacle_contact obstacle_contact; /* explicit runs: kinematic or penalty */
     double mass_scaling;          /* floor of a tet's step over the median's; 0: none */
     double bulk_viscosity;        /* linear bulk viscosity b1 of explicit runs; 0: none */

@@ -36,7 +36,8 @@ static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double 
  * pair's force into out[0..2].  Writes only ce and out.  Returns its pairs
  * in complete failure. */
 static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_law *law,
-                          const void *params, double dt, double kp, cf_pair_force out[3])
+                          const void *params, double dt, double kp, int normal_rises,
+                          cf_pair_force out[3])
 {
     int n_failed = 0, a[3], b[3];
     double nrm[3];
@@ -73,9 +74,10 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         /* Stability cap of a node pair at step dt: a node pair is shared
          * by up to ~8 elements, so a sixteenth of the two-mass limit
          * 4/(dt^2 (wa + wb)) keeps their sum stable.  Only a pair in
-         * compression or with a tangential traction reads it. */
+         * compression, with a tangential traction, or with a normal one
+         * that rises from zero reads it. */
         double cap = 0;
-        if (dn <= 0 || Tt != 0) {
+        if (dn <= 0 || Tt != 0 || (normal_rises && Tn > 0)) {
             double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
             cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
         }
@@ -96,6 +98,12 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
          * 2003). */
         if (Tt != 0)
             Tt = fmin(Tt, cap * dtl);
+        /* With time_continuity "both" the normal traction does so too: an
+         * element inserted where the traction is below its strength would
+         * otherwise pull its faces shut with the whole strength at the
+         * first opening (docs/physics.md §6, regularisation 2). */
+        if (normal_rises && dn > 0 && Tn > 0)
+            Tn = fmin(Tn, cap * dn);
         double fvec[3] = {0, 0, 0}; /* pulls A towards B */
         v3_axpy(area / 3.0 * Tn, nrm, fvec);
         if (dtl > 0)
@@ -154,14 +162,16 @@ static void prefetch_element(const cf_solid *s, const int *elems, int e, int n)
 }
 
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
-                       const int *elems, int n, double dt, double kp, cf_pair_force *pairs)
+                       const int *elems, int n, double dt, double kp, int normal_rises,
+                       cf_pair_force *pairs)
 {
     int n_failed = 0;
     CF_PARALLEL(n >= CF_COHESIVE_PARALLEL_MIN,
                 "omp parallel for schedule(static) reduction(+ : n_failed)",
         for (int e = 0; e < n; e++) {
             prefetch_element(s, elems, e, n);
-            n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, &pairs[3 * e]);
+            n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, normal_rises,
+                                        &pairs[3 * e]);
         });
     /* Elements share nodes: the sums in list and pair order, on one thread. */
     for (int j = 0; j < 3 * n; j++)

@@ -21,7 +21,9 @@
  * facet's area: on a pair that already overlaps it releases energy that no
  * load put in (measured: nodes at 100+ m/s in a 4.4 m/s drop), so the two
  * are never combined.  The tangential traction rises from
- * zero with the same capped stiffness (time continuity).
+ * zero with the same capped stiffness (time continuity), and so does the
+ * normal traction when normal_rises is set (solver.time_continuity "both"),
+ * until each meets the law's envelope.
  * Each element's absorbed work (the trapezoid of its pairs' forces over the
  * change of their separations, what the leapfrog's kinetic energy gives up
  * to them) and
@@ -45,7 +47,8 @@ typedef struct cf_pair_force {
 } cf_pair_force;
 
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
-                       const int *elems, int n, double dt, double kp, cf_pair_force *pairs);
+                       const int *elems, int n, double dt, double kp, int normal_rises,
+                       cf_pair_force *pairs);
 
 /* Energy of cohesive elements elems[0..n) (all of them when elems is NULL),
  * J: stored (recoverable, on the secant; includes compression penalty) and

@@ -14,6 +14,7 @@ static const char *const cf_names_growth[] = {"fronts", "all", NULL};
 static const char *const cf_names_front[] = {"any", "stress", NULL};
 static const char *const cf_names_front_threshold[] = {"strength", "toughness", NULL};
 static const char *const cf_names_front_split[] = {"none", "plane", NULL};
+static const char *const cf_names_time_continuity[] = {"tangential", "both", NULL};
 static const char *const cf_names_obstacle_contact[] = {"kinematic", "penalty", NULL};
 static const char *const cf_names_constraints[] = {"pbd", "xpbd", "none", NULL};
 _Static_assert(CF_RUN_HYBRID == 0 && CF_RUN_FRACTURE == 1, "cf_names_mode follows cf_run_mode");
@@ -26,6 +27,8 @@ _Static_assert(CF_GROWTH_FRONTS == 0 && CF_GROWTH_ALL == 1, "cf_names_growth");
 _Static_assert(CF_FRONT_ANY == 0 && CF_FRONT_STRESS == 1, "cf_names_front");
 _Static_assert(CF_FRONT_STRENGTH == 0 && CF_FRONT_TOUGHNESS == 1, "cf_names_front_threshold");
 _Static_assert(CF_FRONT_SPLIT_NONE == 0 && CF_FRONT_SPLIT_PLANE == 1, "cf_names_front_split");
+_Static_assert(CF_CONTINUITY_TANGENTIAL == 0 && CF_CONTINUITY_BOTH == 1,
+               "cf_names_time_continuity");
 _Static_assert(CF_OBSTACLE_CONTACT_KINEMATIC == 0 && CF_OBSTACLE_CONTACT_PENALTY == 1,
                "cf_names_obstacle_contact");
 _Static_assert(CF_CONSTRAINTS_PBD == 0 && CF_CONSTRAINTS_XPBD == 1 && CF_CONSTRAINTS_NONE == 2,

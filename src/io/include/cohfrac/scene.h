@@ -204,6 +204,11 @@
  *       (constraints = "none"; with PBD/XPBD the crack-contact constraint
  *       keeps the faces apart); 0 = the stability cap of each node pair,
  *       K_p A/3 = 1/(4 dt^2 (1/m_a + 1/m_b))
+ *     time_continuity ["tangential"] | "both": with "both" a cohesive
+ *       element's normal traction, as its tangential one always does,
+ *       rises from zero with that capped stiffness until it meets the PPR
+ *       envelope, instead of starting at the strength at zero opening
+ *       (docs/physics.md §6)
  *     mass_scaling [0]: mass scaling (docs/physics.md §3.2): a tet
  *       whose stable step h/c_d lies below this fraction of the median
  *       tet's gets the density that raises it to that fraction (the added
