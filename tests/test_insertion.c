@@ -172,7 +172,7 @@ static void test_penalty_engages_only_on_approach(void **state)
  * difference at its first opening (time continuity, Papoulia, Sam and
  * Vavasis 2003; docs/physics.md §6, regularisation 2).  The fixture's
  * facet: A = 0.5 m^2, sigma_max = 1 kPa, copies of 100 kg, dt = 0.1 ms, so
- * K_cap = 1.5e10 Pa/m, and the branch meets the envelope at 67 nm of the
+ * K_cap = 7.5e9 Pa/m, and the branch meets the envelope at 133 nm of the
  * law's 44 mm. */
 static void test_normal_traction_rises_from_zero(void **state)
 {
