@@ -13,7 +13,7 @@
 
 static cf_ppr law(double GI, double GII, double smax, double tmax, double alpha, double beta)
 {
-    cf_material m = {1e6, 0.3, 2400, GI, GII, smax, tmax, alpha, beta, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0};
+    cf_material m = {1e6, 0.3, 2400, GI, GII, smax, tmax, alpha, beta, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0, 0};
     cf_ppr p;
     cf_ppr_init(&p, &m);
     return p;

@@ -22,17 +22,23 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0};
+static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0, 0};
 
-static void init(cf_solid *s, cf_mesh *m)
+/* The solid of mesh m in material ma. */
+static void init_in(cf_solid *s, cf_mesh *m, const cf_material *ma)
 {
     int *body = calloc((size_t)m->n_tets, sizeof(int));
-    assert_int_equal(cf_solid_init(s, m, &mat, body, NULL), CF_OK);
+    assert_int_equal(cf_solid_init(s, m, ma, body, NULL), CF_OK);
     assert_int_equal(cf_solid_init_facets(s, NULL), CF_OK);
     free(body);
     for (int i = 0; i < s->n_nodes; i++) /* a non-uniform velocity field */
         for (int k = 0; k < 3; k++)
             s->v[3 * i + k] = sin(1.0 + 3.7 * i + k) + 0.1 * k;
+}
+
+static void init(cf_solid *s, cf_mesh *m)
+{
+    init_in(s, m, &mat);
 }
 
 static void momentum(const cf_solid *s, double P[3], double *M)
@@ -95,11 +101,13 @@ static void test_two_tets_split_into_two_fragments(void **state)
     cf_solid_free(&s), cf_mesh_free(&m);
 }
 
-/* The two-tet fixture with its shared facet cracked: one cohesive element. */
-static void cracked_two_tets(cf_solid *s, cf_mesh *m, cf_int_list *nodes, cf_int_list *touched)
+/* The two-tet fixture in material ma with its shared facet cracked: one
+ * cohesive element. */
+static void cracked_two_tets_in(cf_solid *s, cf_mesh *m, cf_int_list *nodes, cf_int_list *touched,
+                                const cf_material *ma)
 {
     fixture_two_tets(m);
-    init(s, m);
+    init_in(s, m, ma);
     int f = -1;
     for (int i = 0; i < s->n_facets; i++)
         if (s->facet[4 * i + 2] >= 0)
@@ -107,11 +115,17 @@ static void cracked_two_tets(cf_solid *s, cf_mesh *m, cf_int_list *nodes, cf_int
     assert_int_equal(cf_crack_facet(s, f, nodes, touched), 0);
 }
 
+static void cracked_two_tets(cf_solid *s, cf_mesh *m, cf_int_list *nodes, cf_int_list *touched)
+{
+    cracked_two_tets_in(s, m, nodes, touched, &mat);
+}
+
 /* Moves the lower tet's copies of the cracked facet's vertices to an overlap
  * `depth` (m) into the upper tet and a slide `slide` (m) along x, evaluates
- * the cohesive element once (its normal traction rising from zero when
- * `rises`: time_continuity "both") and returns the largest |f_z| (N) on them. */
-static double squeeze(cf_solid *s, const cf_ppr *law, double depth, double slide, int rises)
+ * the cohesive element once with faces that meet as fc says, and returns
+ * the largest |f_z| (N) on them. */
+static double press(cf_solid *s, const cf_ppr *law, double depth, double slide,
+                    const cf_face_contact *fc)
 {
     memset(s->f, 0, sizeof(double) * 3 * (size_t)s->n_nodes);
     for (int j = 0; j < 3; j++) { /* tet 1 = {0, 2, 1, 4}: slots 0-2 on the facet */
@@ -121,11 +135,18 @@ static double squeeze(cf_solid *s, const cf_ppr *law, double depth, double slide
     }
     cf_pair_force pairs[3];
     int elems[1] = {0};
-    cf_cohesive_forces(s, &cf_law_ppr, law, elems, 1, 1e-4, 0, rises, pairs);
+    cf_cohesive_forces(s, &cf_law_ppr, law, elems, 1, 1e-4, fc, pairs);
     double fz = 0;
     for (int j = 0; j < 3; j++)
         fz = fmax(fz, fabs(s->f[3 * s->tet[4 + j] + 2]));
     return fz;
+}
+
+/* press with the penalty at the cap, no friction, and the normal traction
+ * rising from zero when `rises` (time_continuity "both"). */
+static double squeeze(cf_solid *s, const cf_ppr *law, double depth, double slide, int rises)
+{
+    return press(s, law, depth, slide, &(cf_face_contact){0, rises, 0});
 }
 
 /* The compression penalty of a cohesive element engages on a pair that
@@ -207,6 +228,61 @@ static void test_normal_traction_rises_from_zero(void **state)
            f[1][0], f[1][1], f[1][2], f[0][0], f[0][1], f[0][2]);
 }
 
+/* material.crack_friction: the faces of a cohesive element pressed
+ * together resist sliding by Coulomb friction.  The fixture's crack face,
+ * failed (so the law carries no shear) and pressed 10 um in, is slid along
+ * x by 1 mm and back in 1 um steps.  The friction traction sticks with
+ * half the capped stiffness, K_cap / 2 = 3.75e9 Pa/m (test above), to a
+ * slip of mu |T_n| / (K_cap / 2) = 8 um, then slides at mu |T_n|: on each
+ * node |f_x| = mu |f_z|, against the slide.  Out and back, the pair
+ * dissipates mu |F_n| (2 S - 3 s0) (S the slide, s0 the stick's slip;
+ * docs/physics.md §6, regularisation 3). */
+static void test_pressed_faces_slide_by_coulomb_friction(void **state)
+{
+    (void)state;
+    const double mu = 0.4, depth = 1e-5, S = 1e-3, ds = 1e-6;
+    const double kf = 0.5 * 3.0 / (4.0 * 0.5 * 1e-8 * (1.0 / 100 + 1.0 / 100)); /* Pa/m */
+    const cf_face_contact fc = {0, 0, mu};
+    cf_material rough = mat;
+    rough.crack_friction = mu;
+    cf_ppr law;
+    cf_ppr_init(&law, &rough);
+    cf_solid s;
+    cf_mesh m;
+    cf_int_list nodes = {0}, touched = {0};
+    cracked_two_tets_in(&s, &m, &nodes, &touched, &rough);
+    cf_cohesive_fail(&s, 0);
+    int nstep = (int)lround(S / ds);
+    double fx_stick = 0, fx_slide = 0, fz = 0, ratio_err = 0;
+    for (int step = 0; step <= 2 * nstep; step++) {
+        press(&s, &law, depth, ds * (step <= nstep ? step : 2 * nstep - step), &fc);
+        for (int j = 0; j < 3; j++) {
+            const double *f = &s.f[3 * s.tet[4 + j]];
+            if (step == 2)
+                fx_stick = fmax(fx_stick, fabs(f[0]));
+            if (step > 20 && step < nstep) { /* sliding out: against the slide */
+                assert_true(f[0] < 0);
+                ratio_err = fmax(ratio_err, fabs(fabs(f[0]) - mu * fabs(f[2])) / fabs(f[2]));
+                fx_slide = fabs(f[0]), fz = fabs(f[2]);
+            }
+            if (step > nstep + 20) /* and back */
+                assert_true(f[0] > 0);
+        }
+    }
+    double stored, dissipated;
+    cf_cohesive_energy(&s, NULL, 0, &stored, &dissipated);
+    double Fn = 3 * fz, s0 = mu * fz / (kf * 0.5 / 3.0);
+    double expect = mu * Fn * (2 * S - 3 * s0);
+    assert_true(fabs(fx_stick - kf * 0.5 / 3.0 * 2 * ds) <= 1e-6 * fx_stick); /* the stick */
+    assert_true(ratio_err <= 1e-12);
+    assert_true(fabs(dissipated - expect) <= 0.01 * expect);
+    printf("FIGURE crack friction: stick %.4g N at 2 um, slide %.4g N = %.2f x %.4g N; "
+           "out and back dissipated %.4g J (closed form %.4g J)\n",
+           fx_stick, fx_slide, fx_slide / fz, fz, dissipated, expect);
+    free(nodes.v), free(touched.v);
+    cf_solid_free(&s), cf_mesh_free(&m);
+}
+
 /* Sets the six facet node copies of the cracked two-tet fixture at loop
  * angle th: the lower tet's copies pressed `depth` (m) into the upper one
  * and slid along y by 0.02 (1 - cos th), both sides turned about the x
@@ -252,7 +328,7 @@ static void test_cohesive_work_is_the_forces_work(void **state)
         double th = step <= 1000 ? 0 : 8.0 * atan(1.0) * (step - 1000) / 3000.0;
         loop_pose(&s, depth * fmin(1.0, step / 1000.0) - (step == 0) * 1e-6, th); /* from open */
         memset(s.f, 0, sizeof(double) * 3 * (size_t)n);
-        cf_cohesive_forces(&s, &cf_law_ppr, &law, elems, 1, dt, 0, 0, pairs);
+        cf_cohesive_forces(&s, &cf_law_ppr, &law, elems, 1, dt, &(cf_face_contact){0}, pairs);
         for (int q = 0; step > 0 && q < 3 * n; q++)
             w_nodes -= 0.5 * (f_old[q] + s.f[q]) * (s.x[q] - x_old[q]);
         memcpy(f_old, s.f, sizeof(double) * 3 * (size_t)n);
@@ -1622,6 +1698,7 @@ int main(void)
         cmocka_unit_test(test_two_tets_split_into_two_fragments),
         cmocka_unit_test(test_penalty_engages_only_on_approach),
         cmocka_unit_test(test_normal_traction_rises_from_zero),
+        cmocka_unit_test(test_pressed_faces_slide_by_coulomb_friction),
         cmocka_unit_test(test_cohesive_work_is_the_forces_work),
         cmocka_unit_test(test_box_split_along_a_plane),
         cmocka_unit_test(test_bars_patched_after_insertion_equal_a_rebuild),

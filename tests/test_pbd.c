@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0};
+static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0, 0};
 
 /* A box of 12 x 10 x 10 hexahedra in Tet4 (above the parallel thresholds of
  * bars and tets), its nodes moved off the rest shape by up to 5 %.  Returns

@@ -21,7 +21,7 @@
 
 static cf_material material(double E, double nu, double rho)
 {
-    cf_material m = {E, nu, rho, 22, 22, 1e4, 1e4, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0};
+    cf_material m = {E, nu, rho, 22, 22, 1e4, 1e4, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0, 0};
     return m;
 }
 

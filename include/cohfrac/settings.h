@@ -72,6 +72,10 @@ typedef enum {
       "Coulomb friction coefficient with obstacles")                                           \
     X("material", "restitution", NUM, material.restitution, 0, NULL, NULL, CF_R_UNIT, "",     \
       "restitution coefficient with obstacles")                                                \
+    X("material", "crack_friction", NUM, material.crack_friction, 0, NULL, NULL,              \
+      CF_R_NON_NEGATIVE, "",                                                                   \
+      "Coulomb friction coefficient of a cohesive element's faces pressed together, bonded "  \
+      "or failed (explicit runs, docs/physics.md 6); 0 none")                                  \
     X("material", "compressive_strength", NUM, material.compressive_strength, 0, NULL, NULL,  \
       CF_R_NON_NEGATIVE, "Pa",                                                                 \
       "crushing strength of the Tet4s in uniaxial compression (docs/physics.md 2.1); 0 none")  \

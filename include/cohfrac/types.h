@@ -39,6 +39,9 @@ typedef struct cf_material {
                                       with pressure (Drucker-Prager); 0 von Mises */
     int cohesive_law;              /* index of the cohesive law (material.cohesive_law,
                                       docs/settings.md); 0 PPR */
+    double crack_friction;         /* Coulomb coefficient of a cohesive element's faces
+                                      pressed together, bonded or failed (explicit runs,
+                                      docs/physics.md §6); 0 none */
 } cf_material;
 
 typedef struct cf_body_def {

@@ -32,12 +32,46 @@ static double mid_normal(const cf_solid *s, const cf_cohesive *ce, const double 
     return 0.5 * nn;
 }
 
+/* Coulomb friction of pair i of ce at separation d (x_B - x_A, m) across
+ * the unit normal nrm, its faces pressed together with normal traction
+ * Tn < 0 (Pa).  The friction traction T (Pa; NULL, no friction state:
+ * none) sticks with stiffness kf (Pa/m) to the tangential change of d
+ * since the last evaluation and slides where it would pass mu |Tn| (a
+ * return map onto the Coulomb cone, as penalty contact does, Wriggers,
+ * Computational Contact Mechanics, 2006).  It acts on top of the law's
+ * tangential traction: faces of a brittle solid pressed together resist
+ * sliding by friction, bonded or failed (Snozzi and Molinari, IJNME
+ * 93:510, 2013).  Adds its force on A, the traction times a3 (A/3, m^2),
+ * to fvec (N) and returns the stick spring's energy |T|^2 a3 / (2 kf) (J).
+ * Faces apart, or mu = 0, carry none and forget it. */
+static double friction(const cf_cohesive *ce, double T[3], int i, const double d[3],
+                       const double nrm[3], double Tn, double kf, double mu, double a3,
+                       double fvec[3])
+{
+    if (!T)
+        return 0;
+    if (mu <= 0 || Tn >= 0 || kf <= 0 || !ce->started[i]) {
+        T[0] = T[1] = T[2] = 0;
+        return 0;
+    }
+    double inc[3];
+    v3_sub(d, ce->d_last[i], inc);
+    v3_axpy(kf, inc, T);
+    v3_axpy(-v3_dot(T, nrm), nrm, T); /* in the faces' current plane */
+    double t = v3_norm(T), lim = mu * -Tn;
+    if (t > lim)
+        for (int k = 0; k < 3; k++)
+            T[k] *= lim / t;
+    v3_axpy(a3, T, fvec);
+    return a3 * v3_dot(T, T) / (2.0 * kf);
+}
+
 /* Element ce's three node pairs: tractions, energies and state, and each
  * pair's force into out[0..2].  Writes only ce and out.  Returns its pairs
  * in complete failure. */
 static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_law *law,
-                          const void *params, double dt, double kp, int normal_rises,
-                          cf_pair_force out[3])
+                          const void *params, double dt, const cf_face_contact *fc,
+                          double (*fric)[3], cf_pair_force out[3])
 {
     int n_failed = 0, a[3], b[3];
     double nrm[3];
@@ -77,7 +111,7 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
          * compression, with a tangential traction, or with a normal one
          * that rises from zero reads it. */
         double cap = 0;
-        if (dn <= 0 || Tt != 0 || (normal_rises && Tn > 0)) {
+        if (dn <= 0 || Tt != 0 || (fc->normal_rises && Tn > 0)) {
             double wa = 1.0 / s->m[a[i]], wb = 1.0 / s->m[b[i]];
             cap = 3.0 / (4.0 * area * dt * dt * (wa + wb));
         }
@@ -88,8 +122,8 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
              * back into view already overlapped would be kicked apart
              * with energy 1/2 K_p dn^2 that no load put in. */
             int engaged = !ce->started[i] || L[0] > 0 || L[1] < 0;
-            int facing = kp >= 0 && engaged && v3_dot(d, d) <= 0.25 * area;
-            Tn = facing ? fmin(kp > 0 ? kp : cap, cap) * dn : 0;
+            int facing = fc->kp >= 0 && engaged && v3_dot(d, d) <= 0.25 * area;
+            Tn = facing ? fmin(fc->kp > 0 ? fc->kp : cap, cap) * dn : 0;
         }
         /* The tangential traction rises from zero with the capped
          * stiffness: at zero tangential opening its direction is
@@ -102,12 +136,16 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
          * element inserted where the traction is below its strength would
          * otherwise pull its faces shut with the whole strength at the
          * first opening (docs/physics.md §6, regularisation 2). */
-        if (normal_rises && dn > 0 && Tn > 0)
+        if (fc->normal_rises && dn > 0 && Tn > 0)
             Tn = fmin(Tn, cap * dn);
         double fvec[3] = {0, 0, 0}; /* pulls A towards B */
         v3_axpy(area / 3.0 * Tn, nrm, fvec);
         if (dtl > 0)
             v3_axpy(area / 3.0 * Tt / dtl, tv, fvec);
+        /* Half the cap: the law's tangential traction may stiffen the pair
+         * by the cap already. */
+        elastic += friction(ce, fric ? fric[i] : NULL, i, d, nrm, Tn, 0.5 * cap,
+                            fc->friction, area / 3.0, fvec);
         /* The work absorbed is the trapezoid of the force over the change of
          * separation, 1/2 (F_n-1 + F_n) . (d_n - d_n-1): exactly what the
          * leapfrog's kinetic energy product gives up to the pair's two
@@ -162,7 +200,7 @@ static void prefetch_element(const cf_solid *s, const int *elems, int e, int n)
 }
 
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
-                       const int *elems, int n, double dt, double kp, int normal_rises,
+                       const int *elems, int n, double dt, const cf_face_contact *fc,
                        cf_pair_force *pairs)
 {
     int n_failed = 0;
@@ -170,7 +208,8 @@ int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *para
                 "omp parallel for schedule(static) reduction(+ : n_failed)",
         for (int e = 0; e < n; e++) {
             prefetch_element(s, elems, e, n);
-            n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, kp, normal_rises,
+            n_failed += element_forces(s, &s->coh[elems[e]], law, params, dt, fc,
+                                        s->coh_fric ? s->coh_fric[elems[e]] : NULL,
                                         &pairs[3 * e]);
         });
     /* Elements share nodes: the sums in list and pair order, on one thread. */

@@ -12,7 +12,7 @@
  * Nodal (Newton-Cotes) integration: each node pair carries traction * A/3,
  * A the current mid-surface area, normal from side A to side B.
  * Compression (Delta_n < 0, faces still facing each other, failed or not) is
- * a penalty T_n = K_p Delta_n with K_p = kp Pa/m, capped per node pair so
+ * a penalty T_n = K_p Delta_n with K_p = fc->kp Pa/m, capped per node pair so
  * that the pair is stable at step dt: K_p A/3 <= 1/(4 dt^2 (1/m_a + 1/m_b)),
  * a sixteenth of the two-mass limit, as a node pair may sit in ~8 elements
  * (docs/physics.md §6); kp = 0 means the cap; kp < 0: no penalty, for runs whose
@@ -22,8 +22,13 @@
  * load put in (measured: nodes at 100+ m/s in a 4.4 m/s drop), so the two
  * are never combined.  The tangential traction rises from
  * zero with the same capped stiffness (time continuity), and so does the
- * normal traction when normal_rises is set (solver.time_continuity "both"),
+ * normal traction when fc->normal_rises is set (solver.time_continuity "both"),
  * until each meets the law's envelope.
+ * Faces pressed together (the penalty engaged, T_n < 0) also carry Coulomb
+ * friction when fc->friction > 0 (material.crack_friction) and s->coh_fric
+ * holds their state: a tangential traction that sticks with half the
+ * capped stiffness and slides at fc->friction |T_n|, on top of the law's
+ * (docs/physics.md §6, regularisation 3).
  * Each element's absorbed work (the trapezoid of its pairs' forces over the
  * change of their separations, what the leapfrog's kinetic energy gives up
  * to them) and
@@ -46,8 +51,17 @@ typedef struct cf_pair_force {
     double f[3];
 } cf_pair_force;
 
+/* How the faces of cohesive elements meet: the compression penalty's
+ * stiffness kp (Pa/m; 0 the cap, < 0 none), whether the normal traction
+ * rises from zero, and the Coulomb coefficient of pressed faces. */
+typedef struct cf_face_contact {
+    double kp;
+    int normal_rises;
+    double friction;
+} cf_face_contact;
+
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,
-                       const int *elems, int n, double dt, double kp, int normal_rises,
+                       const int *elems, int n, double dt, const cf_face_contact *fc,
                        cf_pair_force *pairs);
 
 /* Energy of cohesive elements elems[0..n) (all of them when elems is NULL),

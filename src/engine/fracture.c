@@ -402,9 +402,13 @@ static void elasticity_scatter(const cf_step_ctx *ctx, cf_fragment *f)
 static void cohesive_forces(const cf_step_ctx *ctx, cf_fragment *f, double dt)
 {
     const cf_solver_settings *set = &ctx->def->solver;
-    double kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0;
-    cf_cohesive_forces(ctx->solid, ctx->law, ctx->law_params, f->coh.v, f->coh.n, dt, kp,
-                       set->time_continuity == CF_CONTINUITY_BOTH, f->pairs);
+    cf_face_contact fc = {
+        .kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0,
+        .normal_rises = set->time_continuity == CF_CONTINUITY_BOTH,
+        .friction = ctx->def->material.crack_friction,
+    };
+    cf_cohesive_forces(ctx->solid, ctx->law, ctx->law_params, f->coh.v, f->coh.n, dt, &fc,
+                       f->pairs);
 }
 
 /* Stage collision, as a force (explicit runs with the penalty contact,

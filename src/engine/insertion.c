@@ -717,8 +717,17 @@ int cf_crack_facet(cf_solid *s, int f, cf_int_list *nodes, cf_int_list *touched)
         cf_cohesive *c = realloc(s->coh, (size_t)cap * sizeof *c);
         if (!c)
             return -1;
-        s->coh = c, s->cap_coh = cap;
+        s->coh = c;
+        if (s->mat.crack_friction > 0) { /* only a scene with crack friction pays for it */
+            void *fr = realloc(s->coh_fric, (size_t)cap * sizeof *s->coh_fric);
+            if (!fr)
+                return -1;
+            s->coh_fric = fr;
+        }
+        s->cap_coh = cap;
     }
+    if (s->coh_fric)
+        memset(s->coh_fric[s->n_coh], 0, sizeof *s->coh_fric);
     s->coh[s->n_coh++] = ce;
     return 0;
 }

@@ -524,7 +524,7 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->nodal_stress, s->nodal_check, s->vert_check, s->vert_node, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->tet_open, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh,
+                    s->cracked, s->tet_open, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh, s->coh_fric,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until,
                     s->bv_eta, s->bv_rate, s->bv_work};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)

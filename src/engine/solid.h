@@ -170,6 +170,10 @@ typedef struct cf_solid {
 
     int n_coh, cap_coh;
     cf_cohesive *coh;
+    double (*coh_fric)[3][3]; /* with material.crack_friction > 0, [cap_coh]: each element's
+                                 pairs' Coulomb friction tractions while their faces are
+                                 pressed together, Pa, in the sense of the tangential
+                                 separation they resist (cohesive.h); else NULL */
 
     double dt_cfl;            /* s, docs/physics.md §3 */
     /* Mass scaling of the tets that set the step (docs/physics.md §3.2;

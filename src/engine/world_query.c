@@ -455,7 +455,8 @@ void cf_world_memory(const cf_world *w, cf_memory *m)
                       (s->vert_front_active ? (unsigned long long)s->n_verts0 * (sizeof(float) + 1) +
                                                    (unsigned long long)nt * sizeof(float)
                                              : 0);
-    m->cohesive = (unsigned long long)s->cap_coh * sizeof(cf_cohesive);
+    m->cohesive = (unsigned long long)s->cap_coh *
+                  (sizeof(cf_cohesive) + (s->coh_fric ? sizeof *s->coh_fric : 0));
     m->fragments = (unsigned long long)w->cap_frag * sizeof(cf_fragment);
     for (int i = 0; i < w->n_frag; i++) {
         const cf_fragment *f = &w->frag[i];

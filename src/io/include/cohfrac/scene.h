@@ -21,6 +21,10 @@
  *     G_I [22] N/m, sigma_max [1e4] Pa, alpha [2],
  *     G_II [=G_I] N/m, tau_max [=sigma_max] Pa, beta [=alpha],
  *     friction [0.5], restitution [0.0],
+ *     crack_friction [0]: Coulomb friction coefficient of a cohesive
+ *       element's faces pressed together, bonded or failed: in explicit
+ *       runs the tangential traction there gains up to crack_friction times
+ *       the compression penalty's traction (docs/physics.md §6); 0 none,
  *     compressive_strength [0] Pa: sigma_c > 0 makes the Tet4s crush
  *       (perfect plasticity with sigma_c the uniaxial compressive strength,
  *       in the element frame, the work booked as energy_plastic_dissipated;
