@@ -24,6 +24,10 @@
 
 static const cf_material mat = {1e6, 0.3, 2400, 22, 22, 1e3, 1e3, 2, 2, 0.5, 0, 0, 10, 1, 0, 0, 0, 0, 0, 0, 0};
 
+/* K_cap of the cracked two-tet fixture's node pairs (cohesive.h), Pa/m:
+ * facet A = 0.5 m^2, node copies of 100 kg, the step of `press`, 0.1 ms. */
+static const double fixture_kcap = 3.0 / (4.0 * 0.5 * 1e-8 * (1.0 / 100 + 1.0 / 100));
+
 /* The solid of mesh m in material ma. */
 static void init_in(cf_solid *s, cf_mesh *m, const cf_material *ma)
 {
@@ -142,11 +146,11 @@ static double press(cf_solid *s, const cf_ppr *law, double depth, double slide,
     return fz;
 }
 
-/* press with the penalty at the cap, no friction, and the normal traction
+/* press with the penalty at the cap and the normal traction
  * rising from zero when `rises` (time_continuity "both"). */
 static double squeeze(cf_solid *s, const cf_ppr *law, double depth, double slide, int rises)
 {
-    return press(s, law, depth, slide, &(cf_face_contact){0, rises, 0});
+    return press(s, law, depth, slide, &(cf_face_contact){0, rises});
 }
 
 /* The compression penalty of a cohesive element engages on a pair that
@@ -200,7 +204,7 @@ static void test_normal_traction_rises_from_zero(void **state)
     (void)state;
     cf_ppr law;
     cf_ppr_init(&law, &mat);
-    const double k = 3.0 / (4.0 * 0.5 * 1e-8 * (1.0 / 100 + 1.0 / 100)) * 0.5 / 3.0; /* N/m */
+    const double k = fixture_kcap * 0.5 / 3.0; /* N/m */
     double f[2][3], env[3];
     const double open[3] = {1e-9, 2e-9, 1e-6}; /* m, rising */
     for (int i = 0; i < 3; i++) {
@@ -241,8 +245,8 @@ static void test_pressed_faces_slide_by_coulomb_friction(void **state)
 {
     (void)state;
     const double mu = 0.4, depth = 1e-5, S = 1e-3, ds = 1e-6;
-    const double kf = 0.5 * 3.0 / (4.0 * 0.5 * 1e-8 * (1.0 / 100 + 1.0 / 100)); /* Pa/m */
-    const cf_face_contact fc = {0, 0, mu};
+    const double kf = 0.5 * fixture_kcap; /* Pa/m */
+    const cf_face_contact fc = {0, 0};
     cf_material rough = mat;
     rough.crack_friction = mu;
     cf_ppr law;

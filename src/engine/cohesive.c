@@ -145,7 +145,7 @@ static int element_forces(const cf_solid *s, cf_cohesive *ce, const cf_cohesive_
         /* Half the cap: the law's tangential traction may stiffen the pair
          * by the cap already. */
         elastic += friction(ce, fric ? fric[i] : NULL, i, d, nrm, Tn, 0.5 * cap,
-                            fc->friction, area / 3.0, fvec);
+                            s->mat.crack_friction, area / 3.0, fvec);
         /* The work absorbed is the trapezoid of the force over the change of
          * separation, 1/2 (F_n-1 + F_n) . (d_n - d_n-1): exactly what the
          * leapfrog's kinetic energy product gives up to the pair's two

@@ -25,9 +25,9 @@
  * normal traction when fc->normal_rises is set (solver.time_continuity "both"),
  * until each meets the law's envelope.
  * Faces pressed together (the penalty engaged, T_n < 0) also carry Coulomb
- * friction when fc->friction > 0 (material.crack_friction) and s->coh_fric
- * holds their state: a tangential traction that sticks with half the
- * capped stiffness and slides at fc->friction |T_n|, on top of the law's
+ * friction when s->mat.crack_friction = mu > 0 (s->coh_fric holds their
+ * state): a tangential traction that sticks with half the capped
+ * stiffness and slides at mu |T_n|, on top of the law's
  * (docs/physics.md §6, regularisation 3).
  * Each element's absorbed work (the trapezoid of its pairs' forces over the
  * change of their separations, what the leapfrog's kinetic energy gives up
@@ -52,12 +52,12 @@ typedef struct cf_pair_force {
 } cf_pair_force;
 
 /* How the faces of cohesive elements meet: the compression penalty's
- * stiffness kp (Pa/m; 0 the cap, < 0 none), whether the normal traction
- * rises from zero, and the Coulomb coefficient of pressed faces. */
+ * stiffness kp (Pa/m; 0 the cap, < 0 none) and whether the normal
+ * traction rises from zero (the Coulomb coefficient of pressed faces is
+ * the solid's material.crack_friction). */
 typedef struct cf_face_contact {
     double kp;
     int normal_rises;
-    double friction;
 } cf_face_contact;
 
 int cf_cohesive_forces(cf_solid *s, const cf_cohesive_law *law, const void *params,

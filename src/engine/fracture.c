@@ -405,7 +405,6 @@ static void cohesive_forces(const cf_step_ctx *ctx, cf_fragment *f, double dt)
     cf_face_contact fc = {
         .kp = set->constraints == CF_CONSTRAINTS_NONE ? set->contact_stiffness : -1.0,
         .normal_rises = set->time_continuity == CF_CONTINUITY_BOTH,
-        .friction = ctx->def->material.crack_friction,
     };
     cf_cohesive_forces(ctx->solid, ctx->law, ctx->law_params, f->coh.v, f->coh.n, dt, &fc,
                        f->pairs);
