@@ -1400,7 +1400,7 @@ static void test_front_threshold_from_the_toughness(void **state)
         int *all = box_with_crack(&m, &s, sy);
         if (tough) {
             s.mat.G_I = K * K / s.mat.E;
-            assert_int_equal(cf_solid_init_front_toughness(&s, NULL), CF_OK);
+            assert_int_equal(cf_solid_init_front_toughness(&s, 0, NULL), CF_OK);
             assert_float_equal(s.front_K, K, 1e-12);
             assert_true(s.front_floor_min <= K / sqrt(2 * acos(-1.0) * r_max));
         }
@@ -1419,6 +1419,85 @@ static void test_front_threshold_from_the_toughness(void **state)
     assert_int_equal(taken[0], 0);
     assert_true(taken[1] >= 1);
     assert_int_equal(below, 0);
+}
+
+/* A front's threshold from a penny crack (solver.front_threshold "crack",
+ * docs/physics.md §5.1).  The box of test_front_threshold_from_the_toughness
+ * under sy = 0.6 of a facet's threshold, its crack of one facet f0, K_IC
+ * such that a penny crack is critical under sy at radius a_c = pi K^2 /
+ * (4 sy^2) = 0.03 m, and three checks, each later than the last: the crack
+ * grows from its fronts (with the strength's threshold it takes nothing,
+ * as that test shows), every facet taken belongs to f0's crack, and each
+ * extends an edge that a facet cracked in an earlier check holds, at a
+ * radius a (f0's rest centroid to the edge's midpoint) whose penny-crack
+ * threshold K_IC sqrt(pi) / (2 sqrt(a)) its normal stress sy n_y^2
+ * reaches: the closed form, from the test's own geometry.  A facet at 45
+ * degrees to the tension (sy / 2) is below the first fronts' threshold
+ * (a about 0.06-0.09 m) and above a wider crack's. */
+static void test_front_threshold_from_a_penny_crack(void **state)
+{
+    (void)state;
+    double thr = 0.9, sy = 0.6 * thr, a_c = 0.03, K = 2 * sy * sqrt(a_c / acos(-1.0));
+    cf_mesh m;
+    cf_solid s;
+    int *all = box_with_crack(&m, &s, sy), f0 = middle_facet(&s), taken = 0, tilted[3] = {0};
+    s.mat.G_I = K * K / s.mat.E;
+    assert_int_equal(cf_solid_init_front_toughness(&s, 1, NULL), CF_OK);
+    cf_insertion_init_front_floors(&s);
+    double c0[3] = {0, 0, 0}, a_min = INFINITY;
+    int o0[3];
+    facet_vertices(&s, f0, o0);
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++)
+            c0[k] += s.X[3 * o0[i] + k] / 3;
+    for (int round = 0; round < 3; round++) {
+        unsigned char *before = malloc((size_t)s.n_facets);
+        memcpy(before, s.cracked, (size_t)s.n_facets);
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0};
+        cf_int_list cand = {0};
+        memset(s.hot, 1, (size_t)s.n_tets);
+        int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
+                                        &cand);
+        n = n > 0 ? cf_insertion_select(&s, &cand, CF_CRITERION_SOURCE, &g) : n;
+        for (int i = 0; i < n; i++) {
+            int h = cand.v[i], o[3], fronts = 0;
+            double ny = facet_normal_y(&s, h), lowest = INFINITY;
+            assert_int_equal(s.nucleus[h], f0);
+            facet_vertices(&s, h, o);
+            for (int e = 0; e < 3; e++) {
+                int a = o[(e + 1) % 3], b = o[(e + 2) % 3], old = 0;
+                for (int g2 = 0; g2 < s.n_facets; g2++) {
+                    int og[3], on = 0;
+                    facet_vertices(&s, g2, og);
+                    for (int q = 0; q < 3; q++)
+                        on += og[q] == a || og[q] == b;
+                    old |= g2 != h && before[g2] && on == 2;
+                }
+                if (!old)
+                    continue;
+                double d[3];
+                for (int k = 0; k < 3; k++)
+                    d[k] = c0[k] - 0.5 * (s.X[3 * a + k] + s.X[3 * b + k]);
+                lowest = fmin(lowest, K * sqrt(acos(-1.0)) / (2 * sqrt(v3_norm(d))));
+                a_min = fmin(a_min, v3_norm(d));
+                fronts++;
+            }
+            assert_true(fronts >= 1);
+            assert_true(sy * ny * ny >= lowest * (1 - 1e-9));
+            tilted[round] += ny * ny < 0.9;
+        }
+        taken += n;
+        free(cand.v), free(before);
+    }
+    printf("FIGURE front threshold from a penny crack: %d facets taken in 3 checks at 0.6 of "
+           "the strength's threshold, fronts from a = %.3f m (a_c = %.2f m); facets at 45 "
+           "degrees to the tension %d, %d, %d\n",
+           taken, a_min, a_c, tilted[0], tilted[1], tilted[2]);
+    /* the first fronts are too short for a facet at 45 degrees (sy / 2 below their
+     * threshold), the wider crack's are not */
+    assert_true(taken >= 1 && tilted[0] == 0 && tilted[1] + tilted[2] >= 1);
+    free(all);
+    cf_solid_free(&s), cf_mesh_free(&m);
 }
 
 /* The 4-cell box of m with a Weibull strength field (modulus 6, reference
@@ -1499,7 +1578,7 @@ static void test_values_exact_from_the_floor_take_the_same_facets(void **state)
  * wherever it lies.  The facets taken go to picks[round]; returns the
  * checks with fewer tets hot than all.  Each tet's count of the cracked
  * facets on its edges must equal a count of the facets. */
-static int checks_with_floors(int weibull, double strength, double K, int floors,
+static int checks_with_floors(int weibull, double strength, double K, int floors, int crack,
                               cf_int_list picks[3])
 {
     cf_mesh m;
@@ -1507,7 +1586,7 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
     int *all = weibull ? weibull_box_with_crack(&s, &m, strength)
                        : box_with_crack(&m, &s, 0.6 * 0.9 * strength);
     s.mat.G_I = K * K / s.mat.E;
-    assert_int_equal(cf_solid_init_front_toughness(&s, NULL), CF_OK);
+    assert_int_equal(cf_solid_init_front_toughness(&s, crack, NULL), CF_OK);
     if (floors) /* without: every vertex's lowest front floor, the solid's hot bound */
         cf_insertion_init_front_floors(&s);
     int cooler = 0;
@@ -1567,29 +1646,36 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
  * box under uniform tension below every strength only fronts grow (K_IC
  * as in test_front_threshold_from_the_toughness); on the deformed Weibull
  * box, with K_IC such that a tip's field a cell ahead is half the
- * threshold, fronts and nuclei. */
+ * threshold, fronts and nuclei.  The same with the penny crack's threshold
+ * ("crack") at a quarter of that K_IC, about the tip's field at the first
+ * fronts (a near a quarter of a cell, r near one). */
 static void test_toughness_floors_take_the_same_facets(void **state)
 {
     (void)state;
-    int taken[2] = {0, 0}, cooler = 0;
-    for (int level = 0; level < 5; level++) {
-        int weibull = level > 0;
-        double strength = weibull ? 0.2 * (1 << (level - 1)) * 0.02 * mat.E : 1.0;
-        double K = weibull ? 0.45 * strength * sqrt(2 * acos(-1.0) * 0.25) : 0.4;
+    int taken[2][2] = {{0, 0}, {0, 0}}, cooler = 0;
+    for (int level = 0; level < 10; level++) {
+        int crack = level >= 5;
+        int weibull = level % 5 > 0;
+        double strength = weibull ? 0.2 * (1 << (level % 5 - 1)) * 0.02 * mat.E : 1.0;
+        double K = (weibull ? 0.45 * strength * sqrt(2 * acos(-1.0) * 0.25) : 0.4) /
+                   (crack ? 4 : 1);
         cf_int_list picks[2][3] = {{{0}}};
         for (int floors = 0; floors < 2; floors++)
-            cooler += checks_with_floors(weibull, strength, K, floors, picks[floors]);
+            cooler += checks_with_floors(weibull, strength, K, floors, crack, picks[floors]);
         for (int round = 0; round < 3; round++) {
             assert_int_equal(picks[0][round].n, picks[1][round].n);
             for (int i = 0; i < picks[0][round].n; i++)
                 assert_int_equal(picks[0][round].v[i], picks[1][round].v[i]);
-            taken[weibull] += picks[0][round].n;
+            taken[crack][weibull] += picks[0][round].n;
             free(picks[0][round].v), free(picks[1][round].v);
         }
     }
     printf("FIGURE toughness floors: %d facets taken alike under tension, %d on the Weibull "
-           "box, %d checks with fewer tets hot\n", taken[0], taken[1], cooler);
-    assert_true(taken[0] >= 3 && taken[1] >= 3 && cooler >= 3);
+           "box; penny crack's %d and %d; %d checks with fewer tets hot\n",
+           taken[0][0], taken[0][1], taken[1][0], taken[1][1], cooler);
+    for (int crack = 0; crack < 2; crack++)
+        assert_true(taken[crack][0] >= 3 && taken[crack][1] >= 3);
+    assert_true(cooler >= 6);
 }
 
 /* The size-free strength factor of facet f of area A_f on the box of
@@ -1720,6 +1806,7 @@ int main(void)
         cmocka_unit_test(test_values_exact_from_the_floor_take_the_same_facets),
         cmocka_unit_test(test_front_rank_reads_this_check_only),
         cmocka_unit_test(test_front_threshold_from_the_toughness),
+        cmocka_unit_test(test_front_threshold_from_a_penny_crack),
         cmocka_unit_test(test_toughness_floors_take_the_same_facets),
         cmocka_unit_test(test_contact_memo_changes_nothing),
         cmocka_unit_test(test_strength_is_a_field_of_the_material),

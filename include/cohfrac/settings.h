@@ -142,7 +142,8 @@ typedef enum {
       "fronts: onto any facet, or one whose normal stress reaches it (docs/physics.md 5.1)")  \
     X("solver", "front_threshold", ENUM, solver.front_threshold, 0, NULL, cf_names_front_threshold, \
       CF_R_NONE, "",                                                                           \
-      "a front's threshold: the strength's, or at most the toughness's (docs/physics.md 5.1)") \
+      "a front's threshold: the strength's, or at most the toughness's at the vertex ahead, "  \
+      "or at most a penny crack's of the front's radius (docs/physics.md 5.1)")                \
     X("solver", "front_max_kink", NUM, solver.front_max_kink, 180, NULL, NULL, CF_R_KINK,      \
       "degree", "fronts: the most a front may turn from the crack facet it extends "          \
       "(docs/physics.md 5.1); 180 no limit")                                                   \

@@ -126,7 +126,11 @@ typedef enum { CF_GROWTH_FRONTS, CF_GROWTH_ALL } cf_crack_growth;
  * only one whose own normal stress does (the maximum tangential stress
  * criterion; criterion "source"). */
 typedef enum { CF_FRONT_ANY, CF_FRONT_STRESS } cf_front_direction;
-typedef enum { CF_FRONT_STRENGTH, CF_FRONT_TOUGHNESS } cf_front_threshold;
+/* A crack front's threshold (docs/physics.md §5.1): the strength's, or at
+ * most the field of a crack tip at the toughness a distance r ahead
+ * (K_IC / sqrt(2 pi r)), or at most the far stress that makes a penny
+ * crack of the front's radius a critical (K_IC sqrt(pi) / (2 sqrt(a))). */
+typedef enum { CF_FRONT_STRENGTH, CF_FRONT_TOUGHNESS, CF_FRONT_CRACK } cf_front_threshold;
 /* Where a crack front's vertices are duplicated (docs/physics.md §5.1):
  * only where cracked facets cut a vertex's star, or also the vertices
  * behind a new front facet, split along its plane. */

@@ -286,16 +286,48 @@ static int edge_cracked(const cf_solid *s, int f, int t, int i, int j)
     return edge_count(s, t, i, j) > s->cracked[f];
 }
 
+/* The widest crack on the edge of original vertices a and b: among the
+ * cracked facets other than `skip` there, the one with the lowest
+ * penny-crack threshold (cf_front_penny), which goes to *th (INFINITY
+ * where none).  Returns that facet, or -1.  With s->nucleus. */
+static int widest_on_edge(const cf_solid *s, int a, int b, int skip, double *th)
+{
+    int widest = -1;
+    *th = INFINITY;
+    for (int j = s->vt_start[a]; j < s->vt_start[a + 1]; j++) {
+        int slot = s->vt_slot[j], t = slot / 4, sb = slot_of(s, t, b);
+        for (int q = 0; sb >= 0 && q < 4; q++) { /* face q holds every corner but q */
+            int g = s->tet_facet[4 * t + q];
+            if (q == slot % 4 || q == sb || g == skip || !s->cracked[g])
+                continue;
+            double p = cf_front_penny(s, s->nucleus[g], a, b);
+            if (p < *th)
+                *th = p, widest = g;
+        }
+    }
+    return widest;
+}
+
 /* The threshold of the vertex at corner j of face k of tet ta as the vertex
  * ahead of a front, Pa: the facet's `threshold`, or with
  * solver.front_threshold "toughness" at most the field of a crack tip at
  * the toughness, K_IC / sqrt(2 pi r), r the vertex's rest distance from
  * the line of the face's other two vertices, the front's edge (linear
  * elastic fracture mechanics: the stress a distance r ahead of a tip of
- * stress intensity K is K / sqrt(2 pi r); docs/physics.md §5.1). */
+ * stress intensity K is K / sqrt(2 pi r); docs/physics.md §5.1), or with
+ * "crack" at most the far stress that makes the widest crack on that edge
+ * critical as a penny crack (widest_on_edge). */
 static double front_threshold(const cf_solid *s, int ta, int k, int j, double threshold)
 {
-    return s->front_K > 0 ? fmin(threshold, cf_front_toughness(s, ta, k, j)) : threshold;
+    if (s->front_K <= 0)
+        return threshold;
+    if (!s->nucleus)
+        return fmin(threshold, cf_front_toughness(s, ta, k, j));
+    const int *K = CF_TET_FACE[k];
+    double th;
+    widest_on_edge(s, s->tet0[4 * ta + K[(j + 1) % 3]], s->tet0[4 * ta + K[(j + 2) % 3]],
+                   s->tet_facet[4 * ta + k], &th);
+    return fmin(threshold, th);
 }
 
 /* The vertices of face k of tet ta, an uncracked facet, that may lie ahead
@@ -637,7 +669,9 @@ static void crack_edge(cf_solid *s, int f, int a, int b, int d, int fronts)
             int c = s->tet0[4 * t + (6 - q - slot % 4 - sb)], jc = 0;
             while (s->tet0[4 * G[0] + CF_TET_FACE[G[1]][jc]] != c)
                 jc++;
-            float th = nextafterf((float)cf_front_toughness(s, G[0], G[1], jc), 0.0f);
+            double field = s->nucleus ? cf_front_penny(s, s->nucleus[f], a, b)
+                                      : cf_front_toughness(s, G[0], G[1], jc);
+            float th = nextafterf((float)field, 0.0f);
             s->vert_front_active[c] = fminf(s->vert_front_active[c], th);
         }
     }
@@ -951,16 +985,35 @@ static int closes_small_piece(cf_solid *s, int f, int most, double least_volume)
     return 0;
 }
 
-/* Crack facet f (rest centroid c) at time t: on the crack grid, marked,
- * and appended to cand at *kept.  Returns 0, or -1 out of memory. */
-static int take_facet(cf_solid *s, int f, const double c[3], double t, cf_int_list *cand,
-                      int *kept)
+/* Crack facet f (rest centroid c) at time t, of the crack that facet
+ * `nucleus` began: on the crack grid, marked, and appended to cand at
+ * *kept.  Returns 0, or -1 out of memory. */
+static int take_facet(cf_solid *s, int f, int nucleus, const double c[3], double t,
+                      cf_int_list *cand, int *kept)
 {
     if (cf_int_list_reserve(cand, *kept + 1) || cf_crack_grid_add(&s->cracks, c))
         return -1;
+    if (s->nucleus) /* before its edges' fronts are valued (crack_edge) */
+        s->nucleus[f] = nucleus;
     cf_mark_cracked(s, f, 1), s->crack_time[f] = t;
     cand->v[(*kept)++] = f;
     return 0;
+}
+
+/* The nucleus of the crack front facet f (original vertices o) extends:
+ * among the cracked facets on its edges, the one whose front is the widest
+ * (the lowest cf_front_penny); f itself without s->nucleus or such a
+ * facet. */
+static int crack_of(const cf_solid *s, int f, const int o[3])
+{
+    int best = f;
+    double low = INFINITY, th;
+    for (int e = 0; s->nucleus && e < 3; e++) {
+        int g = widest_on_edge(s, o[(e + 1) % 3], o[(e + 2) % 3], f, &th);
+        if (g >= 0 && th < low)
+            low = th, best = s->nucleus[g];
+    }
+    return best;
 }
 
 /* Which side of the plane through original vertex o with normal n (rest
@@ -1032,7 +1085,7 @@ static int split_front(cf_solid *s, int f, int ta, const int o[3], const cf_grow
                 double c[3];
                 face_vertices(s, H[0], H[1], oh);
                 centroid(s, oh, c);
-                if (take_facet(s, h, c, g->t, cand, kept))
+                if (take_facet(s, h, s->nucleus ? s->nucleus[f] : h, c, g->t, cand, kept))
                     return -1;
             }
         }
@@ -1115,7 +1168,7 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
             (contact == CF_CLEAR && cf_crack_grid_near(&s->cracks, c, shield)) ||
             closes_small_piece(s, f, g->min_piece_tets, g->min_piece_volume))
             continue;
-        if (take_facet(s, f, c, g->t, cand, &kept) ||
+        if (take_facet(s, f, contact == CF_FRONT ? crack_of(s, f, o) : f, c, g->t, cand, &kept) ||
             (g->split_plane && contact == CF_FRONT && split_front(s, f, ta, o, g, cand, &kept))) {
             for (int j = 0; j < kept; j++) { /* nothing marked */
                 const int *F = &s->facet[4 * cand->v[j]];

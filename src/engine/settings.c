@@ -12,7 +12,7 @@ static const char *const cf_names_elasticity[] = {"corotational", "linear", NULL
 static const char *const cf_names_criterion[] = {"traction", "source", "none", NULL};
 static const char *const cf_names_growth[] = {"fronts", "all", NULL};
 static const char *const cf_names_front[] = {"any", "stress", NULL};
-static const char *const cf_names_front_threshold[] = {"strength", "toughness", NULL};
+static const char *const cf_names_front_threshold[] = {"strength", "toughness", "crack", NULL};
 static const char *const cf_names_front_split[] = {"none", "plane", NULL};
 static const char *const cf_names_time_continuity[] = {"tangential", "both", NULL};
 static const char *const cf_names_obstacle_contact[] = {"kinematic", "penalty", NULL};
@@ -25,7 +25,8 @@ _Static_assert(CF_CRITERION_TRACTION == 0 && CF_CRITERION_SOURCE == 1 && CF_CRIT
                "cf_names_criterion");
 _Static_assert(CF_GROWTH_FRONTS == 0 && CF_GROWTH_ALL == 1, "cf_names_growth");
 _Static_assert(CF_FRONT_ANY == 0 && CF_FRONT_STRESS == 1, "cf_names_front");
-_Static_assert(CF_FRONT_STRENGTH == 0 && CF_FRONT_TOUGHNESS == 1, "cf_names_front_threshold");
+_Static_assert(CF_FRONT_STRENGTH == 0 && CF_FRONT_TOUGHNESS == 1 && CF_FRONT_CRACK == 2,
+                "cf_names_front_threshold");
 _Static_assert(CF_FRONT_SPLIT_NONE == 0 && CF_FRONT_SPLIT_PLANE == 1, "cf_names_front_split");
 _Static_assert(CF_CONTINUITY_TANGENTIAL == 0 && CF_CONTINUITY_BOTH == 1,
                "cf_names_time_continuity");

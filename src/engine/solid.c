@@ -334,9 +334,35 @@ double cf_front_toughness(const cf_solid *s, int t, int k, int j)
     return s->front_K / sqrt(2 * acos(-1.0) * r);
 }
 
-cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
+double cf_front_penny(const cf_solid *s, int nucleus, int e0, int e1)
+{
+    const int *F = &s->facet[4 * nucleus], *T = &s->tet0[4 * F[0]], *K = CF_TET_FACE[F[1]];
+    double d[3];
+    for (int i = 0; i < 3; i++)
+        d[i] = (s->X[3 * T[K[0]] + i] + s->X[3 * T[K[1]] + i] + s->X[3 * T[K[2]] + i]) / 3.0 -
+               0.5 * (s->X[3 * e0 + i] + s->X[3 * e1 + i]);
+    return s->front_K * sqrt(acos(-1.0)) / (2 * sqrt(v3_norm(d)));
+}
+
+cf_status cf_solid_init_front_toughness(cf_solid *s, int crack, cf_error *err)
 {
     s->front_K = sqrt(s->mat.E * s->mat.G_I);
+    if (crack) {
+        s->nucleus = malloc((size_t)(s->n_facets > 0 ? s->n_facets : 1) * sizeof(int));
+        if (!s->nucleus)
+            return cf_error_set(err, CF_ERR_NOMEM, "out of memory for crack nuclei");
+        for (int f = 0; f < s->n_facets; f++)
+            s->nucleus[f] = f;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int o = 0; crack && o < s->n_verts0; o++)
+        for (int i = 0; i < 3; i++)
+            lo[i] = fmin(lo[i], s->X[3 * o + i]), hi[i] = fmax(hi[i], s->X[3 * o + i]);
+    double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    /* a penny crack as wide as the body: no front's threshold lies lower */
+    float widest = crack ? nextafterf((float)(s->front_K * sqrt(acos(-1.0)) / (2 * sqrt(v3_norm(d)))),
+                                      0.0f)
+                         : INFINITY;
     s->vert_front_active = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
     s->vert_front_near = calloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1), 1);
     s->tet_floor = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), sizeof(float));
@@ -352,7 +378,7 @@ cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err)
         for (int j = 0; j < 3; j++) {
             int o = s->tet0[4 * t + CF_TET_FACE[k][j]];
             /* rounded down, so that the float never lies above a threshold */
-            float th = nextafterf((float)cf_front_toughness(s, t, k, j), 0.0f);
+            float th = crack ? widest : nextafterf((float)cf_front_toughness(s, t, k, j), 0.0f);
             s->vert_front_active[o] = fminf(s->vert_front_active[o], th);
             s->front_floor_min = fmin(s->front_floor_min, th);
         }
@@ -524,7 +550,7 @@ void cf_solid_free(cf_solid *s)
                     s->origin, s->tet, s->tet0,
                     s->Dm_inv, s->vol, s->rq, s->sigma, s->hot, s->qualify, s->node_mark,
                     s->nodal, s->nodal_stress, s->nodal_check, s->vert_check, s->vert_node, s->piece, s->piece_mark, s->tf, s->tw, s->ep, s->wp, s->crushed, s->bc, s->tet_frag, s->facet, s->tet_facet,
-                    s->cracked, s->tet_open, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_active, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh, s->coh_fric,
+                    s->cracked, s->tet_open, s->edge_cracks, s->crack_time, s->candidate, s->strength, s->vert_wmin, s->vert_front_active, s->nucleus, s->vert_front_near, s->tet_floor, s->vt_start, s->vt_slot, s->coh, s->coh_fric,
                     s->vert_cracks, s->contact_key, s->contact_kind, s->contact_until,
                     s->bv_eta, s->bv_rate, s->bv_work};
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++)

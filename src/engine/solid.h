@@ -132,6 +132,9 @@ typedef struct cf_solid {
                                  nodal value passes no facet there */
     double front_K;           /* Pa m^1/2: K_IC = sqrt(E G_I) of a front's threshold
                                  (solver.front_threshold "toughness"), 0 off */
+    int *nucleus;             /* [nf] with solver.front_threshold "crack": the facet
+                                 that nucleated the crack a cracked facet belongs to
+                                 (itself when it nucleated one); NULL otherwise */
     double front_floor_min;   /* Pa, with front_K: the lowest front threshold
                                  K_IC / sqrt(2 pi r) of any vertex ahead of any
                                  interior facet (INFINITY when off) */
@@ -230,14 +233,26 @@ cf_status cf_solid_init_facets(cf_solid *s, cf_error *err);
 void cf_solid_update_open(cf_solid *s, int f);
 
 /* A crack front's threshold from the toughness (solver.front_threshold
- * "toughness", docs/physics.md §5.1): s->front_K = K_IC = sqrt(E G_I) (Pa
- * m^1/2), and each original vertex's lowest threshold K_IC / sqrt(2 pi r)
- * as the vertex ahead of a front, r (m) its rest distance from the line of
- * the opposite edge of an interior facet (s->vert_front_active, their
- * least s->front_floor_min): the check's floors as if every front were
- * there (cf_insertion_init_front_floors sets them from the cracks).  After
- * cf_solid_init_facets.  Errors: CF_ERR_NOMEM. */
-cf_status cf_solid_init_front_toughness(cf_solid *s, cf_error *err);
+ * "toughness" or "crack", docs/physics.md §5.1): s->front_K = K_IC =
+ * sqrt(E G_I) (Pa m^1/2), and each original vertex's lowest threshold as
+ * the vertex ahead of a front (s->vert_front_active, their least
+ * s->front_floor_min): the check's floors as if every front were there
+ * (cf_insertion_init_front_floors sets them from the cracks).  "toughness"
+ * (crack = 0): K_IC / sqrt(2 pi r), r (m) the vertex's rest distance from
+ * the line of the opposite edge of an interior facet.  "crack" (crack =
+ * 1): a penny crack's, cf_front_penny, at most as low as for a crack as
+ * wide as the body (its rest bounding box's diagonal); allocates
+ * s->nucleus, every facet its own.  After cf_solid_init_facets.  Errors:
+ * CF_ERR_NOMEM. */
+cf_status cf_solid_init_front_toughness(cf_solid *s, int crack, cf_error *err);
+
+/* The far stress at which a penny crack of radius a is critical, Pa:
+ * K_IC sqrt(pi) / (2 sqrt(a)) (K_I = 2 sigma sqrt(a / pi); Tada, Paris and
+ * Irwin, The Stress Analysis of Cracks Handbook, 2000), a (m) the rest
+ * distance from the centroid of facet `nucleus`, where the crack began,
+ * to the midpoint of the front's edge, original vertices e0 and e1.  With
+ * s->front_K set. */
+double cf_front_penny(const cf_solid *s, int nucleus, int e0, int e1);
 
 /* The field of a crack tip at the toughness, Pa: K_IC / sqrt(2 pi r) at the
  * vertex at corner j of face k of tet t as the vertex ahead of a front, r

@@ -447,8 +447,9 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
             st = cf_solid_init_facets(&w->solid, err);
         if (st == CF_OK && scene->solver.criterion == CF_CRITERION_SOURCE &&
             scene->solver.crack_growth == CF_GROWTH_FRONTS &&
-            scene->solver.front_threshold == CF_FRONT_TOUGHNESS)
-            st = cf_solid_init_front_toughness(&w->solid, err);
+            scene->solver.front_threshold != CF_FRONT_STRENGTH)
+            st = cf_solid_init_front_toughness(
+                &w->solid, scene->solver.front_threshold == CF_FRONT_CRACK, err);
         if (st == CF_OK)
             cf_insertion_init_front_floors(&w->solid);
         cf_mesh_free(&all);
