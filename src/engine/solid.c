@@ -334,6 +334,13 @@ double cf_front_toughness(const cf_solid *s, int t, int k, int j)
     return s->front_K / sqrt(2 * acos(-1.0) * r);
 }
 
+/* The far stress at which a penny crack of radius a (m) is critical, Pa
+ * (cf_front_penny). */
+static double penny(const cf_solid *s, double a)
+{
+    return s->front_K * sqrt(acos(-1.0)) / (2 * sqrt(a));
+}
+
 double cf_front_penny(const cf_solid *s, int nucleus, int e0, int e1)
 {
     const int *F = &s->facet[4 * nucleus], *T = &s->tet0[4 * F[0]], *K = CF_TET_FACE[F[1]];
@@ -341,28 +348,27 @@ double cf_front_penny(const cf_solid *s, int nucleus, int e0, int e1)
     for (int i = 0; i < 3; i++)
         d[i] = (s->X[3 * T[K[0]] + i] + s->X[3 * T[K[1]] + i] + s->X[3 * T[K[2]] + i]) / 3.0 -
                0.5 * (s->X[3 * e0 + i] + s->X[3 * e1 + i]);
-    return s->front_K * sqrt(acos(-1.0)) / (2 * sqrt(v3_norm(d)));
+    return penny(s, v3_norm(d));
 }
 
 cf_status cf_solid_init_front_toughness(cf_solid *s, int crack, cf_error *err)
 {
     s->front_K = sqrt(s->mat.E * s->mat.G_I);
+    float widest = INFINITY; /* with "crack", every vertex's floor */
     if (crack) {
         s->nucleus = malloc((size_t)(s->n_facets > 0 ? s->n_facets : 1) * sizeof(int));
         if (!s->nucleus)
             return cf_error_set(err, CF_ERR_NOMEM, "out of memory for crack nuclei");
         for (int f = 0; f < s->n_facets; f++)
             s->nucleus[f] = f;
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int o = 0; o < s->n_verts0; o++)
+            for (int i = 0; i < 3; i++)
+                lo[i] = fmin(lo[i], s->X[3 * o + i]), hi[i] = fmax(hi[i], s->X[3 * o + i]);
+        double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+        /* a penny crack as wide as the body: no front's threshold lies lower */
+        widest = nextafterf((float)penny(s, v3_norm(d)), 0.0f);
     }
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int o = 0; crack && o < s->n_verts0; o++)
-        for (int i = 0; i < 3; i++)
-            lo[i] = fmin(lo[i], s->X[3 * o + i]), hi[i] = fmax(hi[i], s->X[3 * o + i]);
-    double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-    /* a penny crack as wide as the body: no front's threshold lies lower */
-    float widest = crack ? nextafterf((float)(s->front_K * sqrt(acos(-1.0)) / (2 * sqrt(v3_norm(d)))),
-                                      0.0f)
-                         : INFINITY;
     s->vert_front_active = malloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1) * sizeof(float));
     s->vert_front_near = calloc((size_t)(s->n_verts0 > 0 ? s->n_verts0 : 1), 1);
     s->tet_floor = calloc((size_t)(s->n_tets > 0 ? s->n_tets : 1), sizeof(float));
