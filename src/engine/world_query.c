@@ -454,7 +454,8 @@ void cf_world_memory(const cf_world *w, cf_memory *m)
                       (unsigned long long)s->n_verts0 * (sizeof(unsigned) + sizeof(int)) +
                       (s->vert_front_active ? (unsigned long long)s->n_verts0 * (sizeof(float) + 1) +
                                                    (unsigned long long)nt * sizeof(float)
-                                             : 0);
+                                             : 0) +
+                      (s->nucleus ? (unsigned long long)s->n_facets * I : 0); /* "crack" */
     m->cohesive = (unsigned long long)s->cap_coh *
                   (sizeof(cf_cohesive) + (s->coh_fric ? sizeof *s->coh_fric : 0));
     m->fragments = (unsigned long long)w->cap_frag * sizeof(cf_fragment);
