@@ -157,12 +157,12 @@ def tau_fit(masses, m_min=10.0):
     2006): with a = tau - 1, r = m_min / m_max and S = sum ln(m_i / m_min),
     the root of n/a - S + n r^a ln r / (1 - r^a) = 0 (the log-likelihood is
     concave in a), found by bisection; its limit as a -> 0 is
-    -n ln r / 2 - S.  A body's fragments are bounded by
-    its mass, and over the 1.3-2 decades a sphere of a few thousand tets
-    gives, the estimator of an unbounded law (1 + n / S, Clauset, Shalizi
-    and Newman 2009) reads a power law of tau = 1.67 as 1.98 over 1.3
-    decades and 1.79 over 2 (tests/checks/test_tau_fit.py).  tau = 1 where the likelihood rises
-    towards a flat law (no root above a = 0)."""
+    -n ln r / 2 - S.  A body's fragments are bounded by its mass, and
+    over the 1.3-2 decades a sphere of a few thousand tets gives, the
+    estimator of an unbounded law (1 + n / S, Clauset, Shalizi and Newman
+    2009) reads a power law of tau = 1.67 as 1.98 over 1.3 decades and
+    1.79 over 2 (tests/checks/test_tau_fit.py).  tau = 1 where the
+    likelihood rises towards a flat law (no root above a = 0)."""
     x = np.asarray([m for m in masses if m >= m_min], dtype=float)
     n = len(x)
     if n < 3:
