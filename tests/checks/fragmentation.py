@@ -197,17 +197,23 @@ def own_thresholds(runs):
     return out
 
 
+def add_study_arguments(ap):
+    """The options a study of runs takes: -o DIR, -j N, --known FILE and
+    --set KEY=VALUE (repeatable)."""
+    ap.add_argument("-o", "--output", default=None)
+    ap.add_argument("-j", "--jobs", type=int, default=1)
+    ap.add_argument("--known", default=None)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene setting for every run (cohfrac run --set)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("cohfrac")
     ap.add_argument("--size", choices=SIZES, default="ci")
     ap.add_argument("--seeds", type=int, default=3,
                     help="strength seeds per case (1..N; default 3)")
-    ap.add_argument("-o", "--output", default=None)
-    ap.add_argument("-j", "--jobs", type=int, default=1)
-    ap.add_argument("--known", default=None)
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                    help="a scene setting for every run (cohfrac run --set)")
+    add_study_arguments(ap)
     a = ap.parse_args()
     out = a.output or os.path.join("build", "fragmentation", a.size)
     os.makedirs(os.path.join(out, "runs"), exist_ok=True)
