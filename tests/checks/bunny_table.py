@@ -23,10 +23,14 @@ step or another seed (docs/physics.md §14.34 and §14.42).  With --draws K
 each seed and mesh is run K times, draw k starting the bunny k nm higher
 (k = 0 is the scene as shipped), and count and largest then compare each
 mesh's median over its draws.  The report adds each mesh's range over the
-draws, and two agreement rates over pairs of runs of one seed: of two draws
-on one mesh (how often the process agrees with itself), and of two draws on
-two meshes.  Where the two rates are alike, the mesh changes the outcome no
-more than a nanometre does.
+draws, and two figures over the pairs of runs of one seed, for two draws on
+one mesh (how far the process agrees with itself) and for two draws on two
+meshes: how often they agree as the table asks, and how much of the mass of
+their pieces of at least 5 % they break into the same pieces, the same
+regions of the rest body (`shared`: the count and the largest share can
+agree while the pieces are other parts of the bunny).  Where the figures on
+one mesh and across meshes are alike, the mesh changes the outcome no more
+than a nanometre does.
 
 Writes DIR/bunny_table.md (the table) and DIR/bunny_table.json (every run's
 figures); runs are cached in DIR/runs/ (rerun when the program or the scene
@@ -47,6 +51,7 @@ import sys
 
 import h5py
 import numpy as np
+import scipy.spatial
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import check_physics  # noqa: E402
@@ -107,18 +112,61 @@ def start_height(h5):
                            f"{START_Z} m: set START_Z in {__file__} to the scene's")
 
 
+def partition(h5):
+    """The run's rest tets at its last frame: centroids (m), volume shares
+    and fragment ids, with a k-d tree of the centroids."""
+    with h5py.File(h5, "r") as f:
+        X, T = f["mesh/rest/nodes"][()], f["mesh/rest/tets"][()]
+        frag = f["mesh/tet_fragment/value"][-1]
+    P = X[T]
+    vol = np.abs(np.einsum("ij,ij->i", np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]),
+                           P[:, 3] - P[:, 0])) / 6
+    cen = P.mean(axis=1)
+    return cen, vol / vol.sum(), frag, scipy.spatial.cKDTree(cen)
+
+
+def kept_by(a, b):
+    """The share of the mass of a's pieces of at least 5 % that lies in one
+    piece of b, each of a's pieces with the piece of b that holds most of
+    it, measured on b's tets (each given a's fragment at its centroid);
+    nan when a has no such piece."""
+    cen_b, vol_b, frag_b, _ = b
+    _, near = a[3].query(cen_b)
+    frag_a = a[2][near]
+    ids, inv = np.unique(frag_a, return_inverse=True)
+    size = np.bincount(inv, weights=vol_b)
+    big = np.flatnonzero(size >= 0.05)
+    kept = 0.0
+    for k in big:
+        mine = inv == k
+        _, j = np.unique(frag_b[mine], return_inverse=True)
+        kept += np.bincount(j, weights=vol_b[mine]).max()
+    return kept / size[big].sum() if len(big) else float("nan")
+
+
+def shared(a, b):
+    """How far two runs break into the same large pieces: kept_by both ways,
+    averaged; 1 when their pieces of at least 5 % are the same regions of
+    the rest body, whatever the mesh, near 0 when none is."""
+    return 0.5 * (kept_by(a, b) + kept_by(b, a))
+
+
 def agree(a, b):
     """Two runs agree as the table asks: counts within 1, largest within 0.15."""
     return abs(len(a["pieces"]) - len(b["pieces"])) <= 1 and abs(a["largest"] - b["largest"]) <= 0.15
 
 
-def rates(runs, meshes):
-    """Agreement over pairs of one seed's runs: (within one mesh, across two)."""
-    within, across = [], []
-    for a, b in itertools.combinations(runs, 2):
-        (within if a["mesh"] == b["mesh"] else across).append(agree(a, b))
-    rate = lambda v: float(np.mean(v)) if v else float("nan")  # noqa: E731
-    return rate(within), rate(across)
+def pairs(runs, parts):
+    """Each pair of one seed's runs: (mesh, mesh, whether they agree as the
+    table asks, the mass they break into the same pieces)."""
+    return [(a["mesh"], b["mesh"], agree(a, b), shared(parts[a["tag"]], parts[b["tag"]]))
+            for a, b in itertools.combinations(runs, 2)]
+
+
+def mean_of(ps, i, same):
+    """The mean of field i over the pairs on one mesh (same) or on two."""
+    v = [p[i] for p in ps if (p[0] == p[1]) == same]
+    return float(np.nanmean(v)) if v else float("nan")
 
 
 def main():
@@ -150,7 +198,8 @@ def main():
             return 2
 
     median = lambda v: float(np.median(v))  # noqa: E731
-    rows, checks = [], []
+    parts = {r["tag"]: partition(os.path.join(a.output, "runs", r["tag"] + ".h5")) for r in runs}
+    rows, checks, every_pair = [], [], []
     for s in seeds:
         mine = [r for r in runs if r["seed"] == s]
         per = {m: [r for r in mine if r["mesh"] == m] for m in meshes}
@@ -158,10 +207,14 @@ def main():
         big = {m: median([r["largest"] for r in per[m]]) for m in meshes}
         ok_count = max(counts.values()) - min(counts.values()) <= 1
         ok_big = max(big.values()) - min(big.values()) <= 0.15
-        within, across = rates(mine, meshes)
+        ps = pairs(mine, parts)
+        every_pair += ps
+        within, across, same_within, same_across = (mean_of(ps, i, same) for i, same in
+                                                    ((2, True), (2, False), (3, True), (3, False)))
         checks += [(f"count_s{s}", ok_count), (f"largest_s{s}", ok_big)]
         rows.append({"seed": s, "counts": counts, "largest": big, "count_ok": ok_count,
                      "largest_ok": ok_big, "agree_within": within, "agree_across": across,
+                     "shared_within": same_within, "shared_across": same_across,
                      "range": {m: [min(len(r["pieces"]) for r in per[m]),
                                    max(len(r["pieces"]) for r in per[m]),
                                    min(r["largest"] for r in per[m]),
@@ -172,8 +225,9 @@ def main():
     pooled = {m: (median([r["largest"] for r in runs if r["mesh"] == m]),
                   median([len(r["pieces"]) for r in runs if r["mesh"] == m]),
                   median([r["crack_area"] for r in runs if r["mesh"] == m])) for m in meshes}
-    w_all = float(np.mean([r["agree_within"] for r in rows]))
-    a_all = float(np.mean([r["agree_across"] for r in rows]))
+    w_all, a_all, sw_all, sa_all = (float(np.mean([r[k] for r in rows])) for k in
+                                    ("agree_within", "agree_across", "shared_within",
+                                     "shared_across"))
 
     n_draws = len(draws)
     what = "median over the draws" if n_draws > 1 else "one run"
@@ -185,7 +239,7 @@ def main():
              + (f"; settings: {' '.join(a.set)}" if a.set else "") + ".", ""]
     head = "| seed | " + " | ".join(meshes) + " | count within 1 | largest within 0.15 |"
     if n_draws > 1:
-        head += " pairs agreeing, one mesh | across meshes |"
+        head += " pairs agreeing, one mesh | across meshes | same pieces, one mesh | across |"
     lines += [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         cells = []
@@ -198,7 +252,8 @@ def main():
         line = (f"| {r['seed']} | " + " | ".join(cells) +
                 f" | {'yes' if r['count_ok'] else 'no'} | {'yes' if r['largest_ok'] else 'no'} |")
         if n_draws > 1:
-            line += f" {100 * r['agree_within']:.0f} % | {100 * r['agree_across']:.0f} % |"
+            line += (f" {100 * r['agree_within']:.0f} % | {100 * r['agree_across']:.0f} % |"
+                     f" {100 * r['shared_within']:.0f} % | {100 * r['shared_across']:.0f} % |")
         lines.append(line)
     lines += ["", "Pooled over seeds and draws, the medians of the largest share, the count and "
               "the crack area: " + ", ".join(f"{m} {100 * b:.1f} %, {c:g} and {ca:.3g} m^2"
@@ -206,8 +261,18 @@ def main():
               f"Chips (fragments of at most {CHIP_TETS} tets): at most {100 * chips:.2f} % of the "
               f"mass; runs outside check_physics.py or over 1 % residual: {', '.join(bad) or 'none'}."]
     if n_draws > 1:
+        by_meshes = {}
+        for m1, m2, _, x in every_pair:
+            by_meshes.setdefault(tuple(sorted((m1, m2), key=meshes.index)), []).append(x)
+        lines.append("The share of their large pieces' mass that two runs of one seed break into the same pieces, by meshes: " +
+                     ", ".join(f"{m1} and {m2} {100 * np.nanmean(by_meshes[m1, m2]):.0f} %"
+                               for m1, m2 in itertools.combinations_with_replacement(meshes, 2)
+                               if (m1, m2) in by_meshes) + ".")
         lines.append(f"Pairs of one seed's runs that agree (counts within 1, largest within 0.15): "
-                     f"{100 * w_all:.0f} % on one mesh, {100 * a_all:.0f} % across meshes.")
+                     f"{100 * w_all:.0f} % on one mesh, {100 * a_all:.0f} % across meshes; "
+                     f"the share of the mass of its pieces of at least 5 % that such a pair "
+                     f"breaks into the same pieces (the same regions of the rest body): {100 * sw_all:.0f} % on one mesh, "
+                     f"{100 * sa_all:.0f} % across meshes.")
     text = "\n".join(lines) + "\n"
     with open(os.path.join(a.output, "bunny_table.md"), "w") as f:
         f.write(text)
