@@ -4,7 +4,7 @@
 set -eu
 PKGS="gcc g++ make cmake pkg-config libbullet-dev libbullet-extras-dev libccd-dev libfcl-dev
       libhdf5-dev libcmocka-dev liblua5.4-dev tetgen gmsh glmark2-data python3 python3-h5py
-      python3-numpy python3-matplotlib ffmpeg libtinygltf-dev nlohmann-json3-dev
+      python3-numpy python3-scipy python3-matplotlib ffmpeg libtinygltf-dev nlohmann-json3-dev
       blender python3-meshio paraview python3-paraview xvfb
       clang libomp-dev libassimp-dev libmeshoptimizer-dev libcgal-dev
       libopenmpi-dev openmpi-bin metis"
