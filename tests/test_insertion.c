@@ -859,7 +859,7 @@ static void test_fronts_close_no_small_piece(void **state)
         for (int t = 0; t < s.n_tets; t++) /* hydrostatic tension: every normal */
             s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
         cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4,
-                       rule == 2 ? two_cells : 0, 0, 0, 0, 0};
+                       rule == 2 ? two_cells : 0, 0, 0, 0, 0, 0};
         cracked[rule] = grow(&s, all, g, 1.0, 200);
         least[rule] = smallest_closed_piece(&s, &least_vol[rule]);
         free(all);
@@ -902,7 +902,7 @@ static void test_contact_memo_changes_nothing(void **state)
             if (scene == 0)
                 for (int t = 0; t < s.n_tets; t++)
                     s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
-            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0, 0, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0, 0, 0, 0};
             n[forget] = grow_memo(&s, all, g, scene == 0 ? 1.0 : 0.01, 200, forget);
             nf = s.n_facets;
             cracked[forget] = malloc((size_t)nf), when[forget] = malloc((size_t)nf * sizeof(double));
@@ -939,7 +939,7 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid s;
     int *all = stressed_box(&s, &m, 1.4, 1.0, 100.0);
     double speed = 10.0, dt = 0.01, cell = sqrt(3.0);
-    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0, 0, 0, 0};
     cf_int_list cand = {0}, nodes = {0}, touched = {0};
     double first[3] = {0, 0, 0}, worst = -INFINITY;
     int nuclei = 0, total = 0;
@@ -1099,7 +1099,7 @@ static void test_fronts_do_not_branch(void **state)
     cf_mark_cracked(&s, f1, 1);
     s.crack_time[f1] = -1e9;
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, 0, 0, 0};
     cf_int_list cand = {0};
     int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, NULL, &cand);
     assert_true(n > 0);
@@ -1142,7 +1142,7 @@ static int *box_with_crack(cf_mesh *m, cf_solid *s, double sy)
  * when `along`); the facets taken, in cand. */
 static int check_fronts(cf_solid *s, const int *all, int along, cf_int_list *cand)
 {
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along, 0, 0, 0};
     int n = cf_insertion_candidates(s, all, s->n_tets, CF_CRITERION_SOURCE, s->n_tets, &g, cand);
     return n > 0 ? cf_insertion_select(s, cand, CF_CRITERION_SOURCE, &g) : n;
 }
@@ -1237,7 +1237,7 @@ static void test_fronts_kink_no_further_than_the_limit(void **state)
         cf_mesh m;
         cf_solid s;
         int *all = box_with_crack(&m, &s, 1.35), f0 = middle_facet(&s);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, limit ? acos(-1.0) / 4 : 0, 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, limit ? acos(-1.0) / 4 : 0, 0, 0};
         cf_int_list cand = {0};
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
                                         &cand);
@@ -1285,12 +1285,14 @@ static int copies_of(const cf_solid *s, int o)
  * for a front of its own: the first split took the facets across its
  * edges), more facets are taken, and every one lies on the plane y = 0.5:
  * the split cuts each star along the crack's plane, and the crack stays
- * one surface. */
+ * one surface.  With a reach (solver.front_split_reach) shorter than any
+ * star facet's distance from its vertex, the split takes nothing: as
+ * without it. */
 static void test_front_split_opens_the_crack_to_its_front(void **state)
 {
     (void)state;
-    int taken[2], off_plane[2], parted[2];
-    for (int split = 0; split < 2; split++) {
+    int taken[3], off_plane[3], parted[3];
+    for (int split = 0; split < 3; split++) { /* none, plane, plane within 0.05 m */
         cf_mesh m;
         cf_solid s;
         fixture_box(&m, 4, 4, 4, 1, 1, 1);
@@ -1310,7 +1312,7 @@ static void test_front_split_opens_the_crack_to_its_front(void **state)
         assert_true(f0 >= 0);
         old_crack(&s, f0);
         facet_vertices(&s, f0, o0);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, split};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, split > 0, split == 2 ? 0.05 : 0};
         cf_int_list cand = {0}, nodes = {0}, touched = {0};
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
                                         &cand);
@@ -1327,13 +1329,18 @@ static void test_front_split_opens_the_crack_to_its_front(void **state)
         cf_solid_free(&s), cf_mesh_free(&m);
     }
     printf("FIGURE front split: without, %d facets taken, %d of the crack's 3 first vertices "
-           "parted; with, %d taken (%d off its plane), %d parted\n",
-           taken[0], parted[0], taken[1], off_plane[1], parted[1]);
+           "parted; with, %d taken (%d off its plane), %d parted; within 0.05 m, %d taken, "
+           "%d parted\n",
+           taken[0], parted[0], taken[1], off_plane[1], parted[1], taken[2], parted[2]);
     assert_true(taken[0] >= 1);
     assert_int_equal(parted[0], 0);
     assert_true(taken[1] > taken[0]);
     assert_int_equal(off_plane[1], 0);
     assert_true(parted[1] >= 2);
+    /* every facet of a vertex's star has its centroid at least 0.08 m from
+     * it on cells of 0.25 m: a reach of 0.05 m takes none of them */
+    assert_int_equal(taken[2], taken[0]);
+    assert_int_equal(parted[2], 0);
 }
 
 /* A front's rank reads only this check's nodal values (facet_ratio): a
@@ -1453,7 +1460,7 @@ static void test_front_threshold_from_a_penny_crack(void **state)
     for (int round = 0; round < 3; round++) {
         unsigned char *before = malloc((size_t)s.n_facets);
         memcpy(before, s.cracked, (size_t)s.n_facets);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0, 0};
         cf_int_list cand = {0};
         memset(s.hot, 1, (size_t)s.n_tets);
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
@@ -1540,7 +1547,7 @@ static void test_values_exact_from_the_floor_take_the_same_facets(void **state)
             cf_mesh m;
             cf_solid s;
             int *all = weibull_box_with_crack(&s, &m, strength);
-            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, 0, 0};
             cf_int_list cand = {0};
             int nc = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets,
                                              exact_from_floor ? &g : NULL, &cand);
@@ -1591,7 +1598,7 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
         cf_insertion_init_front_floors(&s);
     int cooler = 0;
     for (int round = 0; round < 3; round++) {
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0, 0};
         cf_stress_check bound = cf_insertion_bound(&s, CF_CRITERION_SOURCE);
         int n_hot = s.n_tets;
         if (floors && weibull) /* the kernel's flags */

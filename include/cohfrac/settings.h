@@ -151,6 +151,10 @@ typedef enum {
       CF_R_NONE, "",                                                                           \
       "fronts: split the vertices behind a new front facet along its plane, or none "         \
       "(docs/physics.md 5.1)")                                                                 \
+    X("solver", "front_split_reach", NUM, solver.front_split_reach, 0, NULL, NULL,            \
+      CF_R_NON_NEGATIVE, "m",                                                                  \
+      "a split takes no facet farther from the vertex it parts (rest centroids, "             \
+      "docs/physics.md 5.1); 0 no limit")                                                      \
     X("solver", "obstacle_contact", ENUM, solver.obstacle_contact, 0, NULL,                   \
       cf_names_obstacle_contact, CF_R_NONE, "",                                                \
       "explicit runs: project nodes onto obstacles, or a penalty force (docs/physics.md 7.1)") \

@@ -165,6 +165,8 @@ typedef struct cf_solver_settings {
                                      crack facet it extends (docs/physics.md §5.1); 180:
                                      no limit */
     cf_front_split front_split;
+    double front_split_reach;     /* m: a split takes no facet whose rest centroid lies
+                                     farther from the vertex it parts; 0: no limit */
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
     double min_piece_size;        /* m: nor one whose equal-volume sphere is narrower;

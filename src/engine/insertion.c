@@ -1055,7 +1055,8 @@ static int star_whole(const cf_solid *s, int o)
  * and whose star the cracks do not part yet: the uncracked interior facets
  * of that star between its tets on the two sides of f's rest plane
  * through the vertex (tet_side) are taken at time t, each unless it would
- * close a small piece.  Returns 0, or -1 out of memory. */
+ * close a small piece or its rest centroid lies farther than split_reach
+ * from the vertex.  Returns 0, or -1 out of memory. */
 static int split_front(cf_solid *s, int f, int ta, const int o[3], const cf_growth *g,
                        cf_int_list *cand, int *kept)
 {
@@ -1079,12 +1080,15 @@ static int split_front(cf_solid *s, int f, int ta, const int o[3], const cf_grow
                 int h = s->tet_facet[4 * t + k], oh[3];
                 const int *H = &s->facet[4 * h];
                 if (k == s->vt_slot[i] % 4 || H[2] < 0 || s->cracked[h] ||
-                    tet_side(s, H[0] == t ? H[2] : H[0], o[a], n) > 0 ||
-                    closes_small_piece(s, h, g->min_piece_tets, g->min_piece_volume))
+                    tet_side(s, H[0] == t ? H[2] : H[0], o[a], n) > 0)
                     continue;
-                double c[3];
+                double c[3], d[3];
                 face_vertices(s, H[0], H[1], oh);
                 centroid(s, oh, c);
+                v3_sub(c, &s->X[3 * o[a]], d);
+                if ((g->split_reach > 0 && v3_norm(d) > g->split_reach) ||
+                    closes_small_piece(s, h, g->min_piece_tets, g->min_piece_volume))
+                    continue;
                 if (take_facet(s, h, s->nucleus ? s->nucleus[f] : h, c, g->t, cand, kept))
                     return -1;
             }

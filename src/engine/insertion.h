@@ -42,6 +42,8 @@ typedef struct cf_growth {
                               edge (solver.front_max_kink); 0: any */
     int split_plane;       /* a front facet's vertices on its crack are split along its
                               plane at once (solver.front_split "plane") */
+    double split_reach;    /* m: the farthest a split's facet lies from the vertex it
+                              parts (rest centroid; solver.front_split_reach); 0: any */
 } cf_growth;
 
 /* Insertion criterion on the interior, uncracked facets of `tets` (a

@@ -181,6 +181,9 @@
  *       its tets on the two sides of the facet's plane (rest shape); "none"
  *       duplicates a vertex only once cracked facets cut its star
  *       (docs/physics.md §5.1)
+ *     front_split_reach [0] m: with "plane", a split takes no facet whose
+ *       rest centroid lies farther from the vertex it parts (a length of
+ *       the material, such as l_ch, where the mesh is coarser; 0: no limit)
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
