@@ -42,11 +42,9 @@ made or read.
 """
 import argparse
 import concurrent.futures
-import hashlib
 import itertools
 import json
 import os
-import subprocess
 import sys
 
 import h5py
@@ -56,7 +54,7 @@ import scipy.spatial
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import check_physics  # noqa: E402
 import fragment_stats  # noqa: E402
-from fragmentation import add_study_arguments, read_known  # noqa: E402
+from fragmentation import add_study_arguments, cached_run, known_verdict, read_known  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENE = os.path.join(ROOT, "scenes", "plaster_bunny_drop.lua")
@@ -68,35 +66,19 @@ SIZES = {"ci": ("bunny_1k,bunny_4k", 3), "full": ("bunny_1k,bunny_4k,bunny_small
 
 def run(exe, out_dir, mesh_dir, extra, mesh, seed, draw):
     """One drop; returns its figures (cached by name in out_dir/runs)."""
-    tag = f"{mesh}_s{seed}_d{draw}"
-    if extra:
-        tag += "_" + hashlib.sha1("\n".join(extra).encode()).hexdigest()[:8]
-    h5 = os.path.join(out_dir, "runs", tag + ".h5")
-    done = h5 + ".done"
-    newest = max(os.path.getmtime(exe), os.path.getmtime(SCENE))
-    if not os.path.exists(done) or os.path.getmtime(done) < newest:
-        sets = [f'bodies[1].mesh="{mesh}"', f"material.strength.seed={seed}"]
-        if draw:
-            sets.append(f"bodies[1].position={{0,0,{START_Z + draw * DRAW_STEP!r}}}")
-        cmd = [exe, "run", SCENE, "-t", "1", "-q", "-o", h5, "--force"]
-        cmd += ["--mesh-dir", mesh_dir] if mesh_dir else []
-        for s in sets + extra:
-            cmd += ["--set", s]
-        r = subprocess.run(cmd, capture_output=True, text=True)
-        if r.returncode != 0:
-            raise RuntimeError(f"{tag}: cohfrac exit {r.returncode}: {r.stderr.strip()[-400:]}")
-        open(done, "w").close()
+    sets = [f'bodies[1].mesh="{mesh}"', f"material.strength.seed={seed}"]
+    if draw:
+        sets.append(f"bodies[1].position={{0,0,{START_Z + draw * DRAW_STEP!r}}}")
+    tag, h5 = cached_run(exe, SCENE, out_dir, f"{mesh}_s{seed}_d{draw}", sets, extra, mesh_dir)
     if draw == 0:
         start_height(h5)
     f = fragment_stats.stats(h5, CHIP_TETS)
     bounds = {}
     plausible = check_physics.check_file(h5, quiet=True, figures=bounds)
-    m, nt, _, _, _ = fragment_stats.last_frame(h5)
     return {"mesh": mesh, "seed": seed, "draw": draw, "tag": tag, "pieces": f["pieces_5pct"],
-            "largest": float(m.max() / m.sum()),
-            "chips": f["chip_share"], "crack_area": f["crack_area"], "fragments": f["fragments"],
-            "n_tets": int(nt.sum()), "residual": float(bounds["residual_share"]),
-            "plausible": bool(plausible)}
+            "largest": f["largest"], "chips": f["chip_share"], "crack_area": f["crack_area"],
+            "fragments": f["fragments"], "n_tets": f["n_tets"],
+            "residual": float(bounds["residual_share"]), "plausible": bool(plausible)}
 
 
 def start_height(h5):
@@ -234,7 +216,7 @@ def main():
     lines = [f"# The plaster bunny drop: {len(meshes)} meshes, seeds 1-{len(seeds)}, "
              f"{n_draws} draw(s) each", "",
              f"Pieces of at least 5 % (the largest share, %), {what}, on "
-             + " / ".join(f"{m} ({runs[[r['mesh'] for r in runs].index(m)]['n_tets']} tets)"
+             + " / ".join(f"{m} ({next(r['n_tets'] for r in runs if r['mesh'] == m)} tets)"
                           for m in meshes)
              + (f"; settings: {' '.join(a.set)}" if a.set else "") + ".", ""]
     head = "| seed | " + " | ".join(meshes) + " | count within 1 | largest within 0.15 |"
@@ -284,11 +266,8 @@ def main():
     failed = {name for name, good in checks if not good}
     for name in sorted(failed):
         print(f"  {'known' if name in known else 'FAIL ':<5} {name}")
-    for name in sorted(set(known) - failed):
-        print(f"  FIXED {name:<11} listed in {a.known} but holds now: remove it from the list")
-    print(f"bunny_table.py: {len(checks)} checks, {len(failed)} failing "
-          f"({len(failed & set(known))} known); report in {a.output}/bunny_table.md")
-    return 0 if failed == set(known) & {name for name, _ in checks} else 1
+    return known_verdict("bunny_table.py", [name for name, _ in checks], failed, known, a.known,
+                         f"{a.output}/bunny_table.md")
 
 
 if __name__ == "__main__":

@@ -42,6 +42,8 @@ def stats(path, chip_tets):
     return {
         "file": path,
         "fragments": int(len(m)),
+        "n_tets": int(nt.sum()),
+        "largest": float(share[0]) if len(share) else 0.0,
         "pieces_5pct": [round(float(s), 4) for s in share[share >= 0.05]],
         "pieces_1pct": int((share >= 0.01).sum()),
         "chip_share": float(m[nt <= chip_tets].sum() / total),
