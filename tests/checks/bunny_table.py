@@ -30,7 +30,10 @@ their pieces of at least 5 % they break into the same pieces, the same
 regions of the rest body (`shared`: the count and the largest share can
 agree while the pieces are other parts of the bunny).  Where the figures on
 one mesh and across meshes are alike, the mesh changes the outcome no more
-than a nanometre does.
+than a nanometre does.  Each mesh's pooled line also gives the share of
+its failed crack area that parts two fragments (fragment_stats.parted_area
+over the crack area; the rest is cracks that run into a piece and stop,
+docs/physics.md §14.43).
 
 Writes DIR/bunny_table.md (the table) and DIR/bunny_table.json (every run's
 figures); runs are cached in DIR/runs/ (rerun when the program or the scene
@@ -77,6 +80,7 @@ def run(exe, out_dir, mesh_dir, extra, mesh, seed, draw):
     plausible = check_physics.check_file(h5, quiet=True, figures=bounds)
     return {"mesh": mesh, "seed": seed, "draw": draw, "tag": tag, "pieces": f["pieces_5pct"],
             "largest": f["largest"], "chips": f["chip_share"], "crack_area": f["crack_area"],
+            "parted_area": f["parted_area"],
             "fragments": f["fragments"], "n_tets": f["n_tets"],
             "residual": float(bounds["residual_share"]), "plausible": bool(plausible)}
 
@@ -97,9 +101,7 @@ def start_height(h5):
 def partition(h5):
     """The run's rest tets at its last frame: centroids (m), volume shares
     and fragment ids, with a k-d tree of the centroids."""
-    with h5py.File(h5, "r") as f:
-        X, T = f["mesh/rest/nodes"][()], f["mesh/rest/tets"][()]
-        frag = f["mesh/tet_fragment/value"][-1]
+    X, T, frag = fragment_stats.rest_partition(h5)
     P = X[T]
     vol = np.abs(np.einsum("ij,ij->i", np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]),
                            P[:, 3] - P[:, 0])) / 6
@@ -206,7 +208,10 @@ def main():
     checks += [("chips", chips <= 0.05), ("physics", not bad)]
     pooled = {m: (median([r["largest"] for r in runs if r["mesh"] == m]),
                   median([len(r["pieces"]) for r in runs if r["mesh"] == m]),
-                  median([r["crack_area"] for r in runs if r["mesh"] == m])) for m in meshes}
+                  median([r["crack_area"] for r in runs if r["mesh"] == m]),
+                  float(np.nanmedian([r["parted_area"] / r["crack_area"] if r["crack_area"] > 0
+                                      else np.nan for r in runs if r["mesh"] == m])))
+              for m in meshes}
     w_all, a_all, sw_all, sa_all = (float(np.mean([r[k] for r in rows])) for k in
                                     ("agree_within", "agree_across", "shared_within",
                                      "shared_across"))
@@ -237,9 +242,11 @@ def main():
             line += (f" {100 * r['agree_within']:.0f} % | {100 * r['agree_across']:.0f} % |"
                      f" {100 * r['shared_within']:.0f} % | {100 * r['shared_across']:.0f} % |")
         lines.append(line)
-    lines += ["", "Pooled over seeds and draws, the medians of the largest share, the count and "
-              "the crack area: " + ", ".join(f"{m} {100 * b:.1f} %, {c:g} and {ca:.3g} m^2"
-                                             for m, (b, c, ca) in pooled.items()) + ".",
+    lines += ["", "Pooled over seeds and draws, the medians of the largest share, the count, "
+              "the crack area and the share of it that parts two fragments (the rest is cracks "
+              "that stop inside a piece): "
+              + ", ".join(f"{m} {100 * b:.1f} %, {c:g}, {ca:.3g} m^2 and {100 * pa:.0f} %"
+                          for m, (b, c, ca, pa) in pooled.items()) + ".",
               f"Chips (fragments of at most {CHIP_TETS} tets): at most {100 * chips:.2f} % of the "
               f"mass; runs outside check_physics.py or over 1 % residual: {', '.join(bad) or 'none'}."]
     if n_draws > 1:
