@@ -30,7 +30,10 @@ their pieces of at least 5 % they break into the same pieces, the same
 regions of the rest body (`shared`: the count and the largest share can
 agree while the pieces are other parts of the bunny).  Where the figures on
 one mesh and across meshes are alike, the mesh changes the outcome no more
-than a nanometre does.  Each mesh's pooled line also gives the share of
+than a nanometre does.  With at least as many draws as meshes, the report
+also gives the table's noise floor (`noise_floor`): how often a table of one
+run per seed and mesh, the issue's form, would pass on copies of one mesh,
+its draws standing for the meshes (docs/physics.md §14.46).  Each mesh's pooled line also gives the share of
 its failed crack area that parts two fragments (fragment_stats.parted_area
 over the crack area; the rest is cracks that run into a piece and stop,
 docs/physics.md §14.43).
@@ -135,9 +138,27 @@ def shared(a, b):
     return 0.5 * (kept_by(a, b) + kept_by(b, a))
 
 
-def agree(a, b):
-    """Two runs agree as the table asks: counts within 1, largest within 0.15."""
-    return abs(len(a["pieces"]) - len(b["pieces"])) <= 1 and abs(a["largest"] - b["largest"]) <= 0.15
+def agree(*runs):
+    """Runs agree as the table asks: their counts of pieces of at least 5 %
+    within 1 of each other, their largest shares within 0.15."""
+    counts = [len(r["pieces"]) for r in runs]
+    largest = [r["largest"] for r in runs]
+    return max(counts) - min(counts) <= 1 and max(largest) - min(largest) <= 0.15
+
+
+def noise_floor(runs, mesh, seeds, k):
+    """How often the table, in the form of one run per seed and mesh, would
+    pass if the meshes did not matter at all: k draws of one mesh stand for
+    k meshes.  Returns (per seed, the share of the sets of k of the mesh's
+    draws that agree; their product, the chance that every seed agrees, the
+    seeds being independent draws of the material).  nan where the mesh has
+    fewer than k draws of a seed."""
+    per = []
+    for s in seeds:
+        mine = [r for r in runs if r["mesh"] == mesh and r["seed"] == s]
+        sets = list(itertools.combinations(mine, k))
+        per.append(sum(agree(*c) for c in sets) / len(sets) if sets else float("nan"))
+    return per, float(np.prod(per))
 
 
 def pairs(runs, parts):
@@ -262,11 +283,20 @@ def main():
                      f"the share of the mass of its pieces of at least 5 % that such a pair "
                      f"breaks into the same pieces (the same regions of the rest body): {100 * sw_all:.0f} % on one mesh, "
                      f"{100 * sa_all:.0f} % across meshes.")
+    k = len(meshes)
+    floor = {m: noise_floor(runs, m, seeds, k) for m in meshes} if k > 1 and n_draws >= k else {}
+    if floor:
+        lines.append(f"If the meshes did not matter: a table of one run per seed on {k} copies of "
+                     f"one mesh ({k} of its draws) meets every seed's checks with a chance of "
+                     + ", ".join(f"{100 * p:.1f} % on {m} (per seed "
+                                 + " ".join(f"{100 * q:.0f}" for q in per) + " %)"
+                                 for m, (per, p) in floor.items()) + ".")
     text = "\n".join(lines) + "\n"
     with open(os.path.join(a.output, "bunny_table.md"), "w") as f:
         f.write(text)
     with open(os.path.join(a.output, "bunny_table.json"), "w") as f:
         json.dump({"meshes": meshes, "draws": n_draws, "set": a.set, "rows": rows,
+                   "noise_floor": {m: {"per_seed": per, "all_seeds": p} for m, (per, p) in floor.items()},
                    "runs": runs}, f, indent=1)
     print(text, end="")
     known = read_known(a.known, a.size)
