@@ -33,10 +33,10 @@ one mesh and across meshes are alike, the mesh changes the outcome no more
 than a nanometre does.  With at least as many draws as meshes, the report
 also gives the table's noise floor (`noise_floor`): how often a table of one
 run per seed and mesh, the issue's form, would pass on copies of one mesh,
-its draws standing for the meshes (docs/physics.md §14.46).  Each mesh's pooled line also gives the share of
-its failed crack area that parts two fragments (fragment_stats.parted_area
-over the crack area; the rest is cracks that run into a piece and stop,
-docs/physics.md §14.43).
+its draws standing for the meshes (docs/physics.md §14.46).  Each mesh's
+pooled line also gives the share of its failed crack area that parts two
+fragments (fragment_stats.parted_area over the crack area; the rest is
+cracks that run into a piece and stop, docs/physics.md §14.43).
 
 Writes DIR/bunny_table.md (the table) and DIR/bunny_table.json (every run's
 figures); runs are cached in DIR/runs/ (rerun when the program or the scene
