@@ -35,10 +35,12 @@ def check(name, ok, value):
     fails += not ok
 
 
-check("counts 3 and 4 agree", agree(run(1, 0, 3, 0.2), run(1, 1, 4, 0.2)), True)
-check("counts 2 and 4 do not", not agree(run(1, 0, 2, 0.2), run(1, 1, 4, 0.2)), False)
-check("largest 10 and 24 % agree", agree(run(1, 0, 3, 0.10), run(1, 1, 3, 0.24)), True)
-check("largest 10 and 26 % do not", not agree(run(1, 0, 3, 0.10), run(1, 1, 3, 0.26)), False)
+for name, a, b, expected in (("counts 3 and 4", run(1, 0, 3, 0.2), run(1, 1, 4, 0.2), True),
+                             ("counts 2 and 4", run(1, 0, 2, 0.2), run(1, 1, 4, 0.2), False),
+                             ("largest 10 and 24 %", run(1, 0, 3, 0.10), run(1, 1, 3, 0.24), True),
+                             ("largest 10 and 26 %", run(1, 0, 3, 0.10), run(1, 1, 3, 0.26), False)):
+    got = agree(a, b)
+    check(f"{name} {'agree' if expected else 'do not agree'}", got == expected, got)
 per, p = noise_floor(runs, "m", [1, 2, 3], 2)
 check("pairs, per seed", all(abs(a - b) < 1e-12 for a, b in zip(per, (1, 2 / 3, 2 / 3))), per)
 check("pairs, every seed", abs(p - 4 / 9) < 1e-12, p)
