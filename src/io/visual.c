@@ -21,6 +21,9 @@ typedef struct grid {
     double lo[3], h;
     int n[3];
     int *start, *item; /* CSR: the tets of cell c are item[start[c] .. start[c + 1]) */
+    double *bary;      /* [nt][12]: each tet's inverse edge matrix (9) and first
+                          vertex (3), the map to its barycentric coordinates;
+                          NaN first for a flat tet */
 } grid;
 
 static long cell_of(const grid *g, const double x[3], int c[3])
@@ -42,8 +45,32 @@ static void tet_cells(const grid *g, const double *X, const int *T, int a[3], in
     cell_of(g, lo, a), cell_of(g, hi, b);
 }
 
+/* Each tet's map to barycentric coordinates, computed once: a triangle's
+ * search tests some twenty tets, most of them again for its neighbours. */
+static int grid_bary(grid *g, const double *X, const int *tets, int nt)
+{
+    g->bary = malloc((size_t)(nt > 0 ? nt : 1) * 12 * sizeof(double));
+    if (!g->bary)
+        return -1;
+    for (int t = 0; t < nt; t++) {
+        const int *T = &tets[4 * t];
+        double M[9], *B = &g->bary[12 * t];
+        for (int k = 0; k < 3; k++) {
+            M[3 * k + 0] = X[3 * T[1] + k] - X[3 * T[0] + k];
+            M[3 * k + 1] = X[3 * T[2] + k] - X[3 * T[0] + k];
+            M[3 * k + 2] = X[3 * T[3] + k] - X[3 * T[0] + k];
+            B[9 + k] = X[3 * T[0] + k];
+        }
+        if (m3_inv(M, B) == 0)
+            B[0] = NAN;
+    }
+    return 0;
+}
+
 static int grid_build(grid *g, const double *X, int nn, const int *tets, int nt)
 {
+    if (grid_bary(g, X, tets, nt))
+        return -1;
     double hi[3], vol = 1;
     points_bbox(X, nn, g->lo, hi);
     for (int k = 0; k < 3; k++)
@@ -87,33 +114,20 @@ static int grid_build(grid *g, const double *X, int nn, const int *tets, int nt)
 }
 
 /* The smallest barycentric coordinate of p in tet t: >= 0 inside. */
-static double inside(const double *X, const int *T, const double p[3])
+static double inside(const grid *g, int t, const double p[3])
 {
-    const double *a = &X[3 * T[0]];
-    double M[9], r[3], l[3];
-    for (int k = 0; k < 3; k++) {
-        M[3 * k + 0] = X[3 * T[1] + k] - a[k];
-        M[3 * k + 1] = X[3 * T[2] + k] - a[k];
-        M[3 * k + 2] = X[3 * T[3] + k] - a[k];
-        r[k] = p[k] - a[k];
-    }
-    double d = m3_det(M);
-    if (d == 0)
+    const double *B = &g->bary[12 * t];
+    if (B[0] != B[0])
         return -INFINITY;
-    /* Cramer's rule, column by column */
-    for (int j = 0; j < 3; j++) {
-        double Mj[9];
-        memcpy(Mj, M, sizeof Mj);
-        for (int k = 0; k < 3; k++)
-            Mj[3 * k + j] = r[k];
-        l[j] = m3_det(Mj) / d;
-    }
+    double r[3] = {p[0] - B[9], p[1] - B[10], p[2] - B[11]}, l[3];
+    for (int j = 0; j < 3; j++)
+        l[j] = B[3 * j] * r[0] + B[3 * j + 1] * r[1] + B[3 * j + 2] * r[2];
     return fmin(fmin(l[0], l[1]), fmin(l[2], 1 - l[0] - l[1] - l[2]));
 }
 
 /* The tet holding p, else the one whose coordinates miss by the least,
  * searched in rings of cells around p until one is found a ring ago. */
-static int locate(const grid *g, const double *X, const int *tets, const double p[3])
+static int locate(const grid *g, const double p[3])
 {
     int c[3], best = -1;
     double best_in = -INFINITY;
@@ -131,7 +145,7 @@ static int locate(const grid *g, const double *X, const int *tets, const double 
                     long cell = ((long)z * g->n[1] + y) * g->n[0] + x;
                     for (int i = g->start[cell]; i < g->start[cell + 1]; i++) {
                         int t = g->item[i];
-                        double in = inside(X, &tets[4 * t], p);
+                        double in = inside(g, t, p);
                         if (in > best_in || (in == best_in && t < best))
                             best_in = in, best = t;
                     }
@@ -192,12 +206,12 @@ cf_status cf_visual_embed(const cf_world_def *def, const cf_body_source *src,
                 for (int k = 0; k < 3; k++)
                     c[k] += V[3 * (v0 + v) + k] / 3;
             }
-            E[t0 + i] = locate(&g, X, tets, c);
+            E[t0 + i] = locate(&g, c);
         }
         out->n_vertices += s.n_verts, out->n_triangles += s.n_tris;
         cf_surface_free(&s);
     }
-    free(g.start), free(g.item);
+    free(g.start), free(g.item), free(g.bary);
     if (st != CF_OK)
         cf_visual_free(out);
     return st;
