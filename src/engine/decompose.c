@@ -20,6 +20,8 @@ typedef struct cluster {
     double tet_volume;   /* m^3 of the fragment inside the cell */
     double hull_volume;  /* m^3 */
     double *pts;         /* hull vertices [n_pts][3] */
+    double *cen;         /* [nt][3]: the centroid of each tet's part inside the
+                            cell, the tet's own where none is (cluster_hull) */
     int n_pts;
     int frozen;          /* a cut left one side empty: split no further */
 } cluster;
@@ -264,22 +266,31 @@ static int tet_in_cell(const cf_solid *s, int t, const cluster *c, clip_buf *cb,
     return 4 * n;
 }
 
-/* Gather the cell's points and make its hull.  `stamp` marks nodes already
- * taken for this cluster (value `mark`).  Returns 0 or -1. */
+/* Gather the cell's points and make its hull, and keep the centroids of
+ * its tets' parts for the cut that may split it (split).  `stamp` marks
+ * nodes already taken for this cluster (value `mark`).  Returns 0 or -1. */
 static int cluster_hull(const cf_solid *s, cluster *c, int *stamp, int mark, double **buf,
                         int *cap)
 {
     clip_buf cb = {0};
     int n = 0;
     c->tet_volume = 0;
+    free(c->cen);
+    c->cen = malloc((size_t)(c->nt > 0 ? c->nt : 1) * 3 * sizeof(double));
+    if (!c->cen)
+        return -1;
     for (int i = 0; i < c->nt; i++) {
         int t = c->tets[i], whole;
-        double v;
-        int k = tet_in_cell(s, t, c, &cb, &v, NULL, &whole);
+        double v, *cen = &c->cen[3 * i];
+        int k = tet_in_cell(s, t, c, &cb, &v, cen, &whole);
         if (k < 0) {
             clip_free(&cb);
             return -1;
         }
+        if (k == 0) /* no part inside the cell: the tet's own centroid */
+            for (int j = 0; j < 4; j++)
+                for (int a = 0; a < 3; a++)
+                    cen[a] += 0.25 * s->X[3 * s->tet[4 * t + j] + a];
         const double *q = cb.a;
         c->tet_volume += v;
         if (n + k > *cap) {
@@ -321,35 +332,24 @@ static int cluster_hull(const cf_solid *s, cluster *c, int *stamp, int mark, dou
 }
 
 /* Cut cluster c by the plane through the median of the centroids of its
- * tets' parts inside the cell, normal to their principal axis of spread: c
- * keeps the side n.x <= d, d gets the other. */
+ * tets' parts inside the cell (c->cen, from cluster_hull), normal to their
+ * principal axis of spread: c keeps the side n.x <= d, d gets the other;
+ * cluster_hull then makes both hulls and their centroids. */
 static int split(const cf_solid *s, cluster *c, cluster *d)
 {
     int n = c->nt;
     keyed *k = malloc((size_t)n * sizeof *k);
-    double *cen = malloc((size_t)n * 3 * sizeof(double));
+    const double *cen = c->cen;
     int *lo = malloc((size_t)n * sizeof(int)), *hi = malloc((size_t)n * sizeof(int));
     double *pc = malloc((size_t)(c->np + 1) * 4 * sizeof(double));
     double *pd = malloc((size_t)(c->np + 1) * 4 * sizeof(double));
-    if (!k || !cen || !lo || !hi || !pc || !pd) {
-        free(k), free(cen), free(lo), free(hi), free(pc), free(pd);
+    if (!k || !lo || !hi || !pc || !pd) {
+        free(k), free(lo), free(hi), free(pc), free(pd);
         return -1;
     }
     double mean[3] = {0, 0, 0}, C[9] = {0};
-    clip_buf cb = {0};
-    for (int i = 0; i < n; i++) {
-        int whole, m = tet_in_cell(s, c->tets[i], c, &cb, NULL, &cen[3 * i], &whole);
-        if (m < 0) {
-            free(k), free(cen), free(lo), free(hi), free(pc), free(pd), clip_free(&cb);
-            return -1;
-        }
-        if (m == 0) /* no part inside the cell: the tet's own centroid */
-            for (int j = 0; j < 4; j++)
-                for (int a = 0; a < 3; a++)
-                    cen[3 * i + a] += 0.25 * s->X[3 * s->tet[4 * c->tets[i] + j] + a];
+    for (int i = 0; i < n; i++)
         v3_axpy(1.0 / n, &cen[3 * i], mean);
-    }
-    clip_free(&cb);
     for (int i = 0; i < n; i++) {
         double r[3];
         v3_sub(&cen[3 * i], mean, r);
@@ -391,9 +391,9 @@ static int split(const cf_solid *s, cluster *c, cluster *d)
         pd[4 * c->np + a] = -pl[a];
     memset(d, 0, sizeof *d);
     d->tets = hi, d->nt = nh, d->planes = pd, d->np = c->np + 1;
-    free(c->tets), free(c->planes);
-    c->tets = lo, c->nt = nl, c->planes = pc, c->np++;
-    free(k), free(cen);
+    free(c->tets), free(c->planes), free(c->cen);
+    c->tets = lo, c->nt = nl, c->planes = pc, c->np++, c->cen = NULL;
+    free(k);
     return 0;
 }
 
@@ -465,7 +465,7 @@ int cf_decompose(const cf_solid *s, const int *tets, int nt, double max_error, i
         out->tet_volume = tet_volume;
     }
     for (int i = 0; cl && i < max_hulls; i++)
-        free(cl[i].pts), free(cl[i].tets), free(cl[i].planes);
+        free(cl[i].pts), free(cl[i].tets), free(cl[i].planes), free(cl[i].cen);
     free(cl), free(stamp), free(buf);
     if (!ok) {
         cf_hulls_free(out);
