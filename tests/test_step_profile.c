@@ -163,15 +163,12 @@ static void step(cf_world *w)
         fail_msg("step: %s", err.msg);
 }
 
-/* Over 200 steps the stages' timers add up to the wall time of the calls
- * to cf_world_step within 2 %, each stage at least 0, and the stages every
- * step of the mode runs took time. */
-static void stages_add_up(scene_kind kind)
+/* One try: 200 steps, the stages' timers against the wall time of the
+ * calls to cf_world_step.  Each stage is at least 0, and the stages every
+ * step of the mode runs took time.  Returns the untimed share, |sum - wall|
+ * over wall. */
+static double untimed_share(cf_world *w, scene_kind kind)
 {
-    cf_mesh box;
-    cf_world *w = make_world(kind, 1, 3, &box);
-    for (int k = 0; k < 20; k++)
-        step(w);
     cf_world_stats a, b;
     cf_world_stats_get(w, &a);
     double wall = 0;
@@ -191,7 +188,6 @@ static void stages_add_up(scene_kind kind)
             printf(" %s %.3g", cf_stage_name((cf_stage)i), d);
     }
     printf("; stages add up to %.5f of it\n", sum / wall);
-    assert_true(fabs(sum - wall) <= 0.02 * wall);
     int fracture = kind == FRACTURE || kind == FRACTURE_PBD;
     const cf_stage ran[] = {fracture ? CF_STAGE_ELASTICITY : CF_STAGE_RIGID_STEP,
                             CF_STAGE_BOOKKEEPING};
@@ -201,6 +197,26 @@ static void stages_add_up(scene_kind kind)
         for (int i = CF_STAGE_COLLISION; i <= CF_STAGE_VELOCITY_UPDATE; i++)
             if (i != CF_STAGE_PBD_PROJECTION || kind != FRACTURE)
                 assert_true(b.stage[i] > a.stage[i]);
+    return fabs(sum - wall) / wall;
+}
+
+/* The stages' timers add up to the step's wall time within 2 %.  A try is
+ * 5 ms of wall time, so one preemption of the process between two stages on
+ * a loaded host shows as a quarter of it untimed; such a try is repeated,
+ * up to five tries.  Work outside every stage is in every try, so it still
+ * fails. */
+static void stages_add_up(scene_kind kind)
+{
+    cf_mesh box;
+    cf_world *w = make_world(kind, 1, 3, &box);
+    for (int k = 0; k < 20; k++)
+        step(w);
+    double best = 1;
+    for (int t = 0; t < 5 && best > 0.02; t++) {
+        double share = untimed_share(w, kind);
+        best = share < best ? share : best;
+    }
+    assert_true(best <= 0.02);
     cf_world_destroy(w);
 }
 
