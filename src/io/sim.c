@@ -180,8 +180,11 @@ static cf_status write_rest_mesh(cf_sim *sim, const cf_scene *sc, cf_error *err)
     if (st == CF_OK)
         st = cf_h5_write_rest_mesh(sim->h5, X, nn, sim->rest_tets, nt, err);
     cf_visual vis = {0}; /* the bodies' finer surfaces, riding on the rest tets */
+    cf_world_stats ws;
+    cf_world_stats_get(w, &ws);
     if (st == CF_OK)
-        st = cf_visual_embed(&sc->world, sc->sources, &sim->meshes, X, nn, sim->rest_tets, nt, &vis, err);
+        st = cf_visual_embed(&sc->world, sc->sources, &sim->meshes, X, nn, sim->rest_tets, nt,
+                             ws.threads, &vis, err);
     if (st == CF_OK && vis.n_triangles > 0)
         st = cf_h5_write_visual(sim->h5, vis.vertices, vis.n_vertices, vis.triangles, vis.tet,
                                 vis.n_triangles, err);

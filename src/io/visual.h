@@ -26,12 +26,13 @@ typedef struct cf_visual {
  * as def places the bodies and embedded in the rest
  * mesh X [nn][3], tets [nt][4] (the world's, after renumbering).
  * `meshes`: the bodies' meshes as loaded (file units), for the placement.
+ * `threads`: the OpenMP threads the embedding may use (the run's, >= 1).
  * An empty result when no body has one.  Errors: those of cf_surface_load
  * (the message names the body), CF_ERR_NOMEM. */
 cf_status cf_visual_embed(const cf_world_def *def, const cf_body_source *src,
                           const cf_world_meshes *meshes,
-                          const double *X, int nn, const int *tets, int nt, cf_visual *out,
-                          cf_error *err);
+                          const double *X, int nn, const int *tets, int nt, int threads,
+                          cf_visual *out, cf_error *err);
 void cf_visual_free(cf_visual *v);
 
 #endif
