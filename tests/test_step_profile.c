@@ -212,10 +212,8 @@ static void stages_add_up(scene_kind kind)
     for (int k = 0; k < 20; k++)
         step(w);
     double best = 1;
-    for (int t = 0; t < 5 && best > 0.02; t++) {
-        double share = untimed_share(w, kind);
-        best = share < best ? share : best;
-    }
+    for (int t = 0; t < 5 && best > 0.02; t++)
+        best = fmin(best, untimed_share(w, kind));
     assert_true(best <= 0.02);
     cf_world_destroy(w);
 }

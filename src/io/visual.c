@@ -117,7 +117,7 @@ static int grid_build(grid *g, const double *X, int nn, const int *tets, int nt)
 static double inside(const grid *g, int t, const double p[3])
 {
     const double *B = &g->bary[12 * t];
-    if (B[0] != B[0])
+    if (isnan(B[0]))
         return -INFINITY;
     double r[3] = {p[0] - B[9], p[1] - B[10], p[2] - B[11]}, l[3];
     for (int j = 0; j < 3; j++)

@@ -267,8 +267,8 @@ def main():
         return runs, t, twice, conv
 
     try:  # the diameters walk side by side, sharing the pool's workers
-        walked = dict(zip(DIAMETERS, concurrent.futures.ThreadPoolExecutor(len(DIAMETERS)).map(
-            walk, DIAMETERS)))
+        with concurrent.futures.ThreadPoolExecutor(len(DIAMETERS)) as walkers:
+            walked = dict(zip(DIAMETERS, walkers.map(walk, DIAMETERS)))
     except (RuntimeError, OSError, KeyError) as e:
         print(f"fragmentation.py: {e}", file=sys.stderr)
         return 2
