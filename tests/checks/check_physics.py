@@ -102,8 +102,9 @@ def read(path):
 def check_file(path, quiet=False, figures=None):
     """Checks one output; True when all pass.  figures, a dict, receives the
     ledger residual as a share of the input ("residual_share"), the fastest
-    fragment and its bound ("fastest", "speed_bound", m/s) and the names of
-    the checks that failed ("failed")."""
+    fragment and its bound ("fastest", "speed_bound", m/s), the largest
+    kinetic energy and the input at that frame ("kinetic", "kinetic_input",
+    J) and the names of the checks that failed ("failed")."""
     scene, p, o, pos, vel = read(path)
     g = gravity_of(scene)
     gn = float(np.linalg.norm(g))
@@ -155,6 +156,9 @@ def check_file(path, quiet=False, figures=None):
     if figures is not None:
         figures["residual_share"] = resid / input_ref
         figures["fastest"], figures["speed_bound"] = v_max, v_bound
+        k = int(np.argmax(ke)) if len(ke) else None
+        figures["kinetic"] = float(ke[k]) if k is not None else 0.0
+        figures["kinetic_input"] = float(input_e[k]) if k is not None else 0.0
         figures["failed"] = [name for name, good, _ in checks if not good]
     ok = all(c[1] for c in checks)
     if not quiet or not ok:
