@@ -37,9 +37,10 @@ run: meshes
 	-$(BUILD)/cohfrac blender-setup
 
 # The source chapter's fracture figures (Fig 6.3, 6.11-6.14) at their
-# defaults, checked against what the chapter's text says each shows: the
-# table in docs/scenes.md and the sheet docs/images/figures.png
-# (tools/figures.py; exit 1 while an outcome does not hold).
+# defaults with the strength seeds 1-3, checked against what the chapter's
+# text says each shows: the table in docs/scenes.md and the sheet
+# docs/images/figures.png (tools/figures.py; exit 1 while an outcome does
+# not hold for every seed).
 figures: meshes
 	/usr/bin/python3 tools/figures.py $(BUILD)/cohfrac -m $(MESHES) -o $(BUILD)/figures -j $(JOBS) \
 	    --md docs/scenes.md --sheet docs/images/figures.png
