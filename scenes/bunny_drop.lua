@@ -22,12 +22,12 @@
 --   --set solver.cfl_fraction=0 --set solver.dt_fracture=5e-6
 --   --set solver.obstacle_contact="kinematic" --set solver.debris_size=0
 -- (it lands whole; scenes/source/bunny_drop.lua runs it on bunny_small).
--- Expected (2026-11-25, seed 1): 198 fragments, 3 pieces of at least 5 %
--- (23.4, 13.6, 7.8 %), 13 of at least 1 %, no chip, 0.1 % of the mass as
--- debris; 29.1 kJ go into crushing the base and 0.34 kJ into the cracks;
--- the fastest piece 5.9 m/s against the bound 8.8 m/s; about 9 s on two
--- threads.  Seeds 2 and 3 give 5 pieces (13.0, 12.5, 8.8, 6.1, 5.3 %) and
--- 3 (18.2, 10.2, 9.4 %).
+-- Expected (2026-11-29, seed 1): 188 fragments, 3 pieces of at least 5 %
+-- (19.6, 14.6, 10.0 %), 11 of at least 1 %, no chip, 0.1 % of the mass as
+-- debris; 26.6 kJ go into crushing the base and 0.33 kJ into the cracks;
+-- the fastest piece 5.9 m/s against the bound 9.9 m/s; about 8 s on two
+-- threads.  Seeds 2 and 3 give 4 pieces (11.9, 10.0, 6.9, 5.0 %) and
+-- 3 (11.1, 9.5, 7.2 %).
 return {
   name = "bunny_drop",
   duration = 0.6,               -- 0.15 s after the impact
