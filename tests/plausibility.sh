@@ -27,32 +27,34 @@ trap 'rm -rf "$tmp"' EXIT
 find "$scenes" -name '*.lua' | sort >"$tmp/list"
 count=$(wc -l <"$tmp/list")
 
-# one I SCENE: run and check scene number I; its report line goes to
-# $tmp/report.I, and $tmp/fail.I exists when it is not as expected.
+# one N SCENE: run and check scene number N; its report line goes to
+# $tmp/report.N, and $tmp/fail.N exists when it is not as expected.
+# (Each lane is a subshell of its own, so the functions' variables are the
+# lane's.)
 one() {
-    i=$1
+    n=$1
     scene=$2
     rel=${scene#"$scenes"/}
-    out=$tmp/out.$i
+    out=$tmp/out.$n
     set -- $(sed -n 's/^-- plausibility: *//p' "$scene" | head -n 1)
     start=$(date +%s)
     "$exe" run "$scene" --mesh-dir "$meshes" -q -t 1 -o "$out.h5" "$@" >"$out.log" 2>&1 </dev/null
     rc=$?
     secs=$(($(date +%s) - start))
     if [ "$rc" -ne 0 ]; then
-        { echo "FAIL  exit $rc  $rel"; sed 's/^/      /' "$out.log" | tail -n 5; } >"$tmp/report.$i"
-        : >"$tmp/fail.$i"
+        { echo "FAIL  exit $rc  $rel"; sed 's/^/      /' "$out.log" | tail -n 5; } >"$tmp/report.$n"
+        : >"$tmp/fail.$n"
         return
     fi
     /usr/bin/python3 "$here/checks/check_physics.py" "$out.h5" >"$out.check" 2>&1
     failed=$(sed -n 's/^  FAIL  \([a-z]*\).*/\1/p' "$out.check" | sort | tr '\n' ' ')
     expected=$(awk -v s="$rel" '$1 == s {print $2}' "$known" | sort | tr '\n' ' ')
     if [ "$failed" = "$expected" ]; then
-        echo "ok    ${secs}s  $rel${expected:+  (known: $expected)}" >"$tmp/report.$i"
+        echo "ok    ${secs}s  $rel${expected:+  (known: $expected)}" >"$tmp/report.$n"
     else
         { echo "FAIL  ${secs}s  $rel: failed [${failed}], known [${expected}]"
-          sed 's/^/      /' "$out.check"; } >"$tmp/report.$i"
-        : >"$tmp/fail.$i"
+          sed 's/^/      /' "$out.check"; } >"$tmp/report.$n"
+        : >"$tmp/fail.$n"
     fi
     rm -f "$out.h5" "$out.xdmf"
 }
