@@ -126,6 +126,8 @@ def check_file(path, quiet=False, figures=None):
     input_ref = float(np.max(np.maximum(input_e, 1e-300)))
     ke = o["energy_kinetic"]
     ke_excess = float(np.max(ke - input_e)) if len(ke) else 0.0
+    k = int(np.argmax(ke)) if len(ke) else None  # the frame of the largest kinetic energy
+    ke_max, ke_max_input = (float(ke[k]), float(input_e[k])) if k is not None else (0.0, 0.0)
     dissipated = [d for d in (o["energy_cohesive_dissipated"], o["energy_plastic_dissipated"])
                   if len(d)]
     diss_min = min((float(np.min(d)) for d in dissipated), default=0.0)
@@ -141,8 +143,8 @@ def check_file(path, quiet=False, figures=None):
          f"fastest fragment at the end {v_max:.4g} m/s <= {v_bound:.4g} m/s "
          f"(1.1 (v0 {v0:.3g} + 2U {2 * U:.3g} + sqrt(2 g H), H {H:.3g} m, + v_r {v_r:.3g}))"),
         ("energy", ke_excess <= tol,
-         f"kinetic energy <= input at every frame (largest {float(np.max(ke)) if len(ke) else 0:.4g} J "
-         f"against {float(input_e[int(np.argmax(ke))]) if len(ke) else 0:.4g} J then)"),
+         f"kinetic energy <= input at every frame (largest {ke_max:.4g} J "
+         f"against {ke_max_input:.4g} J then)"),
         ("dissipation", diss_min >= -tol and diss_drop <= tol,
          f"cohesive and plastic dissipation never negative (min {diss_min:.3g} J) and never fall "
          f"(largest fall {max(diss_drop, 0):.3g} J)"),
@@ -156,9 +158,7 @@ def check_file(path, quiet=False, figures=None):
     if figures is not None:
         figures["residual_share"] = resid / input_ref
         figures["fastest"], figures["speed_bound"] = v_max, v_bound
-        k = int(np.argmax(ke)) if len(ke) else None
-        figures["kinetic"] = float(ke[k]) if k is not None else 0.0
-        figures["kinetic_input"] = float(input_e[k]) if k is not None else 0.0
+        figures["kinetic"], figures["kinetic_input"] = ke_max, ke_max_input
         figures["failed"] = [name for name, good, _ in checks if not good]
     ok = all(c[1] for c in checks)
     if not quiet or not ok:
