@@ -56,12 +56,13 @@ while IFS= read -r scene; do
     rc=$?
     partial=""
     if [ "$rc" -eq 124 ] && [ -f "$tmp/run.h5" ]; then
-        # "<time reached> <fragments then>" from the last flushed frame.
+        # "<time reached> <fragments then> <tets of the first body>" from
+        # the last flushed frame (the summary, with the mesh line, never came).
         partial=$(/usr/bin/python3 -c '
 import sys, h5py
 f = h5py.File(sys.argv[1], "r")
 o = f["observables/fragment_count"]
-print("%g %d" % (o["time"][-1], o["value"][-1]))' "$tmp/run.h5" 2>/dev/null)
+print("%g %d %d" % (o["time"][-1], o["value"][-1], f["fragments/n_tets"][0]))' "$tmp/run.h5" 2>/dev/null)
     fi
     # "fastest / bound|kinetic / input|residual|failed checks" from the output.
     phys=""
@@ -113,6 +114,7 @@ EOF
             set -- $partial
             sim="$1 s reached"
             frag="$2 (then)"
+            tets="$3"
         fi
         wall="> $tmo s"
     else
