@@ -15,8 +15,10 @@ that stops inside a piece.  Printed for each file: the largest piece's
 share of the mass, then for the elements between pieces, inside a piece
 and inside the largest piece, their number, their facet area (m^2,
 /cracks/area at the last frame) and the share of them whose node pairs
-have all failed (/cracks/failed).  Elements matched farther than a tenth
-of the mesh's median edge from any face are left out and counted.
+have all failed (/cracks/failed), and how many still hold.  An element
+between pieces that still holds would be a bond the hand-off cut (§9).
+Elements matched farther than a hundredth of the mesh's median edge from
+any face are left out and counted.
 
 docs/physics.md §14.53 reads it.  Exit status: 0 done, 2 a file that is
 not a run with cracks and fields (the message names it and what to set).
@@ -69,7 +71,7 @@ def census(path):
         es = [e for e, i in first_row.items() if ct[i] == T]
         dist, ix = cKDTree(np.array(cents)).query(centroid[[first_row[e] for e in es]])
         for e, j, dd in zip(es, ix, dist):
-            if dd > 0.1 * edge:
+            if dd > 0.01 * edge:
                 far += 1
             else:
                 facet_of[e] = keys[j]
@@ -85,7 +87,7 @@ def census(path):
         if fa == fb == largest:
             groups["inside the largest piece"].append(rec)
     out = [f"{path}: largest piece {100 * share[largest]:.1f} %, {len(first_row)} cohesive "
-           f"elements, {far} left out (matched farther than {0.1 * edge * 1e3:.2g} mm)"]
+           f"elements, {far} left out (matched farther than {0.01 * edge * 1e3:.2g} mm)"]
     for name, recs in groups.items():
         if not recs:
             out.append(f"  {name}: none")
@@ -93,7 +95,8 @@ def census(path):
         ar = np.array([r[0] for r in recs])
         fl = np.array([r[1] for r in recs])
         out.append(f"  {name}: {len(recs)} elements, {ar.sum():.4f} m^2, "
-                   f"{100 * fl.mean():.1f} % failed ({ar[fl].sum():.4f} m^2)")
+                   f"{100 * fl.mean():.1f} % failed ({ar[fl].sum():.4f} m^2), "
+                   f"{np.count_nonzero(~fl)} still holding")
     return out
 
 
