@@ -23,11 +23,15 @@ any face are left out and counted.
 docs/physics.md §14.53 reads it.  Exit status: 0 done, 2 a file that is
 not a run with cracks and fields (the message names it and what to set).
 """
+import os
 import sys
 
 import h5py
 import numpy as np
 from scipy.spatial import cKDTree
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "checks"))
+from fragment_stats import rest_partition, tet_volumes  # noqa: E402
 
 FACES = ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3))
 
@@ -35,20 +39,17 @@ FACES = ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3))
 def census(path):
     """The census of one run file, as lines of text.  Raises KeyError where
     a dataset is missing."""
+    X, tets, frag = rest_partition(path)
     with h5py.File(path, "r") as f:
-        tets = f["mesh/rest/tets"][:]
-        X = f["mesh/rest/nodes"][:]
-        frag = f["mesh/tet_fragment/value"][-1]
         ct, el = f["cracks/time"][:], f["cracks/element"][:]
         centroid, area = f["cracks/centroid"][:], f["cracks/area"][:]
         failed = f["cracks/failed"][:]
         ft, ftet = f["fracture_mode/time"][:], f["fracture_mode/tet"][:]
         corners = f["fracture_mode/corners"][:].reshape(-1, 4, 3)
-    a, b, c, d = (X[tets[:, k]] for k in range(4))
-    vol = np.abs(np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a)) / 6
+    vol = tet_volumes(X, tets)
     share = np.bincount(frag, weights=vol) / vol.sum()
     largest = int(np.argmax(share))
-    edge = np.median(np.linalg.norm(b - a, axis=1))
+    edge = np.median(np.linalg.norm(X[tets[:, 1]] - X[tets[:, 0]], axis=1))
     # facet (sorted rest vertices) -> its tets
     tets_of = {}
     for t, tt in enumerate(tets):

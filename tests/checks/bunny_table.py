@@ -105,10 +105,8 @@ def partition(h5):
     """The run's rest tets at its last frame: centroids (m), volume shares
     and fragment ids, with a k-d tree of the centroids."""
     X, T, frag = fragment_stats.rest_partition(h5)
-    P = X[T]
-    vol = np.abs(np.einsum("ij,ij->i", np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]),
-                           P[:, 3] - P[:, 0])) / 6
-    cen = P.mean(axis=1)
+    vol = fragment_stats.tet_volumes(X, T)
+    cen = X[T].mean(axis=1)
     return cen, vol / vol.sum(), frag, scipy.spatial.cKDTree(cen)
 
 

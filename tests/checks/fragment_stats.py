@@ -53,6 +53,14 @@ def parted_area(X, T, frag):
     return float(0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1).sum())
 
 
+def tet_volumes(X, T):
+    """The rest volume (m^3) of each Tet4: X (n, 3) rest nodes (m), T (t, 4)
+    tets (node indices); (t,)."""
+    P = X[T]
+    return np.abs(np.einsum("ij,ij->i", np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]),
+                            P[:, 3] - P[:, 0])) / 6
+
+
 def rest_partition(path):
     """The rest mesh and each tet's fragment at the last frame: X (m), T, frag."""
     with h5py.File(path, "r") as f:
