@@ -91,6 +91,17 @@ static void test_api_world_equals_lua_scene(void **state)
      * initial body at create, drained here with the first step's). */
     assert_int_equal(inserted, cf_world_cohesive_count(w));
     cf_crack_row row;
+    assert_true(inserted > 0);
+    for (int e = 0; e < inserted; e++) { /* each lies on the face its two tets share */
+        assert_int_equal(cf_world_crack(w, e, &row), 0);
+        int a[4], b[4], shared = 0;
+        assert_int_equal(cf_world_rest_tet(w, row.tets[0], a), 0);
+        assert_int_equal(cf_world_rest_tet(w, row.tets[1], b), 0);
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < 4; j++)
+                shared += a[i] == b[j];
+        assert_int_equal(shared, 3);
+    }
     assert_int_equal(cf_world_crack(w, inserted, &row), -1); /* past the end: refused */
     assert_int_equal(cf_world_crack(w, -1, &row), -1);
     assert_true(row.area == 0 && row.element == 0);

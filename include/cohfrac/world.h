@@ -393,6 +393,8 @@ typedef struct cf_crack_row {
     double opening;          /* m, normal opening, mean of its three node pairs */
     double sliding;          /* m, tangential opening, the same mean */
     int failed;              /* 1: every node pair has failed (a free crack face) */
+    int tets[2];             /* the tets on sides A and B, indices of the mesh's tets:
+                                the facet the element lies on */
 } cf_crack_row;
 
 /* Number of cohesive elements, and element e's state: 0, or -1 with *out

@@ -427,13 +427,13 @@ cf_status cf_world_create(const cf_world_def *def, cf_world **out, cf_error *err
     if (st == CF_OK)
         st = load_bodies(def, &all, &body, &bc, err);
     if (st == CF_OK) {
-        int *user = malloc((size_t)all.n_tets * sizeof(int));
+        w->user_of_tet = malloc((size_t)all.n_tets * sizeof(int));
         w->tet_of_user = malloc((size_t)all.n_tets * sizeof(int));
-        if (!user || !w->tet_of_user || cf_renumber_locality(&all, bc, body, user))
+        if (!w->user_of_tet || !w->tet_of_user ||
+            cf_renumber_locality(&all, bc, body, w->user_of_tet))
             st = cf_error_set(err, CF_ERR_NOMEM, "out of memory renumbering %d tets", all.n_tets);
         for (int t = 0; st == CF_OK && t < all.n_tets; t++)
-            w->tet_of_user[user[t]] = t;
-        free(user);
+            w->tet_of_user[w->user_of_tet[t]] = t;
     }
     if (st == CF_OK) {
         st = cf_solid_init(&w->solid, &all, &scene->material, body, err);
@@ -517,7 +517,7 @@ void cf_world_destroy(cf_world *w)
     cf_arena_free(&w->arena);
     cf_obstacles_free(&w->obs);
     free(w->obstacle_body), free(w->obstacle_moving);
-    free(w->cand.v), free(w->tet_of_user), free(w->ev);
+    free(w->cand.v), free(w->tet_of_user), free(w->user_of_tet), free(w->ev);
     free(w->touched.v), free(w->crushed.v);
     cf_bars_scratch_free(&w->bar_scratch);
     free(w->def.obstacles), free(w->def.boundaries);

@@ -58,6 +58,7 @@ struct cf_world {
     unsigned long long bullet_base; /* Bullet allocator bytes when the run was created */
     int *tet_of_user;        /* [n_tets] the solid's tet of each input tet (the solid is
                                 renumbered for locality at load: renumber.h) */
+    int *user_of_tet;        /* [n_tets] the input tet of each of the solid's */
     cf_int_list cand;        /* facets that qualify at a check (scratch of the step) */
     cf_int_list touched;     /* nodes whose star the step's insertions changed (scratch) */
     cf_int_list crushed;     /* tets the step's check crushed (scratch) */

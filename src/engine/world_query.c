@@ -331,6 +331,8 @@ int cf_world_crack(const cf_world *w, int e, cf_crack_row *r)
         return -1;
     r->time = w->t;
     r->element = e;
+    for (int side = 0; side < 2; side++)
+        r->tets[side] = w->user_of_tet[w->solid.coh[e].tet[side]];
     cf_cohesive_state(&w->solid, e, r->centroid, r->normal, &r->area, &r->opening, &r->sliding,
                       &r->failed);
     return 0;

@@ -112,10 +112,11 @@ static const column_def HANDOFF_COLUMNS[HO_COUNT] = {
 };
 
 /* "time" is last, as for the hand-offs. */
-enum { CR_ELEMENT, CR_CENTROID, CR_NORMAL, CR_AREA, CR_OPENING, CR_SLIDING, CR_FAILED, CR_TIME,
-       CR_COUNT };
+enum { CR_ELEMENT, CR_TETS, CR_CENTROID, CR_NORMAL, CR_AREA, CR_OPENING, CR_SLIDING, CR_FAILED,
+       CR_TIME, CR_COUNT };
 static const column_def CRACK_COLUMNS[CR_COUNT] = {
     {"element", 1, 1, NULL},
+    {"tets", 2, 1, NULL},
     {"centroid", 3, 0, "m"},
     {"normal", 3, 0, NULL},
     {"area", 1, 0, "m2"},
@@ -1288,13 +1289,14 @@ static cf_status add_cracks_impl(cf_h5 *h, const cf_crack_row *r, int n, cf_erro
     if (st != CF_OK || n == 0)
         return st;
     /* Column by column from the rows. */
-    int *ibuf = malloc((size_t)n * sizeof(int));
+    int *ibuf = malloc((size_t)n * 2 * sizeof(int));
     double *dbuf = malloc((size_t)n * 3 * sizeof(double));
     for (int c = 0; st == CF_OK && ibuf && dbuf && c < CR_COUNT; ++c) {
         for (int i = 0; i < n; ++i) {
             const cf_crack_row *q = &r[i];
             switch (c) {
             case CR_ELEMENT: ibuf[i] = q->element; break;
+            case CR_TETS: memcpy(&ibuf[2 * i], q->tets, 2 * sizeof(int)); break;
             case CR_FAILED: ibuf[i] = q->failed; break;
             case CR_CENTROID: memcpy(&dbuf[3 * i], q->centroid, 3 * sizeof(double)); break;
             case CR_NORMAL: memcpy(&dbuf[3 * i], q->normal, 3 * sizeof(double)); break;

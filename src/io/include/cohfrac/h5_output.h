@@ -32,7 +32,8 @@
  *              momentum_error (relative), momentum_change[3] kg m/s and
  *              angular_momentum_change[3] kg m^2/s (after - before, about the
  *              origin), handoff_loss (J)}  one row per hand-off
- *   /cracks/{element, centroid[3] m, normal[3], area m^2, opening m,
+ *   /cracks/{element, tets[2] int32 (input order: the two tets whose shared
+ *            face it lies on), centroid[3] m, normal[3], area m^2, opening m,
  *            sliding m, failed, time s}  with output.cracks: one row per
  *            cohesive element per frame (rows of a frame share its time)
  *   /fracture_mode/{tet int32 (input order), corners[4 * 3] m, stress[6] Pa
