@@ -26,6 +26,12 @@ ledger in /observables:
   complete  the last frame is at the scene's duration: a run that stopped
             early (diverged, exit 3, or interrupted) has no end to check,
             and its frames so far may all look fine.
+  bonds     (files written with output.cracks only) no cohesive element
+            that still holds lies between two fragments at the end: the
+            hand-off keeps pieces joined by an element whose node pairs
+            have not all failed as one body (docs/physics.md §9), so an
+            element whose two tets (/cracks/tets) end in different
+            fragments (/mesh/tet_fragment) has failed (/cracks/failed).
 
 Prints one line per check with the figure and its bound.  Exit status 0
 when every check of every file holds, 1 when one fails, 2 when a file
@@ -99,6 +105,21 @@ def read(path):
     return scene, p, o, pos, vel
 
 
+def bonds(path):
+    """The cohesive elements between two fragments at the end of a run, and
+    how many of them still hold: (between, holding), or None for a file
+    written without output.cracks (or before /cracks/tets)."""
+    with h5py.File(path, "r") as f:
+        if "cracks/tets" not in f or "mesh/tet_fragment/value" not in f:
+            return None
+        time = f["cracks/time"][:]
+        last = time == time.max() if len(time) else np.zeros(0, dtype=bool)
+        tets, failed = f["cracks/tets"][:][last], f["cracks/failed"][:][last]
+        frag = f["mesh/tet_fragment/value"][-1]
+    between = frag[tets[:, 0]] != frag[tets[:, 1]]
+    return int(np.count_nonzero(between)), int(np.count_nonzero(between & (failed == 0)))
+
+
 def check_file(path, quiet=False, figures=None):
     """Checks one output; True when all pass.  figures, a dict, receives the
     ledger residual as a share of the input ("residual_share"), the fastest
@@ -155,6 +176,11 @@ def check_file(path, quiet=False, figures=None):
          f"last frame at t = {t_last:.6g} s against the duration {duration:.6g} s"
          + ("" if complete else " (the run stopped early: its exit status and log say why)")),
     ]
+    held = bonds(path)
+    if held is not None:
+        checks.append(("bonds", held[1] == 0,
+                       f"{held[1]} of the {held[0]} cohesive elements between two fragments at "
+                       "the end still hold (0: the hand-off cut no bond)"))
     if figures is not None:
         figures["residual_share"] = resid / input_ref
         figures["fastest"], figures["speed_bound"] = v_max, v_bound
