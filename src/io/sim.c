@@ -789,6 +789,28 @@ static void print_memory(const cf_sim *sim, FILE *out)
     fputc('\n', out);
 }
 
+/* The cohesive elements by where they end: between two fragments or inside
+ * one, and how many of each still hold (not every node pair failed).  One
+ * between fragments that holds would be a bond the hand-off cut, which it
+ * never does (docs/physics.md §5.1). */
+static void print_cohesive(const cf_world *w, FILE *out)
+{
+    int n = cf_world_cohesive_count(w), between = 0, between_holding = 0, holding = 0;
+    for (int e = 0; e < n; e++) {
+        cf_crack_row r;
+        cf_world_crack(w, e, &r);
+        int apart = cf_world_tet_fragment(w, r.tets[0]) != cf_world_tet_fragment(w, r.tets[1]);
+        between += apart;
+        between_holding += apart && !r.failed;
+        holding += !apart && !r.failed;
+    }
+    fprintf(out, "cohesive elements  %d", n);
+    if (n > 0)
+        fprintf(out, ": %d between fragments (%d holding), %d inside one (%d holding)", between,
+                between_holding, n - between, holding);
+    fputc('\n', out);
+}
+
 void cf_sim_print_summary(const cf_sim *sim, FILE *out)
 {
     const cf_world *w = sim->world;
@@ -823,7 +845,7 @@ void cf_sim_print_summary(const cf_sim *sim, FILE *out)
         fprintf(out, "debris             %d fragments, %.4g kg (%.2f%% of the mass), spheres in "
                      "the rigid step (docs/physics.md §9.2)\n",
                 p.debris, p.debris_mass, 100 * p.debris_mass / fmax(p.mass_alive, 1e-300));
-    fprintf(out, "cohesive elements  %d\n", p.cohesive);
+    print_cohesive(w, out);
     fprintf(out, "hand-offs          %d, max linear momentum error %.3g (relative), "
                  "handoff_loss %.4g J\n",
             p.handoffs, p.max_momentum_error, p.handoff_loss);
