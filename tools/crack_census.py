@@ -26,6 +26,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "checks"))
+from check_physics import last_crack_rows  # noqa: E402
 from fragment_stats import rest_partition, tet_volumes  # noqa: E402
 
 
@@ -34,8 +35,7 @@ def census(path):
     a dataset is missing."""
     X, tets, frag = rest_partition(path)
     with h5py.File(path, "r") as f:
-        ct = f["cracks/time"][:]
-        last = ct == ct.max()
+        last = last_crack_rows(f)
         pair, area = f["cracks/tets"][:][last], f["cracks/area"][:][last]
         failed = f["cracks/failed"][:][last] > 0
     vol = tet_volumes(X, tets)

@@ -105,6 +105,13 @@ def read(path):
     return scene, p, o, pos, vel
 
 
+def last_crack_rows(f):
+    """The /cracks rows of the last frame written (one per cohesive element
+    then) in the open run file f: their indices, empty where there are none."""
+    time = f["cracks/time"][:]
+    return np.flatnonzero(time == time.max()) if len(time) else np.zeros(0, dtype=int)
+
+
 def bonds(path):
     """The cohesive elements between two fragments at the end of a run, and
     how many of them still hold: (between, holding), or None for a file
@@ -112,8 +119,7 @@ def bonds(path):
     with h5py.File(path, "r") as f:
         if "cracks/tets" not in f or "mesh/tet_fragment/value" not in f:
             return None
-        time = f["cracks/time"][:]
-        last = time == time.max() if len(time) else np.zeros(0, dtype=bool)
+        last = last_crack_rows(f)
         tets, failed = f["cracks/tets"][:][last], f["cracks/failed"][:][last]
         frag = f["mesh/tet_fragment/value"][-1]
     between = frag[tets[:, 0]] != frag[tets[:, 1]]
