@@ -112,6 +112,16 @@ def last_crack_rows(f):
     return np.flatnonzero(time == time.max()) if len(time) else np.zeros(0, dtype=int)
 
 
+def final_crack_sides(f):
+    """The /cracks rows of the last frame in the open run file f (as
+    last_crack_rows), and for each whether its element's two tets
+    (/cracks/tets) end in different fragments (/mesh/tet_fragment)."""
+    last = last_crack_rows(f)
+    tets = f["cracks/tets"][:][last]
+    frag = f["mesh/tet_fragment/value"][-1]
+    return last, frag[tets[:, 0]] != frag[tets[:, 1]]
+
+
 def bonds(path):
     """The cohesive elements between two fragments at the end of a run, and
     how many of them still hold: (between, holding), or None for a file
@@ -119,10 +129,8 @@ def bonds(path):
     with h5py.File(path, "r") as f:
         if "cracks/tets" not in f or "mesh/tet_fragment/value" not in f:
             return None
-        last = last_crack_rows(f)
-        tets, failed = f["cracks/tets"][:][last], f["cracks/failed"][:][last]
-        frag = f["mesh/tet_fragment/value"][-1]
-    between = frag[tets[:, 0]] != frag[tets[:, 1]]
+        last, between = final_crack_sides(f)
+        failed = f["cracks/failed"][:][last]
     return int(np.count_nonzero(between)), int(np.count_nonzero(between & (failed == 0)))
 
 

@@ -23,7 +23,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from check_physics import bonds, last_crack_rows  # noqa: E402
+from check_physics import bonds, final_crack_sides  # noqa: E402
 
 
 def main(exe, meshes, scene, out):
@@ -52,10 +52,8 @@ def main(exe, meshes, scene, out):
     broken = os.path.join(out, "handoff_bonds_cut.h5")
     shutil.copyfile(run, broken)
     with h5py.File(broken, "r+") as f:
-        last = last_crack_rows(f)
-        tets = f["cracks/tets"][:][last]
-        frag = f["mesh/tet_fragment/value"][-1]
-        f["cracks/failed"][last[frag[tets[:, 0]] != frag[tets[:, 1]]][0]] = 0
+        last, between = final_crack_sides(f)
+        f["cracks/failed"][last[between][0]] = 0
     between, holding = bonds(broken)
     report(holding == 1, f"with one of them marked holding, bonds counts {holding} holding (1)")
     os.remove(broken)
