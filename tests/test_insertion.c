@@ -859,7 +859,7 @@ static void test_fronts_close_no_small_piece(void **state)
         for (int t = 0; t < s.n_tets; t++) /* hydrostatic tension: every normal */
             s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
         cf_growth g = {rule == 0 ? CF_GROWTH_ALL : CF_GROWTH_FRONTS, INFINITY, 4,
-                       rule == 2 ? two_cells : 0, 0, 0, 0, 0, 0};
+                       rule == 2 ? two_cells : 0, 0, 0, 0, 0, 0, 0};
         cracked[rule] = grow(&s, all, g, 1.0, 200);
         least[rule] = smallest_closed_piece(&s, &least_vol[rule]);
         free(all);
@@ -902,7 +902,7 @@ static void test_contact_memo_changes_nothing(void **state)
             if (scene == 0)
                 for (int t = 0; t < s.n_tets; t++)
                     s.sigma[9 * t] = s.sigma[9 * t + 4] = s.sigma[9 * t + 8] = 10.0;
-            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0, 0, 0, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, scene == 0 ? INFINITY : 10.0, 4, 0, 0, 0, 0, 0, 0, 0};
             n[forget] = grow_memo(&s, all, g, scene == 0 ? 1.0 : 0.01, 200, forget);
             nf = s.n_facets;
             cracked[forget] = malloc((size_t)nf), when[forget] = malloc((size_t)nf * sizeof(double));
@@ -939,7 +939,7 @@ static void test_front_moves_no_faster_than_its_speed(void **state)
     cf_solid s;
     int *all = stressed_box(&s, &m, 1.4, 1.0, 100.0);
     double speed = 10.0, dt = 0.01, cell = sqrt(3.0);
-    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, speed, 0, 0, 0, 0, 0, 0, 0, 0};
     cf_int_list cand = {0}, nodes = {0}, touched = {0};
     double first[3] = {0, 0, 0}, worst = -INFINITY;
     int nuclei = 0, total = 0;
@@ -1099,7 +1099,7 @@ static void test_fronts_do_not_branch(void **state)
     cf_mark_cracked(&s, f1, 1);
     s.crack_time[f1] = -1e9;
     assert_int_equal(cracked_on_edge(&s, e[0], e[1]), 2);
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, 0, 0, 0, 0};
     cf_int_list cand = {0};
     int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_TRACTION, s.n_tets, NULL, &cand);
     assert_true(n > 0);
@@ -1142,7 +1142,7 @@ static int *box_with_crack(cf_mesh *m, cf_solid *s, double sy)
  * when `along`); the facets taken, in cand. */
 static int check_fronts(cf_solid *s, const int *all, int along, cf_int_list *cand)
 {
-    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along, 0, 0, 0};
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, along, 0, 0, 0, 0};
     int n = cf_insertion_candidates(s, all, s->n_tets, CF_CRITERION_SOURCE, s->n_tets, &g, cand);
     return n > 0 ? cf_insertion_select(s, cand, CF_CRITERION_SOURCE, &g) : n;
 }
@@ -1237,7 +1237,7 @@ static void test_fronts_kink_no_further_than_the_limit(void **state)
         cf_mesh m;
         cf_solid s;
         int *all = box_with_crack(&m, &s, 1.35), f0 = middle_facet(&s);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, limit ? acos(-1.0) / 4 : 0, 0, 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 0, limit ? acos(-1.0) / 4 : 0, 0, 0, 0};
         cf_int_list cand = {0};
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
                                         &cand);
@@ -1273,6 +1273,27 @@ static int copies_of(const cf_solid *s, int o)
     return n;
 }
 
+/* The facet on the plane y = 0.5 nearest the centre of fixture_box's unit
+ * box. */
+static int central_facet(const cf_solid *s)
+{
+    int f0 = -1;
+    double best = INFINITY;
+    for (int f = 0; f < s->n_facets; f++) {
+        int o[3];
+        facet_vertices(s, f, o);
+        double d = 0;
+        for (int k = 0; k < 3; k++) {
+            double c = (s->X[3 * o[0] + k] + s->X[3 * o[1] + k] + s->X[3 * o[2] + k]) / 3 - 0.5;
+            d += c * c;
+        }
+        if (fabs(facet_normal_y(s, f)) == 1 && d < best)
+            best = d, f0 = f;
+    }
+    assert_true(f0 >= 0);
+    return f0;
+}
+
 /* A front splits the vertices behind it along its plane
  * (solver.front_split "plane", docs/physics.md §5.1 rule 3).  In the box
  * under a uniaxial tension along y of 1.5 thresholds, a crack of one
@@ -1296,23 +1317,10 @@ static void test_front_split_opens_the_crack_to_its_front(void **state)
         cf_mesh m;
         cf_solid s;
         fixture_box(&m, 4, 4, 4, 1, 1, 1);
-        int *all = stressed_box(&s, &m, 1.35, 1.0, 1e9), f0 = -1, o0[3];
-        double best = INFINITY; /* the facet on y = 0.5 nearest the centre */
-        for (int f = 0; f < s.n_facets; f++) {
-            int o[3];
-            facet_vertices(&s, f, o);
-            double d = 0;
-            for (int k = 0; k < 3; k++) {
-                double c = (s.X[3 * o[0] + k] + s.X[3 * o[1] + k] + s.X[3 * o[2] + k]) / 3 - 0.5;
-                d += c * c;
-            }
-            if (fabs(facet_normal_y(&s, f)) == 1 && d < best)
-                best = d, f0 = f;
-        }
-        assert_true(f0 >= 0);
+        int *all = stressed_box(&s, &m, 1.35, 1.0, 1e9), f0 = central_facet(&s), o0[3];
         old_crack(&s, f0);
         facet_vertices(&s, f0, o0);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, split > 0, split == 2 ? 0.05 : 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, split > 0, split == 2 ? 0.05 : 0, 0};
         cf_int_list cand = {0}, nodes = {0}, touched = {0};
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
                                         &cand);
@@ -1341,6 +1349,104 @@ static void test_front_split_opens_the_crack_to_its_front(void **state)
      * it on cells of 0.25 m: a reach of 0.05 m takes none of them */
     assert_int_equal(taken[2], taken[0]);
     assert_int_equal(parted[2], 0);
+}
+
+/* A front's vertex ahead moves onto the plane across the tension
+ * (solver.front_snap "stress", docs/physics.md §5.1 rule 3).  In a box of
+ * 6^3 cells under a uniaxial tension along d = (0, cos 0.3, sin 0.3), 1.8
+ * times the strength, stretched uniformly by A (x = A X) and moving with a
+ * non-uniform velocity, a crack of one facet on y = 0.5 at the centre
+ * grows in one check by fronts across the tension.  Each vertex that
+ * moves is the vertex ahead of a facet taken, and its distance from the
+ * plane through that facet's front edge with rest normal A^T d (the
+ * tension's normal pulled back) falls to 0, a half or three quarters of
+ * what it was (the whole move, or half or a quarter of it); every tet
+ * keeps the gradient A to round-off (the current position moves by A
+ * times the rest shift), and the mass, the volume and the momentum are
+ * unchanged to round-off.  The step's least height is halved, as on a
+ * mesh whose worst tet lies elsewhere: on this box every tet sets it. */
+static void test_front_snap_moves_the_vertex_onto_the_plane(void **state)
+{
+    (void)state;
+    cf_mesh m;
+    cf_solid s;
+    fixture_box(&m, 6, 6, 6, 1, 1, 1);
+    int *all = stressed_box(&s, &m, 0, 1.0, 1e9), f0 = -1;
+    double d[3] = {0, cos(0.3), sin(0.3)}, sig = 1.8;
+    double A[9] = {1.0005, 0.0002, 0, 0, 1.001, 0.0007, 0.0001, 0, 0.9995};
+    for (int t = 0; t < s.n_tets; t++)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                s.sigma[9 * t + 3 * i + j] = sig * d[i] * d[j];
+    for (int i = 0; i < s.n_nodes; i++)
+        m3_mulv(A, &s.X[3 * i], &s.x[3 * i]);
+    s.dt_cfl *= 0.5;
+    double P0[3], M0, V0 = 0, u0[3];
+    f0 = central_facet(&s);
+    old_crack(&s, f0);
+    momentum(&s, P0, &M0);
+    for (int t = 0; t < s.n_tets; t++)
+        V0 += s.vol[t];
+    double *X0 = malloc((size_t)s.n_nodes * 3 * sizeof(double));
+    memcpy(X0, s.X, (size_t)s.n_nodes * 3 * sizeof(double));
+    for (int k = 0; k < 3; k++) /* the rest normal of the tension's planes */
+        u0[k] = A[k] * d[0] + A[3 + k] * d[1] + A[6 + k] * d[2];
+    cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, 0, 0, 1};
+    cf_int_list cand = {0};
+    int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g, &cand);
+    n = n > 0 ? cf_insertion_select(&s, &cand, CF_CRITERION_SOURCE, &g) : n;
+    assert_true(n >= 1);
+    int moved = 0, whole = 0, onto = 0;
+    for (int c = 0; c < s.n_verts0; c++) {
+        double sh[3];
+        v3_sub(&s.X[3 * c], &X0[3 * c], sh);
+        if (v3_norm(sh) == 0)
+            continue;
+        moved++;
+        for (int i = 0, found = 0; i < n && !found; i++) { /* the facet it is ahead of */
+            int o[3], a = 0;
+            facet_vertices(&s, cand.v[i], o);
+            while (a < 3 && o[a] != c)
+                a++;
+            if (a == 3)
+                continue;
+            int e0 = o[(a + 1) % 3], e1 = o[(a + 2) % 3];
+            double e[3], u[3], r0[3], r1[3];
+            v3_sub(&s.X[3 * e1], &s.X[3 * e0], e);
+            memcpy(u, u0, sizeof u);
+            v3_axpy(-v3_dot(u, e) / v3_dot(e, e), e, u);
+            v3_sub(&X0[3 * c], &s.X[3 * e0], r0), v3_sub(&s.X[3 * c], &s.X[3 * e0], r1);
+            double q = v3_dot(r1, u) / v3_dot(r0, u);
+            found = fabs(q) < 1e-9 || fabs(q - 0.5) < 1e-9 || fabs(q - 0.75) < 1e-9;
+            onto += found, whole += found && fabs(q) < 1e-9;
+        }
+    }
+    double worst = 0, P[3], M, V = 0;
+    for (int t = 0; t < s.n_tets; t++) {
+        const int *C = &s.tet[4 * t];
+        double Ds[9], F[9];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                Ds[3 * r + c] = s.x[3 * C[c + 1] + r] - s.x[3 * C[0] + r];
+        m3_mul(Ds, &s.Dm_inv[9 * t], F);
+        for (int k = 0; k < 9; k++)
+            worst = fmax(worst, fabs(F[k] - A[k]));
+        V += s.vol[t];
+    }
+    momentum(&s, P, &M);
+    printf("FIGURE front snap: %d facets taken, %d vertices moved, %d towards their plane "
+           "(%d the whole way); largest |F - A| %.2e; mass %.2e, volume %.2e, momentum %.2e "
+           "apart\n",
+           n, moved, onto, whole, worst, fabs(M - M0) / M0, fabs(V - V0) / V0,
+           fabs(P[0] - P0[0]) + fabs(P[1] - P0[1]) + fabs(P[2] - P0[2]));
+    assert_true(moved >= 1);
+    assert_int_equal(onto, moved);
+    assert_true(worst < 1e-12);
+    assert_true(fabs(M - M0) < 1e-12 * M0 && fabs(V - V0) < 1e-12 * V0);
+    for (int k = 0; k < 3; k++)
+        assert_true(fabs(P[k] - P0[k]) < 1e-12 * (fabs(P0[0]) + fabs(P0[1]) + fabs(P0[2])));
+    free(X0), free(cand.v), free(all);
+    cf_solid_free(&s), cf_mesh_free(&m);
 }
 
 /* A front's rank reads only this check's nodal values (facet_ratio): a
@@ -1460,7 +1566,7 @@ static void test_front_threshold_from_a_penny_crack(void **state)
     for (int round = 0; round < 3; round++) {
         unsigned char *before = malloc((size_t)s.n_facets);
         memcpy(before, s.cracked, (size_t)s.n_facets);
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0, 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0, 0, 0};
         cf_int_list cand = {0};
         memset(s.hot, 1, (size_t)s.n_tets);
         int n = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets, &g,
@@ -1547,7 +1653,7 @@ static void test_values_exact_from_the_floor_take_the_same_facets(void **state)
             cf_mesh m;
             cf_solid s;
             int *all = weibull_box_with_crack(&s, &m, strength);
-            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, 0, 0};
+            cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 0.0, 1, 0, 0, 0, 0};
             cf_int_list cand = {0};
             int nc = cf_insertion_candidates(&s, all, s.n_tets, CF_CRITERION_SOURCE, s.n_tets,
                                              exact_from_floor ? &g : NULL, &cand);
@@ -1598,7 +1704,7 @@ static int checks_with_floors(int weibull, double strength, double K, int floors
         cf_insertion_init_front_floors(&s);
     int cooler = 0;
     for (int round = 0; round < 3; round++) {
-        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0, 0};
+        cf_growth g = {CF_GROWTH_FRONTS, 1e-6, 0, 0, 1e9 * (round + 1), 1, 0, 0, 0, 0};
         cf_stress_check bound = cf_insertion_bound(&s, CF_CRITERION_SOURCE);
         int n_hot = s.n_tets;
         if (floors && weibull) /* the kernel's flags */
@@ -1810,6 +1916,7 @@ int main(void)
         cmocka_unit_test(test_fronts_run_across_the_tension),
         cmocka_unit_test(test_fronts_kink_no_further_than_the_limit),
         cmocka_unit_test(test_front_split_opens_the_crack_to_its_front),
+        cmocka_unit_test(test_front_snap_moves_the_vertex_onto_the_plane),
         cmocka_unit_test(test_values_exact_from_the_floor_take_the_same_facets),
         cmocka_unit_test(test_front_rank_reads_this_check_only),
         cmocka_unit_test(test_front_threshold_from_the_toughness),

@@ -155,6 +155,10 @@ typedef enum {
       CF_R_NON_NEGATIVE, "m",                                                                  \
       "a split takes no facet farther from the vertex it parts (rest centroids, "             \
       "docs/physics.md 5.1); 0 no limit")                                                      \
+    X("solver", "front_snap", ENUM, solver.front_snap, 0, NULL, cf_names_front_snap,          \
+      CF_R_NONE, "",                                                                           \
+      "fronts: move a new front facet's vertex ahead onto the plane across the largest "      \
+      "principal stress, or none (docs/physics.md 5.1)")                                      \
     X("solver", "obstacle_contact", ENUM, solver.obstacle_contact, 0, NULL,                   \
       cf_names_obstacle_contact, CF_R_NONE, "",                                                \
       "explicit runs: project nodes onto obstacles, or a penalty force (docs/physics.md 7.1)") \

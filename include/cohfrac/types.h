@@ -135,6 +135,10 @@ typedef enum { CF_FRONT_STRENGTH, CF_FRONT_TOUGHNESS, CF_FRONT_CRACK } cf_front_
  * only where cracked facets cut a vertex's star, or also the vertices
  * behind a new front facet, split along its plane. */
 typedef enum { CF_FRONT_SPLIT_NONE, CF_FRONT_SPLIT_PLANE } cf_front_split;
+/* Whether a new front facet's vertex ahead stays where the mesh has it, or
+ * moves onto the plane through the front's edge across the largest
+ * principal stress (docs/physics.md §5.1). */
+typedef enum { CF_FRONT_SNAP_NONE, CF_FRONT_SNAP_STRESS } cf_front_snap;
 /* Where a cohesive element's traction rises from zero with the capped
  * stiffness instead of starting at the strength (time continuity,
  * docs/physics.md §6): the tangential traction only, or the normal too. */
@@ -167,6 +171,7 @@ typedef struct cf_solver_settings {
     cf_front_split front_split;
     double front_split_reach;     /* m: a split takes no facet whose rest centroid lies
                                      farther from the vertex it parts; 0: no limit */
+    cf_front_snap front_snap;
     int min_piece_tets;           /* no insertion encloses a piece of at most this many
                                      tets in crack faces (fronts growth); 0: no bound */
     double min_piece_size;        /* m: nor one whose equal-volume sphere is narrower;

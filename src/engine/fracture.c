@@ -148,7 +148,8 @@ static int insertion_check(const cf_step_ctx *ctx, const cf_fragment *f, double 
     cf_growth growth = {set->crack_growth, rayleigh_speed(s), set->min_piece_tets,
                         cf_min_piece_volume(set), t,
                         set->front_direction == CF_FRONT_STRESS, kink,
-                        set->front_split == CF_FRONT_SPLIT_PLANE, set->front_split_reach};
+                        set->front_split == CF_FRONT_SPLIT_PLANE, set->front_split_reach,
+                        set->front_snap == CF_FRONT_SNAP_STRESS};
     int nc = cf_insertion_candidates(s, f->tets, f->nt, set->criterion, n_hot, &growth, ctx->cand);
     if (nc > 0)
         nc = cf_insertion_select(s, ctx->cand, set->criterion, &growth);

@@ -1097,6 +1097,56 @@ static int split_front(cf_solid *s, int f, int ta, const int o[3], const cf_grow
     return 0;
 }
 
+/* solver.front_snap "stress" (docs/physics.md §5.1 rule 3): front facet f
+ * (original vertices o, of tet ta), just taken, moves its vertex ahead,
+ * the one off the front's edge, when that vertex lies on no other crack,
+ * inside the body, onto the plane through the edge normal to the largest
+ * principal stress there (its nodal mean stress of this check, its normal
+ * pulled back to the rest shape by the star's mean gradient), as far as
+ * cf_solid_move_vertex allows: the whole way, else half or a quarter of it.
+ * The fronts the crack then has ahead of that vertex's edges read their
+ * floors from the new shape (crack_edge). */
+static void snap_front(cf_solid *s, int f, int ta, const int o[3])
+{
+    const int *K = CF_TET_FACE[s->facet[4 * f + 1]];
+    int a = 0;
+    while (a < 3 && edge_count(s, ta, K[(a + 1) % 3], K[(a + 2) % 3]) < 2)
+        a++; /* the edge another cracked facet holds */
+    if (a == 3 || s->vert_cracks[o[a]] != 1) /* f the only crack on it */
+        return;
+    int c = o[a], e0 = o[(a + 1) % 3], e1 = o[(a + 2) % 3], n = s->tet[s->vt_slot[s->vt_start[c]]];
+    for (int i = s->vt_start[c]; i < s->vt_start[c + 1]; i++)
+        for (int k = 0; k < 4; k++)
+            if (k != s->vt_slot[i] % 4 && s->facet[4 * s->tet_facet[4 * (s->vt_slot[i] / 4) + k] + 2] < 0)
+                return; /* on the surface: the body's shape stays */
+    double F[9];
+    if (s->nodal_check[n] != s->check_stamp || !cf_solid_star_gradient(s, c, F))
+        return;
+    const double *q = &s->nodal_stress[6 * n];
+    double A[9] = {q[0], q[3], q[4], q[3], q[1], q[5], q[4], q[5], q[2]}, w[3], V[9];
+    sym3_eigen(A, w, V);
+    int top = w[0] >= w[1] ? (w[0] >= w[2] ? 0 : 2) : (w[1] >= w[2] ? 1 : 2);
+    double p[3] = {V[top], V[3 + top], V[6 + top]}, u[3], e[3], d[3], to[3];
+    for (int k = 0; k < 3; k++) /* the rest normal: F^T p */
+        u[k] = F[k] * p[0] + F[3 + k] * p[1] + F[6 + k] * p[2];
+    v3_sub(&s->X[3 * e1], &s->X[3 * e0], e);
+    v3_axpy(-v3_dot(u, e) / v3_dot(e, e), e, u); /* the plane holds the edge */
+    double nu = v3_norm(u);
+    if (!(nu > 1e-9 * v3_norm(e) * v3_norm(p)))
+        return;
+    v3_sub(&s->X[3 * c], &s->X[3 * e0], d);
+    double off = v3_dot(d, u) / (nu * nu);
+    for (double frac = 1; frac > 0.2; frac *= 0.5) {
+        for (int k = 0; k < 3; k++)
+            to[k] = s->X[3 * c + k] - frac * off * u[k];
+        if (cf_solid_move_vertex(s, c, to, F, 0.5)) {
+            for (int i = 0; s->vert_front_active && i < 3; i++)
+                crack_edge(s, f, o[(i + 1) % 3], o[(i + 2) % 3], 0, 1);
+            return;
+        }
+    }
+}
+
 typedef struct {
     double ratio;
     int facet;
@@ -1181,6 +1231,8 @@ int cf_insertion_select(cf_solid *s, cf_int_list *cand, cf_criterion rule, const
             free(r);
             return -1;
         }
+        if (g->snap && contact == CF_FRONT)
+            snap_front(s, f, ta, o);
         s->qualify[ta] = s->qualify[tb] = 1;
     }
     free(r);

@@ -44,6 +44,8 @@ typedef struct cf_growth {
                               plane at once (solver.front_split "plane") */
     double split_reach;    /* m: the farthest a split's facet lies from the vertex it
                               parts (rest centroid; solver.front_split_reach); 0: any */
+    int snap;              /* a front facet's vertex ahead moves onto the plane across
+                              the largest principal stress (solver.front_snap "stress") */
 } cf_growth;
 
 /* Insertion criterion on the interior, uncracked facets of `tets` (a

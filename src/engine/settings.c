@@ -14,6 +14,7 @@ static const char *const cf_names_growth[] = {"fronts", "all", NULL};
 static const char *const cf_names_front[] = {"any", "stress", NULL};
 static const char *const cf_names_front_threshold[] = {"strength", "toughness", "crack", NULL};
 static const char *const cf_names_front_split[] = {"none", "plane", NULL};
+static const char *const cf_names_front_snap[] = {"none", "stress", NULL};
 static const char *const cf_names_time_continuity[] = {"tangential", "both", NULL};
 static const char *const cf_names_obstacle_contact[] = {"kinematic", "penalty", NULL};
 static const char *const cf_names_constraints[] = {"pbd", "xpbd", "none", NULL};
@@ -28,6 +29,7 @@ _Static_assert(CF_FRONT_ANY == 0 && CF_FRONT_STRESS == 1, "cf_names_front");
 _Static_assert(CF_FRONT_STRENGTH == 0 && CF_FRONT_TOUGHNESS == 1 && CF_FRONT_CRACK == 2,
                 "cf_names_front_threshold");
 _Static_assert(CF_FRONT_SPLIT_NONE == 0 && CF_FRONT_SPLIT_PLANE == 1, "cf_names_front_split");
+_Static_assert(CF_FRONT_SNAP_NONE == 0 && CF_FRONT_SNAP_STRESS == 1, "cf_names_front_snap");
 _Static_assert(CF_CONTINUITY_TANGENTIAL == 0 && CF_CONTINUITY_BOTH == 1,
                "cf_names_time_continuity");
 _Static_assert(CF_OBSTACLE_CONTACT_KINEMATIC == 0 && CF_OBSTACLE_CONTACT_PENALTY == 1,

@@ -614,3 +614,73 @@ int cf_solid_copy_node(cf_solid *s, int n)
     s->bc[k] = s->bc[n];
     return k;
 }
+
+int cf_solid_star_gradient(const cf_solid *s, int o, double F[9])
+{
+    int lo = s->vt_start[o], hi = s->vt_start[o + 1], n = s->tet[s->vt_slot[lo]];
+    double vsum = 0;
+    memset(F, 0, 9 * sizeof(double));
+    for (int i = lo; i < hi; i++) {
+        int t = s->vt_slot[i] / 4;
+        const int *C = &s->tet[4 * t];
+        if (C[s->vt_slot[i] % 4] != n) /* a crack parts the star */
+            return 0;
+        double Ds[9], Ft[9];
+        edge_matrix(&s->x[3 * C[0]], &s->x[3 * C[1]], &s->x[3 * C[2]], &s->x[3 * C[3]], Ds);
+        m3_mul(Ds, &s->Dm_inv[9 * t], Ft);
+        for (int k = 0; k < 9; k++)
+            F[k] += s->vol[t] * Ft[k];
+        vsum += s->vol[t];
+    }
+    for (int k = 0; k < 9; k++)
+        F[k] /= vsum;
+    return 1;
+}
+
+int cf_solid_move_vertex(cf_solid *s, int o, const double to[3], const double F[9],
+                         double least_h)
+{
+    enum { MOST = 128 };
+    int lo = s->vt_start[o], ns = s->vt_start[o + 1] - lo, n = s->tet[s->vt_slot[lo]];
+    if (ns > MOST)
+        return 0;
+    double Dinv[MOST][9], vol[MOST], hmin = s->dt_cfl * wave_speed(&s->mat);
+    for (int i = 0; i < ns; i++) {
+        int t = s->vt_slot[lo + i] / 4;
+        const int *T = &s->tet0[4 * t];
+        for (int k = 0; s->ep && k < 6; k++) /* a plastic strain holds the old shape */
+            if (s->ep[6 * t + k] != 0)
+                return 0;
+        const double *p[4], *q[4];
+        for (int j = 0; j < 4; j++)
+            p[j] = T[j] == o ? to : &s->X[3 * T[j]], q[j] = &s->X[3 * T[j]];
+        double Dm[9];
+        edge_matrix(p[0], p[1], p[2], p[3], Dm);
+        vol[i] = m3_inv(Dm, Dinv[i]) / 6.0;
+        if (!(vol[i] > 0) || tet_h(vol[i], p[0], p[1], p[2], p[3]) <
+                                 fmax(hmin, least_h * tet_h(s->vol[t], q[0], q[1], q[2], q[3])))
+            return 0;
+    }
+    double d[3], dx[3];
+    v3_sub(to, &s->X[3 * o], d);
+    m3_mulv(F, d, dx);
+    for (int k = 0; k < 3; k++) {
+        s->x[3 * n + k] += dx[k], s->p[4 * n + k] = s->x[3 * n + k];
+        s->X[3 * n + k] = s->X[3 * o + k] = to[k];
+    }
+    /* re-lumped masses (rho V / 4 of each tet), each node keeping its momentum */
+    for (int i = 0; i < ns; i++) {
+        int t = s->vt_slot[lo + i] / 4;
+        double dm = cf_tet_mass(s, t) * (vol[i] / s->vol[t] - 1) / 4;
+        for (int j = 0; j < 4; j++) {
+            int a = s->tet[4 * t + j];
+            double m0 = s->m[a];
+            s->m[a] += dm;
+            for (int k = 0; k < 3; k++)
+                s->v[3 * a + k] *= m0 / s->m[a];
+        }
+        memcpy(&s->Dm_inv[9 * t], Dinv[i], sizeof Dinv[i]);
+        s->vol[t] = vol[i];
+    }
+    return 1;
+}

@@ -268,4 +268,23 @@ double cf_solid_crack_area(const cf_solid *s);
  * or -1 when out of memory. */
 int cf_solid_copy_node(cf_solid *s, int n);
 
+/* F (row-major 3x3): the volume-weighted mean deformation gradient of the
+ * tets round original vertex o.  Returns 1, or 0 (F unset) when a crack
+ * parts its star (o has more than one copy). */
+int cf_solid_star_gradient(const cf_solid *s, int o, double F[9]);
+
+/* Move original vertex o, whose star no crack parts, to rest position
+ * `to` (m), as universal meshes move a vertex onto a crack (Rangarajan and
+ * Lew, IJNME 98:236, 2014; docs/physics.md §5.1): its current position
+ * moves by F (the star's mean gradient, cf_solid_star_gradient) times the
+ * same shift, so a uniform strain stays as it was; the star's tets take
+ * their new rest shape (Dm_inv, vol), and its nodes their re-lumped
+ * masses, each keeping its momentum (the star's volume, and the mass, do
+ * not change).  Refused (returns 0, nothing changed) when a tet of the
+ * star has a plastic strain (held in its old shape), would invert, or
+ * would be lower (twice its inradius) than the step allows (dt_cfl) or
+ * than least_h times its own height; 1 when moved. */
+int cf_solid_move_vertex(cf_solid *s, int o, const double to[3], const double F[9],
+                         double least_h);
+
 #endif

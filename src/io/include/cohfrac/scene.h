@@ -184,6 +184,11 @@
  *     front_split_reach [0] m: with "plane", a split takes no facet whose
  *       rest centroid lies farther from the vertex it parts (a length of
  *       the material, such as l_ch, where the mesh is coarser; 0: no limit)
+ *     front_snap ["none"] | "stress": with "fronts", "stress" moves the
+ *       vertex ahead of each new front facet (inside the body, on no other
+ *       crack, no crushed tet round it) onto the plane through the front's
+ *       edge across the largest principal stress there, as far as its
+ *       tets' shape allows (docs/physics.md §5.1)
  *     min_piece_tets [4] (integer >= 0): with "fronts", no insertion closes
  *       crack faces around a piece of at most this many tets (the mesh
  *       cannot resolve such a piece; 0: no bound)
