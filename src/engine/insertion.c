@@ -1127,8 +1127,7 @@ static void snap_front(cf_solid *s, int f, int ta, const int o[3])
     sym3_eigen(A, w, V);
     int top = w[0] >= w[1] ? (w[0] >= w[2] ? 0 : 2) : (w[1] >= w[2] ? 1 : 2);
     double p[3] = {V[top], V[3 + top], V[6 + top]}, u[3], e[3], d[3], to[3];
-    for (int k = 0; k < 3; k++) /* the rest normal: F^T p */
-        u[k] = F[k] * p[0] + F[3 + k] * p[1] + F[6 + k] * p[2];
+    m3_tmulv(F, p, u); /* the rest normal: F^T p */
     v3_sub(&s->X[3 * e1], &s->X[3 * e0], e);
     v3_axpy(-v3_dot(u, e) / v3_dot(e, e), e, u); /* the plane holds the edge */
     double nu = v3_norm(u);
